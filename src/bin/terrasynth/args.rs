@@ -1,0 +1,50 @@
+//! Argument pieces shared by several subcommands.
+
+use clap::Args as ClapArgs;
+use std::path::Path;
+use terrasynth::io::{self, Format, ReadOptions};
+
+/// How to read an input heightfield.
+#[derive(ClapArgs, Debug, Clone, Default)]
+pub struct Input {
+    /// Input format, when the extension does not say it.
+    #[arg(long = "in-format", value_parser = parse_format)]
+    pub format: Option<Format>,
+    /// Dimensions WxH of headerless raw input (R16/R32) without a sidecar.
+    #[arg(long = "in-size", value_parser = parse_size)]
+    pub size: Option<(usize, usize)>,
+    /// Override the input's cell size, in metres.
+    #[arg(long = "cell-size")]
+    pub cell_size: Option<f64>,
+}
+
+impl Input {
+    pub fn read(&self, path: &Path) -> Result<terrasynth::Heightfield, io::IoError> {
+        io::read(
+            path,
+            &ReadOptions {
+                format: self.format,
+                size: self.size,
+                cell_size: self.cell_size,
+            },
+        )
+    }
+}
+
+pub fn parse_format(s: &str) -> Result<Format, String> {
+    Format::from_name(&s.to_ascii_lowercase())
+        .ok_or_else(|| format!("unknown format {s:?}: expected one of {}", Format::list()))
+}
+
+/// Parses `WxH` (e.g. `1024x768`); each side in 1..=65535.
+pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
+    let err = || format!("invalid size {s:?}: expected WxH with each side in 1..=65535, e.g. 1024x1024");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
+    let w: usize = w.trim().parse().map_err(|_| err())?;
+    let h: usize = h.trim().parse().map_err(|_| err())?;
+    if (1..=65535).contains(&w) && (1..=65535).contains(&h) {
+        Ok((w, h))
+    } else {
+        Err(err())
+    }
+}

@@ -1,0 +1,57 @@
+//! The `terrasynth` command-line tool: one file per subcommand.
+
+mod args;
+mod convert;
+mod info;
+mod progress;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Example-based terrain synthesis from real elevation data.
+///
+/// Heightfields are read and written by file extension: .png (16-bit + JSON
+/// sidecar), and more formats listed under `convert --help`.
+#[derive(Parser)]
+#[command(name = "terrasynth", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a heightfield's size, cell size, height range and nodata count.
+    Info(info::Args),
+    /// Convert a heightfield between formats (chosen by extension).
+    Convert(convert::Args),
+}
+
+/// What every subcommand returns: a message for the user on failure.
+pub type CliResult = Result<(), Box<dyn std::error::Error + Send + Sync>>;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(a) => info::run(a),
+        Command::Convert(a) => convert::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // Print the cause chain, skipping causes the message already states.
+            let mut shown = e.to_string();
+            eprintln!("error: {shown}");
+            let mut source = e.source();
+            while let Some(s) = source {
+                let text = s.to_string();
+                if !shown.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                    shown = text;
+                }
+                source = s.source();
+            }
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,364 @@
+//! The `Heightfield`: a regular grid of elevations in metres.
+//!
+//! Nodata has exactly one representation: a NaN sample. Readers turn every
+//! format's void marker (SRTM −32768, GDAL_NODATA, ESRI `NODATA_value`, NaN in
+//! EXR) into NaN, so a missing sample can never be silently used as a height:
+//! any arithmetic that touches it yields NaN, and [`Heightfield::stats`] and the
+//! writers see it. Infinite samples are refused at construction for the same
+//! reason. The mask view ([`Heightfield::nodata_mask`]) is derived, not stored,
+//! so it cannot disagree with the data.
+
+use crate::error::SizeError;
+
+/// Largest accepted side, in samples. Larger grids are refused before any
+/// allocation (a corrupt header must not make us allocate gigabytes).
+pub const MAX_SIDE: usize = 1 << 20;
+/// Largest accepted sample count (4 GiB of `f32`).
+pub const MAX_PIXELS: usize = 1 << 30;
+
+/// Checks a declared grid size before anything is allocated for it.
+pub fn check_dims(width: usize, height: usize) -> Result<(), SizeError> {
+    if width == 0 || height == 0 {
+        return Err(SizeError::Empty { width, height });
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
+        return Err(SizeError::TooLarge {
+            width,
+            height,
+            max_side: MAX_SIDE,
+            max_pixels: MAX_PIXELS,
+        });
+    }
+    Ok(())
+}
+
+/// Summary statistics over the valid (non-nodata) samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stats {
+    pub min: f32,
+    pub max: f32,
+    pub mean: f64,
+    /// Number of valid samples.
+    pub valid: usize,
+    /// Number of nodata samples.
+    pub nodata: usize,
+}
+
+/// Optional georeference carried through formats that have one (GeoTIFF
+/// tiepoint, ESRI ASCII `xllcorner`/`yllcorner`): map coordinates of the
+/// outer corner of the top-left cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Georef {
+    pub origin_x: f64,
+    pub origin_y: f64,
+}
+
+/// A row-major grid of heights in metres; row 0 is north, column 0 is west.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Heightfield {
+    width: usize,
+    height: usize,
+    cell_size: f64,
+    data: Vec<f32>,
+    georef: Option<Georef>,
+}
+
+impl Heightfield {
+    /// A flat grid at 0 m.
+    pub fn new(width: usize, height: usize, cell_size: f64) -> Result<Self, SizeError> {
+        check_dims(width, height)?;
+        check_cell_size(cell_size)?;
+        Ok(Self {
+            width,
+            height,
+            cell_size,
+            data: vec![0.0; width * height],
+            georef: None,
+        })
+    }
+
+    /// Wraps row-major samples. NaN marks nodata; ±∞ is refused because no
+    /// format can mean it and it would poison every statistic.
+    pub fn from_vec(
+        width: usize,
+        height: usize,
+        cell_size: f64,
+        data: Vec<f32>,
+    ) -> Result<Self, SizeError> {
+        check_dims(width, height)?;
+        check_cell_size(cell_size)?;
+        if data.len() != width * height {
+            return Err(SizeError::Length {
+                expected: width * height,
+                found: data.len(),
+            });
+        }
+        if let Some(i) = data.iter().position(|v| v.is_infinite()) {
+            return Err(SizeError::Infinite {
+                x: i % width,
+                y: i / width,
+            });
+        }
+        Ok(Self {
+            width,
+            height,
+            cell_size,
+            data,
+            georef: None,
+        })
+    }
+
+    /// Builds a grid from a function of (x, y), evaluated in parallel by row.
+    pub fn from_fn(
+        width: usize,
+        height: usize,
+        cell_size: f64,
+        f: impl Fn(usize, usize) -> f32 + Sync,
+    ) -> Result<Self, SizeError> {
+        use rayon::prelude::*;
+        let mut hf = Self::new(width, height, cell_size)?;
+        hf.data
+            .par_chunks_mut(width)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, v) in row.iter_mut().enumerate() {
+                    let h = f(x, y);
+                    *v = if h.is_finite() { h } else { f32::NAN };
+                }
+            });
+        Ok(hf)
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+    pub fn height(&self) -> usize {
+        self.height
+    }
+    /// Cell size (sample spacing) in metres.
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+    pub fn set_cell_size(&mut self, cell_size: f64) -> Result<(), SizeError> {
+        check_cell_size(cell_size)?;
+        self.cell_size = cell_size;
+        Ok(())
+    }
+    pub fn georef(&self) -> Option<Georef> {
+        self.georef
+    }
+    pub fn set_georef(&mut self, georef: Option<Georef>) {
+        self.georef = georef;
+    }
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+    /// Never true: a heightfield has at least one sample.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+    pub fn data(&self) -> &[f32] {
+        &self.data
+    }
+    /// Mutable samples. Writing ±∞ breaks the invariant; use NaN for nodata.
+    pub fn data_mut(&mut self) -> &mut [f32] {
+        &mut self.data
+    }
+    pub fn into_vec(self) -> Vec<f32> {
+        self.data
+    }
+    pub fn row(&self, y: usize) -> &[f32] {
+        &self.data[y * self.width..(y + 1) * self.width]
+    }
+    pub fn get(&self, x: usize, y: usize) -> f32 {
+        self.data[y * self.width + x]
+    }
+    pub fn set(&mut self, x: usize, y: usize, v: f32) {
+        self.data[y * self.width + x] = v;
+    }
+    /// Sample with coordinates clamped to the grid (edge replication).
+    pub fn get_clamped(&self, x: isize, y: isize) -> f32 {
+        let x = x.clamp(0, self.width as isize - 1) as usize;
+        let y = y.clamp(0, self.height as isize - 1) as usize;
+        self.data[y * self.width + x]
+    }
+
+    pub fn is_nodata(&self, x: usize, y: usize) -> bool {
+        self.get(x, y).is_nan()
+    }
+    pub fn nodata_count(&self) -> usize {
+        self.data.iter().filter(|v| v.is_nan()).count()
+    }
+    /// `Some(mask)` (true = nodata) when any sample is missing, else `None`.
+    pub fn nodata_mask(&self) -> Option<Vec<bool>> {
+        let mask: Vec<bool> = self.data.iter().map(|v| v.is_nan()).collect();
+        mask.iter().any(|&m| m).then_some(mask)
+    }
+
+    /// Min, max and mean over valid samples; `None` when every sample is nodata.
+    pub fn stats(&self) -> Option<Stats> {
+        let (mut min, mut max, mut sum, mut valid) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f64, 0);
+        for &v in &self.data {
+            if !v.is_nan() {
+                min = min.min(v);
+                max = max.max(v);
+                sum += v as f64;
+                valid += 1;
+            }
+        }
+        (valid > 0).then(|| Stats {
+            min,
+            max,
+            mean: sum / valid as f64,
+            valid,
+            nodata: self.data.len() - valid,
+        })
+    }
+
+    /// A borrowed window; fails if it does not lie inside the grid.
+    pub fn view(&self, x: usize, y: usize, w: usize, h: usize) -> Result<View<'_>, SizeError> {
+        self.check_window(x, y, w, h)?;
+        Ok(View {
+            hf: self,
+            x0: x,
+            y0: y,
+            width: w,
+            height: h,
+        })
+    }
+
+    /// An owned copy of a window (cell size and shifted georeference kept).
+    pub fn crop(&self, x: usize, y: usize, w: usize, h: usize) -> Result<Heightfield, SizeError> {
+        self.view(x, y, w, h).map(|v| v.to_heightfield())
+    }
+
+    fn check_window(&self, x: usize, y: usize, w: usize, h: usize) -> Result<(), SizeError> {
+        if w == 0 || h == 0 || x + w > self.width || y + h > self.height {
+            return Err(SizeError::Window {
+                x,
+                y,
+                w,
+                h,
+                width: self.width,
+                height: self.height,
+            });
+        }
+        Ok(())
+    }
+}
+
+fn check_cell_size(cell_size: f64) -> Result<(), SizeError> {
+    if cell_size.is_finite() && cell_size > 0.0 {
+        Ok(())
+    } else {
+        Err(SizeError::CellSize(cell_size))
+    }
+}
+
+/// A rectangular window of a [`Heightfield`], without copying.
+#[derive(Debug, Clone, Copy)]
+pub struct View<'a> {
+    hf: &'a Heightfield,
+    x0: usize,
+    y0: usize,
+    width: usize,
+    height: usize,
+}
+
+impl<'a> View<'a> {
+    pub fn width(&self) -> usize {
+        self.width
+    }
+    pub fn height(&self) -> usize {
+        self.height
+    }
+    pub fn get(&self, x: usize, y: usize) -> f32 {
+        debug_assert!(x < self.width && y < self.height);
+        self.hf.get(self.x0 + x, self.y0 + y)
+    }
+    pub fn row(&self, y: usize) -> &'a [f32] {
+        let start = (self.y0 + y) * self.hf.width + self.x0;
+        &self.hf.data[start..start + self.width]
+    }
+    pub fn to_heightfield(&self) -> Heightfield {
+        let mut data = Vec::with_capacity(self.width * self.height);
+        for y in 0..self.height {
+            data.extend_from_slice(self.row(y));
+        }
+        let georef = self.hf.georef.map(|g| Georef {
+            origin_x: g.origin_x + self.x0 as f64 * self.hf.cell_size,
+            origin_y: g.origin_y - self.y0 as f64 * self.hf.cell_size,
+        });
+        Heightfield {
+            width: self.width,
+            height: self.height,
+            cell_size: self.hf.cell_size,
+            data,
+            georef,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_ignore_nodata() {
+        let hf = Heightfield::from_vec(2, 2, 1.0, vec![1.0, f32::NAN, 3.0, 5.0]).unwrap();
+        let s = hf.stats().unwrap();
+        assert_eq!((s.min, s.max, s.valid, s.nodata), (1.0, 5.0, 3, 1));
+        assert!((s.mean - 3.0).abs() < 1e-12);
+        assert_eq!(hf.nodata_mask().unwrap(), vec![false, true, false, false]);
+    }
+
+    #[test]
+    fn all_nodata_has_no_stats() {
+        let hf = Heightfield::from_vec(1, 2, 1.0, vec![f32::NAN; 2]).unwrap();
+        assert!(hf.stats().is_none());
+    }
+
+    #[test]
+    fn refuses_bad_sizes_and_values() {
+        assert!(matches!(
+            Heightfield::new(0, 5, 1.0),
+            Err(SizeError::Empty { .. })
+        ));
+        assert!(matches!(
+            Heightfield::new(100_000, 100_000, 1.0),
+            Err(SizeError::TooLarge { .. })
+        ));
+        assert!(matches!(
+            Heightfield::from_vec(2, 2, 1.0, vec![0.0; 3]),
+            Err(SizeError::Length { .. })
+        ));
+        assert!(matches!(
+            Heightfield::from_vec(2, 1, 1.0, vec![0.0, f32::INFINITY]),
+            Err(SizeError::Infinite { x: 1, y: 0 })
+        ));
+        assert!(matches!(
+            Heightfield::new(1, 1, -1.0),
+            Err(SizeError::CellSize(_))
+        ));
+    }
+
+    #[test]
+    fn crop_copies_window_and_shifts_georef() {
+        let mut hf = Heightfield::from_fn(4, 3, 2.0, |x, y| (x + 10 * y) as f32).unwrap();
+        hf.set_georef(Some(Georef {
+            origin_x: 100.0,
+            origin_y: 50.0,
+        }));
+        let c = hf.crop(1, 1, 2, 2).unwrap();
+        assert_eq!(c.data(), &[11.0, 12.0, 21.0, 22.0]);
+        assert_eq!(
+            c.georef(),
+            Some(Georef {
+                origin_x: 102.0,
+                origin_y: 48.0
+            })
+        );
+        assert!(hf.crop(3, 0, 2, 1).is_err());
+        assert_eq!(hf.view(0, 2, 4, 1).unwrap().row(0), &[20.0, 21.0, 22.0, 23.0]);
+    }
+}

@@ -1,0 +1,98 @@
+//! Errors of the format layer. [`FormatError`] says what is wrong with the
+//! bytes; [`IoError`] adds the file it came from.
+
+use crate::error::SizeError;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// What is wrong with a file's contents.
+#[non_exhaustive]
+#[derive(Debug, Error)]
+pub enum FormatError {
+    #[error("truncated: {what} needs {expected} bytes, the file has {found}")]
+    Truncated {
+        what: &'static str,
+        expected: u64,
+        found: u64,
+    },
+    #[error("truncated: the {0} ends early")]
+    EndsEarly(&'static str),
+    #[error("bad magic: expected {expected}, found {found}")]
+    BadMagic { expected: &'static str, found: String },
+    #[error("unsupported {what}: {found} (supported: {supported})")]
+    Unsupported {
+        what: &'static str,
+        found: String,
+        supported: &'static str,
+    },
+    #[error("dimension mismatch: {0}")]
+    DimensionMismatch(String),
+    #[error(
+        "declared size {width}x{height} needs more data than a {file_len}-byte file can hold"
+    )]
+    SizeNotJustified {
+        width: u64,
+        height: u64,
+        file_len: u64,
+    },
+    #[error("{0}")]
+    Size(#[from] SizeError),
+    #[error("invalid sidecar: {0}")]
+    InvalidSidecar(String),
+    #[error("line {line}: {message}")]
+    Syntax { line: usize, message: String },
+    #[error("corrupt data: {0}")]
+    Corrupt(String),
+    #[error("cannot write: {0}")]
+    Unwritable(String),
+}
+
+impl FormatError {
+    pub(crate) fn truncated(what: &'static str, expected: u64, found: usize) -> Self {
+        FormatError::Truncated {
+            what,
+            expected,
+            found: found as u64,
+        }
+    }
+}
+
+/// A file that could not be read or written.
+#[non_exhaustive]
+#[derive(Debug, Error)]
+pub enum IoError {
+    #[error("{path}: {source}")]
+    Os {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: {kind}")]
+    Format { path: PathBuf, kind: FormatError },
+    #[error(
+        "{path}: cannot tell the format from the file name; give it explicitly (one of: {formats})"
+    )]
+    UnknownFormat { path: PathBuf, formats: String },
+}
+
+impl IoError {
+    pub(crate) fn os(path: &Path, source: std::io::Error) -> Self {
+        IoError::Os {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+    pub(crate) fn unknown_format(path: &Path) -> Self {
+        IoError::UnknownFormat {
+            path: path.to_path_buf(),
+            formats: super::Format::list(),
+        }
+    }
+    /// The format problem, if this is one (tests match on it).
+    pub fn format_error(&self) -> Option<&FormatError> {
+        match self {
+            IoError::Format { kind, .. } => Some(kind),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,203 @@
+//! Heightfields in and out of the formats terrain people exchange.
+//!
+//! Two layers:
+//! - [`decode`] / [`encode`] work on bytes and return a [`FormatError`]; they
+//!   never touch the file system, so the fuzz targets call them directly.
+//! - [`read`] / [`write`] add paths: sidecar lookup, format choice by
+//!   extension, and atomic output (temporary file, then rename — a failed
+//!   write never leaves a partial file behind). Their [`IoError`] names the file.
+//!
+//! Every reader checks declared sizes against [`crate::heightfield::check_dims`]
+//! and against what the file's length can justify *before* allocating.
+
+mod atomic;
+mod error;
+mod png;
+mod sidecar;
+
+pub use atomic::write_atomic;
+pub use error::{FormatError, IoError};
+pub use sidecar::{HeightMapping, Sidecar};
+
+use crate::heightfield::Heightfield;
+use std::path::{Path, PathBuf};
+
+/// A heightfield file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// 16-bit greyscale PNG; metres via a JSON sidecar (`<stem>.json`).
+    Png16,
+    /// 8-bit greyscale PNG (read only); metres via the sidecar or the default mapping.
+    Png8,
+}
+
+impl Format {
+    /// Every format, in the order `--help` lists them.
+    pub const ALL: &'static [Format] = &[Format::Png16, Format::Png8];
+
+    /// The name used on the command line (`--format`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Png16 => "png16",
+            Format::Png8 => "png8",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Format> {
+        Self::ALL.iter().copied().find(|f| f.name() == name)
+    }
+
+    /// The format a path's extension implies. `.png` means 16-bit on output;
+    /// on input the PNG's own bit depth decides between [`Format::Png16`] and
+    /// [`Format::Png8`].
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "png" => Some(Format::Png16),
+            _ => None,
+        }
+    }
+
+    pub fn can_write(self) -> bool {
+        !matches!(self, Format::Png8)
+    }
+
+    /// Formats that store heights as integers and need a sidecar to mean metres.
+    pub fn uses_sidecar(self) -> bool {
+        matches!(self, Format::Png16 | Format::Png8)
+    }
+
+    /// Comma-separated names, for error messages.
+    pub fn list() -> String {
+        Self::ALL
+            .iter()
+            .map(|f| f.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+impl std::fmt::Display for Format {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// How to read a file. The defaults suit every self-describing format.
+#[derive(Debug, Clone, Default)]
+pub struct ReadOptions {
+    /// Overrides the format implied by the extension.
+    pub format: Option<Format>,
+    /// Dimensions of headerless raw files (R16/R32) when no sidecar gives them.
+    pub size: Option<(usize, usize)>,
+    /// Overrides the cell size found in the file or sidecar.
+    pub cell_size: Option<f64>,
+}
+
+/// How to write a file.
+#[derive(Debug, Clone, Default)]
+pub struct WriteOptions {
+    /// Overrides the format implied by the extension.
+    pub format: Option<Format>,
+    /// Height range mapped onto the integer range of quantized formats
+    /// (PNG16); by default the data's own min..max, so no precision is wasted.
+    pub height_range: Option<(f64, f64)>,
+}
+
+/// Decodes a heightfield from bytes. `sidecar` is the JSON sidecar's bytes for
+/// formats that use one.
+pub fn decode(
+    bytes: &[u8],
+    format: Format,
+    sidecar: Option<&[u8]>,
+    opts: &ReadOptions,
+) -> Result<Heightfield, FormatError> {
+    let sidecar = sidecar.map(Sidecar::parse).transpose()?;
+    let mut hf = match format {
+        Format::Png16 | Format::Png8 => png::decode(bytes, sidecar.as_ref())?,
+    };
+    if let Some(cell) = opts.cell_size {
+        hf.set_cell_size(cell)?;
+    }
+    Ok(hf)
+}
+
+/// What [`encode`] produces: the file's bytes and, for formats that need one,
+/// the sidecar's.
+#[derive(Debug, Clone)]
+pub struct Encoded {
+    pub bytes: Vec<u8>,
+    pub sidecar: Option<Vec<u8>>,
+}
+
+/// Encodes a heightfield. Formats that cannot represent nodata refuse a
+/// heightfield that has any (fill it first, see [`crate::fill`]).
+pub fn encode(hf: &Heightfield, format: Format, opts: &WriteOptions) -> Result<Encoded, FormatError> {
+    match format {
+        Format::Png16 => png::encode16(hf, opts.height_range),
+        Format::Png8 => Err(FormatError::Unwritable(format!(
+            "{format} is read-only; write png16 instead"
+        ))),
+    }
+}
+
+/// The sidecar path of a data file: the same stem with `.json`.
+pub fn sidecar_path(path: &Path) -> PathBuf {
+    path.with_extension("json")
+}
+
+/// Resolves the format of an input file: explicit, else by extension, with
+/// PNG bit depth sniffed from the header.
+fn input_format(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Format, IoError> {
+    let format = match opts.format {
+        Some(f) => f,
+        None => Format::from_path(path).ok_or_else(|| IoError::unknown_format(path))?,
+    };
+    Ok(match format {
+        Format::Png16 | Format::Png8 => png::sniff_depth(bytes).unwrap_or(format),
+        other => other,
+    })
+}
+
+/// Reads a heightfield file (and its sidecar when the format uses one).
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<Heightfield, IoError> {
+    let bytes = std::fs::read(path).map_err(|e| IoError::os(path, e))?;
+    let format = input_format(path, &bytes, opts)?;
+    let sidecar_bytes = if format.uses_sidecar() {
+        let sc = sidecar_path(path);
+        match std::fs::read(&sc) {
+            Ok(b) => Some(b),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) => return Err(IoError::os(&sc, e)),
+        }
+    } else {
+        None
+    };
+    decode(&bytes, format, sidecar_bytes.as_deref(), opts).map_err(|kind| {
+        // A sidecar problem is reported against the sidecar's path.
+        let p = if matches!(kind, FormatError::InvalidSidecar(_)) {
+            sidecar_path(path)
+        } else {
+            path.to_path_buf()
+        };
+        IoError::Format { path: p, kind }
+    })
+}
+
+/// Writes a heightfield atomically (and its sidecar when the format has one).
+pub fn write(hf: &Heightfield, path: &Path, opts: &WriteOptions) -> Result<(), IoError> {
+    let format = match opts.format {
+        Some(f) => f,
+        None => Format::from_path(path).ok_or_else(|| IoError::unknown_format(path))?,
+    };
+    let enc = encode(hf, format, opts).map_err(|kind| IoError::Format {
+        path: path.to_path_buf(),
+        kind,
+    })?;
+    // The sidecar goes first: a reader that finds the data file then always
+    // finds the mapping that belongs to it.
+    if let Some(sc) = &enc.sidecar {
+        write_atomic(&sidecar_path(path), sc)?;
+    }
+    write_atomic(path, &enc.bytes)
+}

@@ -1,0 +1,17 @@
+//! # terrasynth
+//!
+//! Controllable, example-based terrain synthesis: from a database of real
+//! elevation models, synthesize new heightfields that look like them while
+//! obeying an artist's constraints (Gain, Merry & Marais 2015), on any
+//! machine, with or without a GPU.
+//!
+//! Data flows one way: [`io`] → database → synthesis → render / [`io`].
+//! See `DESIGN.md` in the repository for the architecture.
+
+pub mod error;
+pub mod heightfield;
+pub mod io;
+pub mod progress;
+
+pub use error::{Error, Result, SizeError};
+pub use heightfield::{Georef, Heightfield, Stats};
