@@ -45,6 +45,8 @@ pub enum Error {
     Size(#[from] SizeError),
     #[error(transparent)]
     Io(#[from] crate::io::IoError),
+    #[error(transparent)]
+    Poisson(#[from] crate::poisson::PoissonError),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -9,8 +9,10 @@
 //! See `DESIGN.md` in the repository for the architecture.
 
 pub mod error;
+pub mod fill;
 pub mod heightfield;
 pub mod io;
+pub mod poisson;
 pub mod progress;
 
 pub use error::{Error, Result, SizeError};

@@ -18,7 +18,10 @@ pub enum FormatError {
     #[error("truncated: the {0} ends early")]
     EndsEarly(&'static str),
     #[error("bad magic: expected {expected}, found {found}")]
-    BadMagic { expected: &'static str, found: String },
+    BadMagic {
+        expected: &'static str,
+        found: String,
+    },
     #[error("unsupported {what}: {found} (supported: {supported})")]
     Unsupported {
         what: &'static str,
@@ -27,9 +30,7 @@ pub enum FormatError {
     },
     #[error("dimension mismatch: {0}")]
     DimensionMismatch(String),
-    #[error(
-        "declared size {width}x{height} needs more data than a {file_len}-byte file can hold"
-    )]
+    #[error("declared size {width}x{height} needs more data than a {file_len}-byte file can hold")]
     SizeNotJustified {
         width: u64,
         height: u64,

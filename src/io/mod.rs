@@ -132,7 +132,11 @@ pub struct Encoded {
 
 /// Encodes a heightfield. Formats that cannot represent nodata refuse a
 /// heightfield that has any (fill it first, see [`crate::fill`]).
-pub fn encode(hf: &Heightfield, format: Format, opts: &WriteOptions) -> Result<Encoded, FormatError> {
+pub fn encode(
+    hf: &Heightfield,
+    format: Format,
+    opts: &WriteOptions,
+) -> Result<Encoded, FormatError> {
     match format {
         Format::Png16 => png::encode16(hf, opts.height_range),
         Format::Png8 => Err(FormatError::Unwritable(format!(

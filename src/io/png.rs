@@ -70,9 +70,12 @@ pub(super) fn decode(bytes: &[u8], sidecar: Option<&Sidecar>) -> Result<Heightfi
     if let Some(sc) = sidecar {
         sc.check_size(w, h)?;
     }
-    let mut buf = vec![0u8; reader.output_buffer_size().ok_or_else(|| {
-        FormatError::Corrupt("PNG output size overflows".into())
-    })?];
+    let mut buf = vec![
+        0u8;
+        reader.output_buffer_size().ok_or_else(|| {
+            FormatError::Corrupt("PNG output size overflows".into())
+        })?
+    ];
     reader.next_frame(&mut buf).map_err(png_error)?;
 
     let mapping = sidecar
@@ -116,7 +119,11 @@ pub(super) fn encode16(
         )));
     }
     // With nodata, code 0 is reserved for it and heights use 1..=65535.
-    let (lo, max_code) = if has_nodata { (1u32, 65534u32) } else { (0, 65535) };
+    let (lo, max_code) = if has_nodata {
+        (1u32, 65534u32)
+    } else {
+        (0, 65535)
+    };
     let m = HeightMapping::spanning(min, max, max_code);
     let mapping = HeightMapping {
         offset_m: m.offset_m - lo as f64 * m.scale_m,
@@ -139,7 +146,9 @@ pub(super) fn encode16(
         let mut enc = png::Encoder::new(&mut out, hf.width() as u32, hf.height() as u32);
         enc.set_color(png::ColorType::Grayscale);
         enc.set_depth(png::BitDepth::Sixteen);
-        let mut w = enc.write_header().map_err(|e| FormatError::Unwritable(e.to_string()))?;
+        let mut w = enc
+            .write_header()
+            .map_err(|e| FormatError::Unwritable(e.to_string()))?;
         w.write_image_data(&bytes)
             .map_err(|e| FormatError::Unwritable(e.to_string()))?;
     }
@@ -167,5 +176,9 @@ fn png_error(e: png::DecodingError) -> FormatError {
 
 fn hex_prefix(bytes: &[u8]) -> String {
     let s: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02X}")).collect();
-    if s.is_empty() { "an empty file".into() } else { s.join(" ") }
+    if s.is_empty() {
+        "an empty file".into()
+    } else {
+        s.join(" ")
+    }
 }
