@@ -46,6 +46,8 @@ pub enum Error {
     #[error(transparent)]
     Io(#[from] crate::io::IoError),
     #[error(transparent)]
+    Database(#[from] crate::database::DbError),
+    #[error(transparent)]
     Poisson(#[from] crate::poisson::PoissonError),
 }
 

@@ -8,12 +8,15 @@
 //! Data flows one way: [`io`] → database → synthesis → render / [`io`].
 //! See `DESIGN.md` in the repository for the architecture.
 
+pub mod database;
 pub mod error;
 pub mod fill;
+pub mod hash;
 pub mod heightfield;
 pub mod io;
 pub mod poisson;
 pub mod progress;
+pub mod resample;
 
 pub use error::{Error, Result, SizeError};
 pub use heightfield::{Georef, Heightfield, Stats};
