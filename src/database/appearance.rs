@@ -18,6 +18,7 @@
 //! half the database's range within 5 texels; clamping only affects scoring of
 //! such texels, which never match anything well anyway).
 
+use super::kdtree::{KEY_DIMS, Key};
 use super::pyramid::{Grid, Quantization};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -87,10 +88,17 @@ pub struct Basis {
     pub explained: f64,
 }
 
-/// Covariance of residuals over every texel of `grids`, then its top three
+/// The stored basis and the wider one used to seed the similarity search.
+pub struct Pca {
+    pub basis: Basis,
+    /// Top [`KEY_DIMS`] unit directions (the first three are `basis.modes`).
+    pub search: Vec<[f64; N]>,
+}
+
+/// Covariance of residuals over every texel of `grids`, then its leading
 /// eigenvectors. Rows are reduced in a fixed order, so the basis does not
 /// depend on the thread count.
-pub fn pca(grids: &[&Grid], q: &Quantization) -> Basis {
+pub fn pca(grids: &[&Grid], q: &Quantization) -> Pca {
     let (g, sg) = weights();
     let rows: Vec<(usize, usize)> = grids
         .iter()
@@ -133,7 +141,8 @@ pub fn pca(grids: &[&Grid], q: &Quantization) -> Basis {
     let total: f64 = values.iter().map(|v| v.max(0.0)).sum();
     let mut modes = Vec::new();
     let mut variances = Vec::new();
-    for &k in order.iter().take(3) {
+    let mut search = Vec::new();
+    for (rank, &k) in order.iter().take(KEY_DIMS).enumerate() {
         let mut v: Vec<f64> = (0..N).map(|i| vectors[i * N + k]).collect();
         // Sign convention: the largest-magnitude component is positive, so
         // the basis is a deterministic function of the data.
@@ -143,18 +152,24 @@ pub fn pca(grids: &[&Grid], q: &Quantization) -> Basis {
         if v[big] < 0.0 {
             v.iter_mut().for_each(|c| *c = -*c);
         }
-        modes.push(v.iter().map(|&c| c as f32).collect());
-        variances.push(values[k].max(0.0));
+        search.push(std::array::from_fn(|i| v[i]));
+        if rank < 3 {
+            modes.push(v.iter().map(|&c| c as f32).collect());
+            variances.push(values[k].max(0.0));
+        }
     }
     let explained = if total > 0.0 {
         variances.iter().sum::<f64>() / total
     } else {
         1.0
     };
-    Basis {
-        modes,
-        variances,
-        explained,
+    Pca {
+        basis: Basis {
+            modes,
+            variances,
+            explained,
+        },
+        search,
     }
 }
 
@@ -182,22 +197,34 @@ fn clamp_i16(v: f64) -> i16 {
     v.round().clamp(-32767.0, 32767.0) as i16
 }
 
-/// Appearance texels of every exemplar at one level (in layout order), plus
-/// the PatchMatch features (the quantized 25-d residuals, zero-padded).
-pub fn project(
-    grids: &[&Grid],
-    q: &Quantization,
-    basis: &Basis,
-) -> (Vec<u64>, Vec<[i16; FEATURE_LANES]>) {
+/// What [`project`] computes for every texel of a level, in layout order.
+pub struct Projected {
+    /// Packed appearance texels (stored).
+    pub texels: Vec<u64>,
+    /// PatchMatch features: quantized 25-d residuals, zero-padded.
+    pub features: Vec<[i16; FEATURE_LANES]>,
+    /// Coordinates in the search space (top [`KEY_DIMS`] directions).
+    pub keys: Vec<Key>,
+}
+
+/// Appearance texels, PatchMatch features and search keys of every
+/// exemplar at one level.
+pub fn project(grids: &[&Grid], q: &Quantization, pca: &Pca) -> Projected {
+    let basis = &pca.basis;
     let (g, sg) = weights();
-    let mut texels = Vec::new();
-    let mut features = Vec::new();
+    let mut out = Projected {
+        texels: Vec::new(),
+        features: Vec::new(),
+        keys: Vec::new(),
+    };
     for gr in grids {
-        let rows: Vec<(Vec<u64>, Vec<[i16; FEATURE_LANES]>)> = (0..gr.height)
+        type Row = (Vec<u64>, Vec<[i16; FEATURE_LANES]>, Vec<Key>);
+        let rows: Vec<Row> = (0..gr.height)
             .into_par_iter()
             .map(|y| {
                 let mut t = Vec::with_capacity(gr.width);
                 let mut f = Vec::with_capacity(gr.width);
+                let mut keys = Vec::with_capacity(gr.width);
                 for x in 0..gr.width {
                     let (mean, r) = neighbourhood(gr, q, &g, &sg, x, y);
                     let mut m = [0i16; 4];
@@ -212,16 +239,22 @@ pub fn project(
                         feat[k] = clamp_i16(r[k]);
                     }
                     f.push(feat);
+                    keys.push(std::array::from_fn(|d| {
+                        pca.search
+                            .get(d)
+                            .map_or(0.0, |e| e.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>() as f32)
+                    }));
                 }
-                (t, f)
+                (t, f, keys)
             })
             .collect();
-        for (t, f) in rows {
-            texels.extend(t);
-            features.extend(f);
+        for (t, f, k) in rows {
+            out.texels.extend(t);
+            out.features.extend(f);
+            out.keys.extend(k);
         }
     }
-    (texels, features)
+    out
 }
 
 /// Eigen-decomposition of a symmetric N×N matrix by cyclic Jacobi rotations.
@@ -305,7 +338,7 @@ mod tests {
     fn modes_are_orthonormal_and_sorted() {
         let t = terrain(64, 48);
         let q = Quantization::spanning(0.0, 300.0);
-        let b = pca(&[&t], &q);
+        let b = pca(&[&t], &q).basis;
         for i in 0..3 {
             for j in 0..3 {
                 let d: f64 = b.modes[i]

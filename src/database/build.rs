@@ -1,6 +1,6 @@
 //! `Database::build`: heightfields (+ optional type masks) → a database.
 
-use super::appearance::{self, FEATURE_LANES};
+use super::appearance;
 use super::error::DbError;
 use super::file::{self, Bytes, Kind, Section};
 use super::layout::{self, MAX_EXEMPLARS};
@@ -202,19 +202,21 @@ pub fn build(
     let mut arrays: Vec<(Vec<u64>, Vec<u32>, Vec<u8>, Vec<u32>)> = Vec::with_capacity(levels + 1);
     for (i, lay) in plan.iter().enumerate() {
         let grids: Vec<&Grid> = pyramids.iter().map(|p| &p[i]).collect();
-        let basis = appearance::pca(&grids, &q);
-        let (texels, features) = appearance::project(&grids, &q, &basis);
+        let pca = appearance::pca(&grids, &q);
+        let projected = appearance::project(&grids, &q, &pca);
+        let basis = pca.basis;
         progress.advance(lay.texels());
         let (similar, dist) = patchmatch::similar(
             lay,
-            &features,
+            &projected.features,
+            &projected.keys,
             patchmatch::Params {
                 iterations: opts.patchmatch_iterations,
                 level: i as u32,
                 ..Default::default()
             },
         );
-        drop::<Vec<[i16; FEATURE_LANES]>>(features);
+        let texels = projected.texels;
         progress.advance(lay.texels());
         let mean_match_distance =
             dist.iter().map(|&d| (d as f64).sqrt()).sum::<f64>() / dist.len() as f64;

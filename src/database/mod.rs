@@ -18,6 +18,7 @@ pub mod appearance;
 mod build;
 pub mod error;
 pub mod file;
+pub mod kdtree;
 pub mod layout;
 pub mod patchmatch;
 pub mod pyramid;

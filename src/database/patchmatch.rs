@@ -21,6 +21,7 @@
 //! independent, so rayon may run them in any order.
 
 use super::appearance::FEATURE_LANES;
+use super::kdtree::{Key, KdTree};
 use super::layout::{LevelLayout, MARGIN, pack, unpack};
 use crate::hash::{below, hash4};
 use rayon::prelude::*;
@@ -59,6 +60,8 @@ pub struct Params {
     pub iterations: u32,
     /// Random initial guesses per texel (the best is kept).
     pub initial_samples: u32,
+    /// Leaves of the PCA-space tree visited per texel to seed the search.
+    pub search_leaves: usize,
     pub seed: u32,
     pub level: u32,
 }
@@ -66,8 +69,9 @@ pub struct Params {
 impl Default for Params {
     fn default() -> Self {
         Params {
-            iterations: 6,
-            initial_samples: 4,
+            iterations: 2,
+            initial_samples: 2,
+            search_leaves: 4,
             seed: 0x7e55,
             level: 0,
         }
@@ -124,7 +128,12 @@ impl Ctx<'_> {
 /// distance of each match. Every exemplar must have an interior large enough
 /// to hold an admissible target for each of its texels (the builder ensures
 /// exemplars are at least 16×16 at the coarsest level).
-pub fn similar(layout: &LevelLayout, features: &[Feature], params: Params) -> (Vec<u32>, Vec<f32>) {
+pub fn similar(
+    layout: &LevelLayout,
+    features: &[Feature],
+    keys: &[Key],
+    params: Params,
+) -> (Vec<u32>, Vec<f32>) {
     let cumulative: Vec<u64> = layout
         .rects
         .iter()
@@ -149,26 +158,34 @@ pub fn similar(layout: &LevelLayout, features: &[Feature], params: Params) -> (V
         .map(|(e, (x, y))| (e, x, y))
         .collect();
 
-    // Initialisation: best of a few uniformly random admissible targets.
+    // Initialisation: the admissible texels of the nearest leaves in the
+    // PCA search space (see `kdtree`), plus a few uniformly random ones.
+    let tree = KdTree::build(keys, |k| {
+        let (e, x, y) = owner[k];
+        layout.rects[e as usize].is_interior(x, y)
+    });
     let (mut nnf, mut dist): (Vec<u32>, Vec<f32>) = (0..n)
         .into_par_iter()
         .map(|k| {
             let (e, ux, uy) = owner[k];
             let mut best = (u32::MAX, f32::INFINITY);
-            let mut s = 0;
-            while s < params.initial_samples.max(1) || best.0 == u32::MAX {
-                let (vx, vy) =
-                    ctx.random_target(hash4(params.seed, params.level, k as u32, 0x1000 + s));
+            let consider = |vx: u32, vy: u32, best: &mut (u32, f32)| {
                 if let Some(d) = ctx.eval(k, e as usize, ux, uy, vx as i64, vy as i64)
                     && d < best.1
                 {
-                    best = (pack(vx, vy), d);
+                    *best = (pack(vx, vy), d);
                 }
+            };
+            tree.query(&keys[k], params.search_leaves, |t| {
+                let (_, vx, vy) = owner[t as usize];
+                consider(vx, vy, &mut best);
+            });
+            let mut s = 0;
+            while s < params.initial_samples || best.0 == u32::MAX {
+                let (vx, vy) = ctx.random_target(hash4(params.seed, params.level, k as u32, 0x1000 + s));
+                consider(vx, vy, &mut best);
                 s += 1;
-                assert!(
-                    s < 10_000,
-                    "no admissible target: exemplar interior too small"
-                );
+                assert!(s < 10_000, "no admissible target: exemplar interior too small");
             }
             best
         })
@@ -202,7 +219,7 @@ pub fn similar(layout: &LevelLayout, features: &[Feature], params: Params) -> (V
                     let (ux, uy) = (r.x0 + lx, ly);
                     let k = base + local;
                     let (mut bv, mut best) = (bn[local], bd[local]);
-                    let mut try_target = |vx: i64, vy: i64, bv: &mut u32, best: &mut f32| {
+                    let try_target = |vx: i64, vy: i64, bv: &mut u32, best: &mut f32| {
                         if let Some(d) = ctx.eval(k, e, ux, uy, vx, vy)
                             && d < *best
                         {
@@ -286,14 +303,14 @@ pub fn similar(layout: &LevelLayout, features: &[Feature], params: Params) -> (V
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-    use crate::database::appearance::{self, Basis};
+    use crate::database::appearance;
     use crate::database::layout::plan;
     use crate::database::pyramid::{Grid, Quantization};
 
     /// Terrain-like test exemplar: ridges at several scales plus hashed noise.
-    pub(crate) fn exemplar(w: usize, h: usize, seed: u32) -> Grid {
+    fn exemplar(w: usize, h: usize, seed: u32) -> Grid {
         let data = (0..w * h)
             .map(|i| {
                 let (x, y) = ((i % w) as f32, (i / w) as f32);
@@ -311,18 +328,37 @@ pub(crate) mod tests {
         }
     }
 
-    fn features_of(g: &Grid) -> Vec<Feature> {
-        let q = Quantization::spanning(-300.0, 600.0);
-        let basis: Basis = appearance::pca(&[g], &q);
-        appearance::project(&[g], &q, &basis).1
+    fn project(g: &Grid) -> appearance::Projected {
+        let q = Quantization::spanning(-300.0, 4000.0);
+        appearance::project(&[g], &q, &appearance::pca(&[g], &q))
+    }
+
+    /// A 128² crop of a real DEM when ../shared is present, else synthetic.
+    fn exemplar_128() -> Grid {
+        let p = std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../shared/dem/pyrenees_andorra.png"
+        ));
+        match crate::io::read(p, &Default::default()) {
+            Ok(hf) => Grid {
+                width: 128,
+                height: 128,
+                data: hf.crop(300, 300, 128, 128).unwrap().into_vec(),
+            },
+            Err(_) => {
+                eprintln!("{} not found: using a synthetic exemplar", p.display());
+                exemplar(128, 128, 7)
+            }
+        }
     }
 
     #[test]
     fn matches_are_admissible_and_close_to_exhaustive() {
-        let g = exemplar(128, 128, 7);
-        let feats = features_of(&g);
+        let g = exemplar_128();
+        let p = project(&g);
+        let feats = &p.features;
         let layout = &plan(&[(128, 128)], 0).unwrap()[0];
-        let (nnf, dist) = similar(layout, &feats, Params::default());
+        let (nnf, dist) = similar(layout, feats, &p.keys, Params::default());
         let r = layout.rects[0];
         for (k, &c) in nnf.iter().enumerate() {
             let (vx, vy) = unpack(c);
@@ -361,74 +397,15 @@ pub(crate) mod tests {
     #[test]
     fn independent_of_thread_count() {
         let g = exemplar(96, 80, 3);
-        let feats = features_of(&g);
+        let p = project(&g);
         let layout = &plan(&[(96, 80)], 0).unwrap()[0];
         let run = |t| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(t)
                 .build()
                 .unwrap()
-                .install(|| similar(layout, &feats, Params::default()).0)
+                .install(|| similar(layout, &p.features, &p.keys, Params::default()).0)
         };
         assert_eq!(run(1), run(2));
-    }
-}
-#[cfg(test)]
-mod tune {
-    use super::*;
-    use crate::database::appearance;
-    use crate::database::layout::plan;
-    use crate::database::pyramid::Quantization;
-    #[test]
-    #[ignore]
-    fn tune() {
-        let which = std::env::var("TUNE").unwrap_or_default();
-        let g = if which.is_empty() {
-            tests::exemplar(128, 128, 7)
-        } else {
-            let hf = crate::io::read(std::path::Path::new(&which), &Default::default()).unwrap();
-            let c = hf.crop(300, 300, 128, 128).unwrap();
-            crate::database::pyramid::Grid {
-                width: 128,
-                height: 128,
-                data: c.into_vec(),
-            }
-        };
-        let q = Quantization::spanning(-300.0, 4000.0);
-        let b = appearance::pca(&[&g], &q);
-        let feats = appearance::project(&[&g], &q, &b).1;
-        let layout = &plan(&[(128, 128)], 0).unwrap()[0];
-        let r = layout.rects[0];
-        let mut ex = 0.0;
-        let mut idx = vec![];
-        for k in (0..feats.len()).step_by(7) {
-            let (ux, uy) = r.coords(k as u64);
-            let mut best = f32::INFINITY;
-            for vy in MARGIN..r.height - MARGIN {
-                for vx in MARGIN..r.width - MARGIN {
-                    if vx.abs_diff(ux) < EXCLUSION && vy.abs_diff(uy) < EXCLUSION {
-                        continue;
-                    }
-                    best = best.min(distance(&feats[k], &feats[r.index(vx, vy)]));
-                }
-            }
-            ex += (best as f64).sqrt();
-            idx.push(k);
-        }
-        for it in [2, 4, 6, 8, 12, 16] {
-            for s in [4, 16] {
-                let (_, d) = similar(
-                    layout,
-                    &feats,
-                    Params {
-                        iterations: it,
-                        initial_samples: s,
-                        ..Default::default()
-                    },
-                );
-                let pm: f64 = idx.iter().map(|&k| (d[k] as f64).sqrt()).sum();
-                eprintln!("it {it} init {s}: ratio {:.4}", pm / ex);
-            }
-        }
     }
 }
