@@ -93,7 +93,15 @@ pub struct Pca {
     pub basis: Basis,
     /// Top [`KEY_DIMS`] unit directions (the first three are `basis.modes`).
     pub search: Vec<[f64; N]>,
+    /// Largest |residual component| over the level (units), which sets the
+    /// feature scale.
+    pub max_residual: f64,
 }
+
+/// Bound on |feature component|: differences of two features then fit i16
+/// and a pair of squared differences fits i32, so the similarity distance is
+/// an exact integer computed with 16-bit multiply-adds (see `patchmatch`).
+pub const FEATURE_MAX: f64 = 8191.0;
 
 /// Covariance of residuals over every texel of `grids`, then its leading
 /// eigenvectors. Rows are reduced in a fixed order, so the basis does not
@@ -105,27 +113,31 @@ pub fn pca(grids: &[&Grid], q: &Quantization) -> Pca {
         .enumerate()
         .flat_map(|(e, gr)| (0..gr.height).map(move |y| (e, y)))
         .collect();
-    let partials: Vec<Vec<f64>> = rows
+    let partials: Vec<(Vec<f64>, f64)> = rows
         .par_iter()
         .map(|&(e, y)| {
             let gr = grids[e];
             let mut c = vec![0.0f64; N * N];
+            let mut max = 0.0f64;
             for x in 0..gr.width {
                 let (_, r) = neighbourhood(gr, q, &g, &sg, x, y);
                 for i in 0..N {
+                    max = max.max(r[i].abs());
                     for j in i..N {
                         c[i * N + j] += r[i] * r[j];
                     }
                 }
             }
-            c
+            (c, max)
         })
         .collect();
     let mut cov = vec![0.0f64; N * N];
-    for p in &partials {
+    let mut max_residual = 0.0f64;
+    for (p, m) in &partials {
         for (c, v) in cov.iter_mut().zip(p) {
             *c += v;
         }
+        max_residual = max_residual.max(*m);
     }
     let count: usize = grids.iter().map(|g| g.width * g.height).sum();
     for i in 0..N {
@@ -170,6 +182,7 @@ pub fn pca(grids: &[&Grid], q: &Quantization) -> Pca {
             explained,
         },
         search,
+        max_residual,
     }
 }
 
@@ -201,8 +214,11 @@ fn clamp_i16(v: f64) -> i16 {
 pub struct Projected {
     /// Packed appearance texels (stored).
     pub texels: Vec<u64>,
-    /// PatchMatch features: quantized 25-d residuals, zero-padded.
+    /// PatchMatch features: 25-d residuals divided by `feature_scale`,
+    /// rounded, zero-padded; every component within ±[`FEATURE_MAX`].
     pub features: Vec<[i16; FEATURE_LANES]>,
+    /// Height units per feature unit at this level.
+    pub feature_scale: f64,
     /// Coordinates in the search space (top [`KEY_DIMS`] directions).
     pub keys: Vec<Key>,
 }
@@ -211,10 +227,16 @@ pub struct Projected {
 /// exemplar at one level.
 pub fn project(grids: &[&Grid], q: &Quantization, pca: &Pca) -> Projected {
     let basis = &pca.basis;
+    let feature_scale = if pca.max_residual > 0.0 {
+        pca.max_residual / FEATURE_MAX
+    } else {
+        1.0
+    };
     let (g, sg) = weights();
     let mut out = Projected {
         texels: Vec::new(),
         features: Vec::new(),
+        feature_scale,
         keys: Vec::new(),
     };
     for gr in grids {
@@ -236,13 +258,16 @@ pub fn project(grids: &[&Grid], q: &Quantization, pca: &Pca) -> Projected {
                     t.push(pack_texel(m));
                     let mut feat = [0i16; FEATURE_LANES];
                     for k in 0..N {
-                        feat[k] = clamp_i16(r[k]);
+                        feat[k] = (r[k] / feature_scale)
+                            .round()
+                            .clamp(-FEATURE_MAX, FEATURE_MAX)
+                            as i16;
                     }
                     f.push(feat);
                     keys.push(std::array::from_fn(|d| {
-                        pca.search
-                            .get(d)
-                            .map_or(0.0, |e| e.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>() as f32)
+                        pca.search.get(d).map_or(0.0, |e| {
+                            e.iter().zip(&r).map(|(a, b)| a * b).sum::<f64>() as f32
+                        })
                     }));
                 }
                 (t, f, keys)

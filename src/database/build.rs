@@ -218,8 +218,9 @@ pub fn build(
         );
         let texels = projected.texels;
         progress.advance(lay.texels());
-        let mean_match_distance =
-            dist.iter().map(|&d| (d as f64).sqrt()).sum::<f64>() / dist.len() as f64;
+        let mean_match_distance = projected.feature_scale
+            * dist.iter().map(|&d| (d as f64).sqrt()).sum::<f64>()
+            / dist.len() as f64;
         let tlevel: Vec<u8> = t0
             .iter()
             .zip(&lay.rects)

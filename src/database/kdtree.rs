@@ -24,52 +24,90 @@ pub type Key = [f32; KEY_DIMS];
 const LEAF: usize = 16;
 
 enum Node {
-    Split { dim: u8, value: f32, left: u32, right: u32 },
-    Leaf { start: u32, end: u32 },
+    Split {
+        dim: u8,
+        value: f32,
+        left: u32,
+        right: u32,
+    },
+    Leaf {
+        start: u32,
+        end: u32,
+    },
 }
 
 pub struct KdTree {
     nodes: Vec<Node>,
-    /// Texel index of each point, in tree order.
+    /// Payload of each point, in tree order.
     order: Vec<u32>,
+    /// Keys in tree order, so a leaf scan reads contiguous memory.
+    keys: Vec<Key>,
 }
 
 impl KdTree {
-    /// Builds a tree over the points whose keys are given, restricted to the
-    /// texels for which `include` is true.
-    pub fn build(keys: &[Key], include: impl Fn(usize) -> bool) -> KdTree {
-        let mut order: Vec<u32> = (0..keys.len() as u32).filter(|&k| include(k as usize)).collect();
+    /// Builds a tree over the points `k` for which `payload(k)` is `Some`;
+    /// queries report that payload (e.g. packed coordinates).
+    pub fn build(keys: &[Key], payload: impl Fn(usize) -> Option<u32>) -> KdTree {
+        let mut order: Vec<u32> = (0..keys.len() as u32)
+            .filter(|&k| payload(k as usize).is_some())
+            .collect();
         let mut nodes = Vec::new();
         if !order.is_empty() {
             let n = order.len();
             split(keys, &mut order, 0, n, &mut nodes);
         }
-        KdTree { nodes, order }
+        let tree_keys = order.iter().map(|&k| keys[k as usize]).collect();
+        let order = order
+            .iter()
+            .map(|&k| payload(k as usize).expect("filtered"))
+            .collect();
+        KdTree {
+            nodes,
+            order,
+            keys: tree_keys,
+        }
     }
 
-    /// Calls `visit(texel)` for every point in the `max_leaves` leaves
-    /// nearest to `q` (best-bin-first).
-    pub fn query(&self, q: &Key, max_leaves: usize, mut visit: impl FnMut(u32)) {
+    /// Calls `visit(payload, squared key distance)` for every point in the
+    /// `max_leaves` leaves nearest to `q` (best-bin-first).
+    pub fn query(&self, q: &Key, max_leaves: usize, mut visit: impl FnMut(u32, f32)) {
         if self.nodes.is_empty() {
             return;
         }
         let mut heap = BinaryHeap::new();
-        heap.push(Bin { bound: 0.0, node: 0 });
+        heap.push(Bin {
+            bound: 0.0,
+            node: 0,
+        });
         let mut leaves = 0;
         while let Some(Bin { node, .. }) = heap.pop() {
             let mut n = node;
             loop {
                 match self.nodes[n as usize] {
                     Node::Leaf { start, end } => {
-                        for i in start..end {
-                            visit(self.order[i as usize]);
+                        for i in start as usize..end as usize {
+                            let k = &self.keys[i];
+                            let mut d = 0.0;
+                            for (a, b) in k.iter().zip(q) {
+                                d += (a - b) * (a - b);
+                            }
+                            visit(self.order[i], d);
                         }
                         leaves += 1;
                         break;
                     }
-                    Node::Split { dim, value, left, right } => {
+                    Node::Split {
+                        dim,
+                        value,
+                        left,
+                        right,
+                    } => {
                         let d = q[dim as usize] - value;
-                        let (near, far) = if d < 0.0 { (left, right) } else { (right, left) };
+                        let (near, far) = if d < 0.0 {
+                            (left, right)
+                        } else {
+                            (right, left)
+                        };
                         heap.push(Bin {
                             bound: d * d,
                             node: far,
@@ -164,7 +202,7 @@ mod tests {
     #[test]
     fn many_leaves_find_the_exact_nearest_neighbour() {
         let keys: Vec<Key> = (0..2000).map(key).collect();
-        let tree = KdTree::build(&keys, |k| k % 3 != 0);
+        let tree = KdTree::build(&keys, |k| (k % 3 != 0).then_some(k as u32));
         let d2 = |a: &Key, b: &Key| a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>();
         for qi in 0..50u32 {
             let q = key(10_000 + qi);
@@ -173,9 +211,10 @@ mod tests {
                 .min_by(|&a, &b| d2(&q, &keys[a as usize]).total_cmp(&d2(&q, &keys[b as usize])))
                 .unwrap();
             let mut best = (f32::INFINITY, 0);
-            tree.query(&q, usize::MAX, |t| {
+            tree.query(&q, usize::MAX, |t, kd| {
                 assert!(t % 3 != 0, "excluded point visited");
                 let d = d2(&q, &keys[t as usize]);
+                assert_eq!(d, kd);
                 if d < best.0 {
                     best = (d, t);
                 }
@@ -187,11 +226,11 @@ mod tests {
     #[test]
     fn few_leaves_visit_close_points() {
         let keys: Vec<Key> = (0..5000).map(key).collect();
-        let tree = KdTree::build(&keys, |_| true);
+        let tree = KdTree::build(&keys, |k| Some(k as u32));
         // Querying a stored point with one leaf finds the point itself.
         for t in (0..5000).step_by(97) {
             let mut seen = false;
-            tree.query(&keys[t as usize], 1, |v| seen |= v == t);
+            tree.query(&keys[t as usize], 1, |v, _| seen |= v == t);
             assert!(seen);
         }
     }

@@ -94,6 +94,22 @@ pub struct Level<'a> {
     pub seeds: &'a [u32],
 }
 
+impl Level<'_> {
+    /// Texel index of a packed virtual coordinate; `None` outside every exemplar.
+    pub fn index_of(&self, c: u32) -> Option<usize> {
+        let (x, y) = layout::unpack(c);
+        let e = self.layout.exemplar_at(self.columns, x, y)?;
+        Some(self.layout.rects[e].index(x, y))
+    }
+
+    /// The k = 2 similarity candidates of texel `u` (paper eq. 3):
+    /// C₁(u) = u (the coherent candidate, not stored) and C₂(u).
+    pub fn candidates(&self, u: u32) -> [u32; 2] {
+        let k = self.index_of(u).expect("u lies in an exemplar");
+        [u, self.similar[k]]
+    }
+}
+
 struct LevelRanges {
     appearance: Range<usize>,
     similar: Range<usize>,

@@ -21,10 +21,11 @@
 //! independent, so rayon may run them in any order.
 
 use super::appearance::FEATURE_LANES;
-use super::kdtree::{Key, KdTree};
+use super::kdtree::{KdTree, Key};
 use super::layout::{LevelLayout, MARGIN, pack, unpack};
 use crate::hash::{below, hash4};
 use rayon::prelude::*;
+use wide::i16x16;
 
 /// Chebyshev radius (texels) of the trivial-match exclusion zone: 5 makes
 /// the source's and target's 5×5 windows disjoint.
@@ -33,24 +34,24 @@ pub const EXCLUSION: u32 = 5;
 /// Rows per scanline band: bands run in parallel, so the band layout (not
 /// the thread count) fixes the result.
 const BAND: u32 = 32;
-const ENRICH: usize = 2;
-const PER_RADIUS: u32 = 2;
-const GLOBAL: u32 = 4;
+/// Seed candidates per texel that get a full distance evaluation.
+const SHORTLIST: usize = 8;
 
 /// One residual feature (25 lanes used, zero-padded).
 pub type Feature = [i16; FEATURE_LANES];
 
-/// Squared distance of two features. Eight independent f32 accumulators
-/// summed in a fixed order: the compiler vectorises it, and the result is a
-/// deterministic function of the inputs.
+/// Exact squared distance of two features, in 16-bit SIMD: components are
+/// within ±8191 (`appearance::FEATURE_MAX`), so differences fit i16, each
+/// multiply-add lane (d₀² + d₁² ≤ 2·16382²) fits i32, two of them still do,
+/// and only the final 8-lane sum needs 64 bits.
 #[inline(always)]
-pub fn distance(a: &Feature, b: &Feature) -> f32 {
-    let mut acc = [0.0f32; 8];
-    for k in 0..FEATURE_LANES {
-        let d = (a[k] as i32 - b[k] as i32) as f32;
-        acc[k % 8] += d * d;
-    }
-    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
+pub fn distance(a: &Feature, b: &Feature) -> u64 {
+    let lo = i16x16::new(a[..16].try_into().expect("16 lanes"))
+        - i16x16::new(b[..16].try_into().expect("16 lanes"));
+    let hi = i16x16::new(a[16..].try_into().expect("16 lanes"))
+        - i16x16::new(b[16..].try_into().expect("16 lanes"));
+    let s = lo.dot(lo) + hi.dot(hi);
+    s.to_array().iter().map(|&v| v as u32 as u64).sum()
 }
 
 /// PatchMatch settings.
@@ -91,7 +92,7 @@ impl Ctx<'_> {
     /// Distance from source texel `k` (exemplar `e`, at `ux, uy`) to target
     /// `v`, or `None` if `v` is not an admissible target.
     #[inline(always)]
-    fn eval(&self, k: usize, e: usize, ux: u32, uy: u32, vx: i64, vy: i64) -> Option<f32> {
+    fn eval(&self, k: usize, e: usize, ux: u32, uy: u32, vx: i64, vy: i64) -> Option<u64> {
         if vx < 0 || vy < 0 || vx >= self.layout.atlas_width as i64 {
             return None;
         }
@@ -125,7 +126,7 @@ impl Ctx<'_> {
 }
 
 /// Runs PatchMatch over one level. Returns C₂ (packed coordinates) and the
-/// distance of each match. Every exemplar must have an interior large enough
+/// squared feature distance of each match. Every exemplar must have an interior large enough
 /// to hold an admissible target for each of its texels (the builder ensures
 /// exemplars are at least 16×16 at the coarsest level).
 pub fn similar(
@@ -133,7 +134,7 @@ pub fn similar(
     features: &[Feature],
     keys: &[Key],
     params: Params,
-) -> (Vec<u32>, Vec<f32>) {
+) -> (Vec<u32>, Vec<u64>) {
     let cumulative: Vec<u64> = layout
         .rects
         .iter()
@@ -162,30 +163,49 @@ pub fn similar(
     // PCA search space (see `kdtree`), plus a few uniformly random ones.
     let tree = KdTree::build(keys, |k| {
         let (e, x, y) = owner[k];
-        layout.rects[e as usize].is_interior(x, y)
+        layout.rects[e as usize]
+            .is_interior(x, y)
+            .then(|| pack(x, y))
     });
-    let (mut nnf, mut dist): (Vec<u32>, Vec<f32>) = (0..n)
+    let (mut nnf, mut dist): (Vec<u32>, Vec<u64>) = (0..n)
         .into_par_iter()
         .map(|k| {
             let (e, ux, uy) = owner[k];
-            let mut best = (u32::MAX, f32::INFINITY);
-            let consider = |vx: u32, vy: u32, best: &mut (u32, f32)| {
+            let mut best = (u32::MAX, u64::MAX);
+            let consider = |vx: u32, vy: u32, best: &mut (u32, u64)| {
                 if let Some(d) = ctx.eval(k, e as usize, ux, uy, vx as i64, vy as i64)
                     && d < best.1
                 {
                     *best = (pack(vx, vy), d);
                 }
             };
-            tree.query(&keys[k], params.search_leaves, |t| {
-                let (_, vx, vy) = owner[t as usize];
-                consider(vx, vy, &mut best);
+            // Rank the visited points by key distance (contiguous, cheap)
+            // and pay for full distances (random access) on the best few.
+            let mut shortlist = [(f32::INFINITY, u32::MAX); SHORTLIST];
+            tree.query(&keys[k], params.search_leaves, |c, kd| {
+                if kd < shortlist[SHORTLIST - 1].0 {
+                    let mut i = SHORTLIST - 1;
+                    while i > 0 && shortlist[i - 1].0 > kd {
+                        shortlist[i] = shortlist[i - 1];
+                        i -= 1;
+                    }
+                    shortlist[i] = (kd, c);
+                }
             });
+            for &(_, c) in shortlist.iter().filter(|s| s.1 != u32::MAX) {
+                let (vx, vy) = unpack(c);
+                consider(vx, vy, &mut best);
+            }
             let mut s = 0;
             while s < params.initial_samples || best.0 == u32::MAX {
-                let (vx, vy) = ctx.random_target(hash4(params.seed, params.level, k as u32, 0x1000 + s));
+                let (vx, vy) =
+                    ctx.random_target(hash4(params.seed, params.level, k as u32, 0x1000 + s));
                 consider(vx, vy, &mut best);
                 s += 1;
-                assert!(s < 10_000, "no admissible target: exemplar interior too small");
+                assert!(
+                    s < 10_000,
+                    "no admissible target: exemplar interior too small"
+                );
             }
             best
         })
@@ -202,7 +222,7 @@ pub fn similar(
         .collect();
     for it in 0..params.iterations {
         let forward = it % 2 == 0;
-        let results: Vec<(usize, Vec<u32>, Vec<f32>)> = bands
+        let results: Vec<(usize, Vec<u32>, Vec<u64>)> = bands
             .par_iter()
             .map(|&(e, y0)| {
                 let r = &layout.rects[e];
@@ -219,7 +239,7 @@ pub fn similar(
                     let (ux, uy) = (r.x0 + lx, ly);
                     let k = base + local;
                     let (mut bv, mut best) = (bn[local], bd[local]);
-                    let try_target = |vx: i64, vy: i64, bv: &mut u32, best: &mut f32| {
+                    let try_target = |vx: i64, vy: i64, bv: &mut u32, best: &mut u64| {
                         if let Some(d) = ctx.eval(k, e, ux, uy, vx, vy)
                             && d < *best
                         {
@@ -248,46 +268,31 @@ pub fn similar(
                     // Forward enrichment (Barnes et al. 2010): similarity
                     // is roughly transitive, and terrain's nearest-neighbour
                     // fields are not coherent enough for propagation alone.
-                    for _ in 0..ENRICH {
-                        let (cx, cy) = unpack(bv);
-                        let c = nnf[layout.rects[ctx
-                            .layout
-                            .exemplar_at(&ctx.columns, cx, cy)
-                            .expect("admissible")]
-                        .index(cx, cy)];
-                        let (px, py) = unpack(c);
-                        try_target(px as i64, py as i64, &mut bv, &mut best);
-                    }
+                    let (cx, cy) = unpack(bv);
+                    let ce = ctx
+                        .layout
+                        .exemplar_at(&ctx.columns, cx, cy)
+                        .expect("admissible");
+                    let (px, py) = unpack(nnf[layout.rects[ce].index(cx, cy)]);
+                    try_target(px as i64, py as i64, &mut bv, &mut best);
                     // Random search around the current best, radius halving.
                     let mut radius = search_radius;
                     let mut step_no = 0u32;
                     while radius >= 1 {
-                        for _ in 0..PER_RADIUS {
-                            let h = hash4(
-                                params.seed ^ it.wrapping_mul(0x9E37_79B9),
-                                params.level,
-                                k as u32,
-                                step_no,
-                            );
-                            let span = (2 * radius + 1) as u32;
-                            let (cx, cy) = unpack(bv);
-                            let vx = cx as i64 + below(h, span) as i64 - radius;
-                            let vy = cy as i64 + below(crate::hash::pcg(h), span) as i64 - radius;
-                            try_target(vx, vy, &mut bv, &mut best);
-                            step_no += 1;
-                        }
+                        let seed = params.seed ^ it.wrapping_mul(0x9E37_79B9);
+                        let h = hash4(seed, params.level, k as u32, step_no);
+                        let span = (2 * radius + 1) as u32;
+                        let (cx, cy) = unpack(bv);
+                        let vx = cx as i64 + below(h, span) as i64 - radius;
+                        let vy = cy as i64 + below(crate::hash::pcg(h), span) as i64 - radius;
+                        try_target(vx, vy, &mut bv, &mut best);
+                        step_no += 1;
                         radius /= 2;
                     }
-                    // Global samples keep other exemplars in reach.
-                    for g in 0..GLOBAL {
-                        let (gx, gy) = ctx.random_target(hash4(
-                            params.seed,
-                            params.level,
-                            k as u32,
-                            0x8000_0000 | it << 8 | g,
-                        ));
-                        try_target(gx as i64, gy as i64, &mut bv, &mut best);
-                    }
+                    // A global sample keeps other exemplars in reach.
+                    let g = hash4(params.seed, params.level, k as u32, 0x8000_0000 | it);
+                    let (gx, gy) = ctx.random_target(g);
+                    try_target(gx as i64, gy as i64, &mut bv, &mut best);
                     bn[local] = bv;
                     bd[local] = best;
                 }
@@ -374,7 +379,7 @@ mod tests {
         let (mut pm, mut ex) = (0.0f64, 0.0f64);
         for k in (0..feats.len()).step_by(7) {
             let (ux, uy) = r.coords(k as u64);
-            let mut best = f32::INFINITY;
+            let mut best = u64::MAX;
             for vy in MARGIN..r.height - MARGIN {
                 for vx in MARGIN..r.width - MARGIN {
                     if vx.abs_diff(ux) < EXCLUSION && vy.abs_diff(uy) < EXCLUSION {

@@ -2,6 +2,7 @@
 
 mod args;
 mod convert;
+mod db;
 mod info;
 mod progress;
 
@@ -25,6 +26,9 @@ enum Command {
     Info(info::Args),
     /// Convert a heightfield between formats (chosen by extension).
     Convert(convert::Args),
+    /// Build or inspect an exemplar database.
+    #[command(subcommand)]
+    Db(db::Command),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -35,6 +39,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Db(c) => db::run(c),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
