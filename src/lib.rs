@@ -12,6 +12,7 @@ pub mod error;
 pub mod heightfield;
 pub mod io;
 pub mod progress;
+pub mod render;
 
 pub use error::{Error, Result, SizeError};
 pub use heightfield::{Georef, Heightfield, Stats};

@@ -4,6 +4,7 @@ mod args;
 mod convert;
 mod info;
 mod progress;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -25,6 +26,8 @@ enum Command {
     Info(info::Args),
     /// Convert a heightfield between formats (chosen by extension).
     Convert(convert::Args),
+    /// Draw a shaded relief map (PNG) of a heightfield.
+    Render(render::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -35,6 +38,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Render(a) => render::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
