@@ -364,7 +364,7 @@ mod tests {
         let mut img = blank(20, 20);
         Canvas::new(&mut img, 2.0, 2.0).point((5.0, 5.0), 3.0, RED);
         assert_eq!(img.get_pixel(10, 10)[0], 255);
-        assert_eq!(img.get_pixel(10, 13)[0], 255);
+        assert_eq!(img.get_pixel(10, 11)[0], 255);
         assert_eq!(img.get_pixel(10, 16)[0], 0);
         assert_eq!(img.get_pixel(0, 0)[0], 0);
     }

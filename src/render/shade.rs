@@ -367,9 +367,18 @@ pub fn shade_pixel(p: &ShadeParams, b: &ShadeBuffers, x: u32, y: u32) -> u32 {
     let s = at(x, ys);
     let se = at(xe, ys);
 
-    // 2. Horn sums: 8 × the gradient in height units per pixel; |·| < 2^30.
-    let gx = (ne + 2 * ea + se) - (nw + 2 * we + sw);
-    let gy = (sw + 2 * s + se) - (nw + 2 * n + ne);
+    // 2. Horn sums: 8 × the gradient in height units per pixel. On the
+    // image border the replicated column spans one pixel instead of two, so
+    // the one-sided sum is doubled (edges shade like the interior).
+    // |sum| ≤ 2^29 inside, ≤ 2 · 4 · 2^27 = 2^30 doubled.
+    let mut gx = (ne + 2 * ea + se) - (nw + 2 * we + sw);
+    let mut gy = (sw + 2 * s + se) - (nw + 2 * n + ne);
+    if xe - xw == 1 {
+        gx *= 2;
+    }
+    if ys - yn == 1 {
+        gy *= 2;
+    }
     let sx = slope(
         gx,
         p.slope_x_mul,

@@ -54,6 +54,27 @@ impl Palette {
         }
     }
 
+    /// The palette moved toward grey by `amount` (0 = unchanged, 1 = grey
+    /// of the same lightness): under a type overlay, so that type colours
+    /// read as themselves instead of mixing with the elevation colours
+    /// (the interference seed 003 §3 notes between tints and type colouring).
+    pub fn muted(&self, amount: f64) -> Palette {
+        let stops = self
+            .stops
+            .iter()
+            .map(|&(t, c)| {
+                let grey = 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
+                let m = |v: u8| {
+                    (v as f64 + (grey - v as f64) * amount)
+                        .round()
+                        .clamp(0.0, 255.0) as u8
+                };
+                (t, [m(c[0]), m(c[1]), m(c[2])])
+            })
+            .collect();
+        Palette { stops }
+    }
+
     /// The colour at `t` (clamped to `[0, 1]`).
     pub fn sample(&self, t: f64) -> [u8; 3] {
         let t = t.clamp(0.0, 1.0);
@@ -98,6 +119,14 @@ mod tests {
         assert_eq!(p.sample(0.5), [100, 50, 25]);
         assert_eq!(p.sample(2.0), [200, 100, 50]);
         assert!(Palette::new(vec![(0.0, [0; 3]), (0.5, [0; 3])]).is_none());
+    }
+
+    #[test]
+    fn muted_keeps_lightness_and_loses_colour() {
+        let p = Palette::new(vec![(0.0, [200, 100, 0]), (1.0, [0, 0, 255])]).unwrap();
+        let g = p.muted(1.0).sample(0.0);
+        assert!(g[0] == g[1] && g[1] == g[2], "{g:?}");
+        assert_eq!(p.muted(0.0), p);
     }
 
     #[test]
