@@ -371,6 +371,13 @@ fn sizes_for_a_person() {
         ..RenderOptions::default()
     };
     assert_eq!(render(&big, &o).unwrap().image.width(), 1000);
+    // A small maximum wins over the default minimum.
+    let o = RenderOptions {
+        max_size: 300,
+        ..RenderOptions::default()
+    };
+    let small = Heightfield::new(100, 100, 1.0).unwrap();
+    assert_eq!(render(&small, &o).unwrap().image.width(), 300);
     let tiny = Heightfield::from_fn(100, 60, 1.0, |x, y| (x * y) as f32).unwrap();
     let p = render(&tiny, &RenderOptions::default()).unwrap();
     assert_eq!(p.image.dimensions(), (600, 360));
@@ -411,7 +418,7 @@ fn bad_options_are_refused_with_the_allowed_range() {
             ..RenderOptions::default()
         },
         RenderOptions {
-            min_size: 5000,
+            sea: Sea::Level(f64::NAN),
             ..RenderOptions::default()
         },
         RenderOptions {

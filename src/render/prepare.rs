@@ -79,7 +79,8 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         check_types(hf, t)?;
     }
     let (w, h) = (hf.width(), hf.height());
-    let (ow, oh) = resample::fit(w, h, o.min_size, o.max_size);
+    // The minimum is a wish and yields to the maximum.
+    let (ow, oh) = resample::fit(w, h, o.min_size.min(o.max_size), o.max_size);
     let resized = resample::heights(hf.data(), w, h, ow, oh);
     let heights: Vec<i32> = resized.iter().map(|&v| quantize(v as f64)).collect();
     let (sx, sy) = (ow as f64 / w as f64, oh as f64 / h as f64);
@@ -101,8 +102,11 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         p.slope_y_post,
         p.slope_y_clamp,
     ) = slope_scale(o.exaggeration, cell_y)?;
-    p.shade_flat = shade::hillshade(&p, 0, 0).max(1);
     p.shade_floor = (o.lighting.shadow * 256.0).round() as u32;
+    // Flat ground must come out at exactly 256 (the tint unchanged): the
+    // gain maps the kernel's own flat hillshade onto 256 − floor.
+    let flat = shade::hillshade(&p, 0, 0).max(1) as f64;
+    p.shade_gain = (((256 - p.shade_floor) as f64 * 65536.0 / flat).round() as u32).min(1 << 19);
     p.shade_max = ((1.0 + o.lighting.highlight) * 256.0).round() as u32;
     p.nodata_colour = pack(NODATA_COLOUR, 255);
     p.nodata_hatch = pack(NODATA_HATCH, 255);
@@ -119,7 +123,10 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
             p.flags |= flags::SEA;
             p.water_level = quantize(s + SEA_TOLERANCE_M);
             let depth = (s + SEA_TOLERANCE_M - lo).max(tint::MIN_WATER_DEPTH_M);
-            p.water_step = ((depth * UNITS_PER_M / 256.0).ceil() as u32).max(1);
+            // A power-of-two depth step (a shift in the kernel) reaching
+            // the deep colour at `depth` or up to twice it.
+            let step = ((depth * UNITS_PER_M / 256.0).ceil() as u32).max(1);
+            p.water_shift = step.next_power_of_two().trailing_zeros();
             p.water_shallow = pack(tint::WATER_SHALLOW, 255);
             p.water_deep = pack(tint::WATER_DEEP, 255);
             p.coast_colour = pack3(contours::COAST_COLOUR);
@@ -139,8 +146,8 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         Some(_) => o.palette.muted(TYPES_MUTE),
         None => o.palette.clone(),
     };
-    let (step, lut) = tint::table(&palette, span);
-    p.tint_step = step;
+    let (shift, lut) = tint::table(&palette, span);
+    p.tint_shift = shift;
     p.tint_len = lut.len() as u32;
 
     // Out-of-range red.
@@ -307,9 +314,6 @@ fn check_options(o: &RenderOptions) -> Result<(), RenderError> {
     };
     if !(1..=super::MAX_PREVIEW_SIDE).contains(&o.max_size) {
         return bad("max_size", o.max_size.to_string(), "1..=16384 pixels");
-    }
-    if o.min_size > o.max_size {
-        return bad("min_size", o.min_size.to_string(), "at most max_size");
     }
     if !(o.exaggeration.is_finite() && o.exaggeration > 0.0 && o.exaggeration <= 1000.0) {
         return bad(

@@ -1,5 +1,8 @@
 //! Sizing the preview for a person: large grids are box-filtered down to the
-//! size limit, tiny ones enlarged by a whole factor with bilinear heights.
+//! size limit, tiny ones enlarged by a whole factor with Catmull-Rom cubic
+//! heights (bilinear heights have a gradient that jumps at every cell edge,
+//! which a hillshade turns into a visible block pattern; the cubic passes
+//! through the samples with a continuous gradient).
 //! Both work on heights *before* shading, so slopes and contours are computed
 //! at the resolution that is shown (shading first and shrinking after would
 //! alias the light and break contour lines).
@@ -26,11 +29,14 @@ pub fn fit(width: usize, height: usize, min_size: usize, max_size: usize) -> (us
 
 /// Resamples row-major heights (NaN = nodata) from `w × h` to `ow × oh`,
 /// one axis at a time: each axis is area-averaged when it shrinks,
-/// bilinearly interpolated (sample centres aligned) when it grows.
+/// Catmull-Rom interpolated (sample centres aligned, edges replicated) when
+/// it grows.
 ///
 /// Nodata rule, per pass: an output sample is the weighted mean of the valid
 /// input samples under its filter, or nodata when they carry less than half
 /// of the filter's weight — so holes neither grow nor shrink noticeably.
+/// (The cubic's negative lobes make this approximate next to holes; the
+/// result stays a weighted mean of nearby valid samples.)
 pub fn heights(data: &[f32], w: usize, h: usize, ow: usize, oh: usize) -> Vec<f32> {
     if (w, h) == (ow, oh) {
         return data.to_vec();
@@ -88,15 +94,28 @@ fn taps(n: usize, on: usize) -> Vec<Taps> {
                     .filter(|&(_, wt)| wt > 0.0)
                     .collect()
             } else if on > n {
-                // Bilinear between the two nearest centres (edges clamp).
+                // Catmull-Rom through the four nearest centres; positions
+                // beyond the outer centres clamp, indices replicate the edge.
                 let x = ((o as f64 + 0.5) * scale - 0.5).clamp(0.0, (n - 1) as f64);
-                let i = (x.floor() as usize).min(n - 1);
-                let f = (x - i as f64) as f32;
-                if f > 0.0 && i + 1 < n {
-                    vec![(i, 1.0 - f), (i + 1, f)]
-                } else {
-                    vec![(i, 1.0)]
+                let i = x.floor() as i64;
+                let f = x - i as f64;
+                let (f2, f3) = (f * f, f * f * f);
+                let w = [
+                    (-f3 + 2.0 * f2 - f) / 2.0,
+                    (3.0 * f3 - 5.0 * f2 + 2.0) / 2.0,
+                    (-3.0 * f3 + 4.0 * f2 + f) / 2.0,
+                    (f3 - f2) / 2.0,
+                ];
+                let mut taps: Taps = Vec::with_capacity(4);
+                for (k, wk) in w.into_iter().enumerate() {
+                    let idx = (i + k as i64 - 1).clamp(0, n as i64 - 1) as usize;
+                    match taps.iter_mut().find(|t| t.0 == idx) {
+                        Some(t) => t.1 += wk as f32,
+                        None => taps.push((idx, wk as f32)),
+                    }
                 }
+                taps.retain(|t| t.1 != 0.0);
+                taps
             } else {
                 vec![(o, 1.0)]
             }
@@ -148,11 +167,19 @@ mod tests {
     }
 
     #[test]
-    fn bilinear_growth_is_exact_on_ramps() {
-        let out = heights(&[0.0, 4.0], 2, 1, 4, 1);
-        assert_eq!(out, vec![0.0, 1.0, 3.0, 4.0]);
+    fn cubic_growth_passes_through_samples_and_keeps_ramps() {
+        // ×4 along a ramp: away from the edges the cubic is exactly linear.
+        let ramp: Vec<f32> = (0..8).map(|i| i as f32 * 2.0).collect();
+        let out = heights(&ramp, 8, 1, 32, 1);
+        for (o, v) in out.iter().enumerate().take(26).skip(6) {
+            let x = (o as f32 + 0.5) / 4.0 - 0.5;
+            assert!((v - 2.0 * x).abs() < 1e-4, "{o}: {v}");
+        }
+        // Constants stay constant, the ends are the end samples.
         let out = heights(&[2.0], 1, 1, 3, 3);
         assert!(out.iter().all(|&v| v == 2.0));
+        let out = heights(&[1.0, 5.0, 3.0], 3, 1, 9, 1);
+        assert_eq!((out[0], out[4], out[8]), (1.0, 5.0, 3.0));
     }
 
     #[test]

@@ -107,24 +107,25 @@ pub struct ShadeParams {
     pub slope_y_post: u32,
     pub slope_y_clamp: i32,
 
-    /// Shading factor (×256) of a fully dark pixel; a flat pixel gets 256.
+    /// Shading factor (×256) of a fully dark pixel: the factor is
+    /// `shade_floor + (hs · shade_gain + 2^15) >> 16`, where the CPU picks
+    /// the gain so that flat ground gets exactly 256 (`≤ 2^19`).
     pub shade_floor: u32,
-    /// Hillshade value of flat ground (0..=4096, ≥ 1).
-    pub shade_flat: u32,
+    pub shade_gain: u32,
     /// Largest shading factor (256..=512); above 256 the colour moves to white.
     pub shade_max: u32,
     pub nodata_colour: u32,
 
-    /// Tint table: entry `clamp((h − tint_lo) / tint_step, 0, tint_len − 1)`.
+    /// Tint table: entry `min((max(h, tint_lo) − tint_lo) >> tint_shift, tint_len − 1)`.
     pub tint_lo: i32,
-    pub tint_step: u32,
+    pub tint_shift: u32,
     pub tint_len: u32,
     pub nodata_hatch: u32,
 
     /// Water is `h <= water_level` (sea level plus a tolerance for flat-sea
-    /// noise); its depth tint is `min(256, (water_level − h) / water_step)`.
+    /// noise); its depth tint is `min(256, (water_level − h) >> water_shift)`.
     pub water_level: i32,
-    pub water_step: u32,
+    pub water_shift: u32,
     pub water_shallow: u32,
     pub water_deep: u32,
 
@@ -252,8 +253,8 @@ impl ShadeParams {
                 ));
             }
         }
-        if self.shade_flat == 0 || self.shade_flat > LIGHT_ONE as u32 {
-            return err(format!("shade_flat {} must be 1..=4096", self.shade_flat));
+        if self.shade_gain > 1 << 19 {
+            return err(format!("shade_gain {} must be <= 2^19", self.shade_gain));
         }
         if self.shade_floor > FULL || !(FULL..=2 * FULL).contains(&self.shade_max) {
             return err(format!(
@@ -261,16 +262,16 @@ impl ShadeParams {
                 self.shade_floor, self.shade_max
             ));
         }
-        if self.tint_step == 0 || self.tint_len == 0 || b.tint.len() != self.tint_len as usize {
+        if self.tint_shift > 31 || self.tint_len == 0 || b.tint.len() != self.tint_len as usize {
             return err(format!(
-                "tint table: step {} and length {} must be >= 1 and match the buffer ({})",
-                self.tint_step,
+                "tint table: shift {} must be <= 31, length {} >= 1 and match the buffer ({})",
+                self.tint_shift,
                 self.tint_len,
                 b.tint.len()
             ));
         }
-        if self.flags & flags::SEA != 0 && self.water_step == 0 {
-            return err("water_step must be >= 1".into());
+        if self.water_shift > 31 {
+            return err(format!("water_shift {} must be <= 31", self.water_shift));
         }
         if self.flags & flags::CONTOURS != 0
             && (self.contour_interval == 0 || self.contour_interval > 1 << 27)
@@ -285,8 +286,8 @@ impl ShadeParams {
             self.index_half_width,
             self.coast_half_width,
         ];
-        if half_widths.iter().any(|&w| w > 16 * FULL) || self.contour_min_spacing > 1 << 20 {
-            return err("line half widths must be <= 16 px, min spacing <= 4096 px".into());
+        if half_widths.iter().any(|&w| w > 16 * FULL) || self.contour_min_spacing > 1 << 13 {
+            return err("line half widths must be <= 16 px, min spacing <= 32 px".into());
         }
         if self.flags & flags::GRID != 0 && (self.grid_step_x < FULL || self.grid_step_y < FULL) {
             return err(format!(
@@ -396,8 +397,8 @@ pub fn shade_pixel(p: &ShadeParams, b: &ShadeBuffers, x: u32, y: u32) -> u32 {
 
     // 3. Light.
     let hs = hillshade(p, sx, sy);
-    let factor = p.shade_floor + hs * (FULL - p.shade_floor) / p.shade_flat;
-    let factor = factor.min(p.shade_max);
+    // hs ≤ 4096, gain ≤ 2^19: the product and the rounding half fit in u32.
+    let factor = (p.shade_floor + ((hs * p.shade_gain + (1 << 15)) >> 16)).min(p.shade_max);
 
     // 4. Colour.
     let water = p.flags & flags::SEA != 0 && h <= p.water_level;
@@ -405,11 +406,11 @@ pub fn shade_pixel(p: &ShadeParams, b: &ShadeBuffers, x: u32, y: u32) -> u32 {
     let mut colour = if out_of_range {
         p.range_colour
     } else if water {
-        let t = ((p.water_level - h) as u32 / p.water_step).min(FULL);
+        let t = ((p.water_level - h) as u32 >> p.water_shift).min(FULL);
         blend(p.water_shallow, p.water_deep, t)
     } else {
         let d = (h.max(p.tint_lo) - p.tint_lo) as u32; // < 2^28
-        b.tint[(d / p.tint_step).min(p.tint_len - 1) as usize]
+        b.tint[(d >> p.tint_shift).min(p.tint_len - 1) as usize]
     };
     if p.flags & flags::TYPES != 0 {
         let t = (b.types[i >> 2] >> ((i as u32 & 3) * 8)) & 0xff;
@@ -420,19 +421,26 @@ pub fn shade_pixel(p: &ShadeParams, b: &ShadeBuffers, x: u32, y: u32) -> u32 {
     }
     colour = apply_shade(colour, factor);
 
-    // 5. Lines.
-    if p.flags & (flags::CONTOURS | flags::SEA) != 0 {
+    // 5. Lines. Which levels pass through the 3×3 neighbourhood is cheap to
+    // find; the gradient magnitude (a square root) is only needed there.
+    let contour_level = if p.flags & flags::CONTOURS != 0 {
+        // Contours follow the 1-2-1 smoothed height (the same 3×3 weights
+        // as the gradient), so sensor noise on flat ground does not draw
+        // a froth of tiny loops. |sum| ≤ 16 · 2^26 = 2^30.
+        let sum = 4 * h + 2 * (n + s + we + ea) + (nw + ne + sw + se);
+        nearest_level(p, floor_div(sum, 16)).filter(|l| straddles(lo, hi, l.level))
+    } else {
+        None
+    };
+    // The coastline is the level just above sea level.
+    let coast = p.flags & flags::SEA != 0 && straddles(lo, hi, p.water_level + 1);
+    if contour_level.is_some() || coast {
         let g = Gradient::new(gx, gy);
-        if p.flags & flags::CONTOURS != 0 {
-            // Contours follow the 1-2-1 smoothed height (the same 3×3 weights
-            // as the gradient), so sensor noise on flat ground does not draw
-            // a froth of tiny loops. |sum| ≤ 16 · 2^26 = 2^30.
-            let sum = 4 * h + 2 * (n + s + we + ea) + (nw + ne + sw + se);
-            colour = contour(p, &g, floor_div(sum, 16), lo, hi, colour);
+        if let Some(l) = contour_level {
+            colour = contour(p, &g, &l, colour);
         }
-        if p.flags & flags::SEA != 0 {
-            // The coastline is the level just above sea level.
-            let cov = line_coverage(&g, h, lo, hi, p.water_level + 1, p.coast_half_width);
+        if coast {
+            let cov = line_coverage(&g, h.abs_diff(p.water_level + 1), p.coast_half_width);
             colour = blend(
                 colour,
                 p.coast_colour,
@@ -474,7 +482,9 @@ pub fn hillshade(p: &ShadeParams, sx: i32, sy: i32) -> u32 {
         ny <<= k;
         nz <<= k;
     }
-    let len = isqrt((nx * nx) as u32 + (ny * ny) as u32 + (nz * nz) as u32).max(1);
+    // len in [2^14, 2^15.8); its reciprocal 2^30 / len in (2^14.2, 2^16].
+    let len = isqrt((nx * nx) as u32 + (ny * ny) as u32 + (nz * nz) as u32);
+    let recip = (1u32 << 30) / len;
 
     // Aspect direction (downslope, the normal's horizontal part) scaled to a
     // largest component in [2^7, 2^8), for the USGS weights.
@@ -492,11 +502,16 @@ pub fn hillshade(p: &ShadeParams, sx: i32, sy: i32) -> u32 {
         }
     }
 
+    // Lambert term dot / len, 0..=4096: dot < (len + 1) · 4096 < 2^27.8, so
+    // (dot >> 12) · recip < 2^15.8 · 2^16 fits u32.
+    let lambert = |l: &[i32; 4]| -> u32 {
+        let dot = nx * l[0] + ny * l[1] + nz * l[2];
+        ((dot.max(0) as u32 >> 12) * recip) >> 18
+    };
     let mut sum = 0u32; // < 4 · 2^15 · 2^12 = 2^29
     let mut wsum = 0u32;
     for l in &p.lights[..p.light_count as usize] {
-        let dot = nx * l[0] + ny * l[1] + nz * l[2];
-        let lambert = (dot.max(0) as u32) / len; // 0..=4096
+        let lambert = lambert(l);
         let w = if aspect {
             // sin²(aspect − azimuth) = cross(d, a)² / (|d|²|a|²), with the
             // light's horizontal direction a at ≤ 2^7: |cross| < 2^15.5.
@@ -513,8 +528,7 @@ pub fn hillshade(p: &ShadeParams, sx: i32, sy: i32) -> u32 {
         // slope exactly along every light): fall back to the fixed weights.
         sum = 0;
         for l in &p.lights[..p.light_count as usize] {
-            let dot = nx * l[0] + ny * l[1] + nz * l[2];
-            sum += l[3] as u32 * ((dot.max(0) as u32) / len);
+            sum += l[3] as u32 * lambert(l);
             wsum += l[3] as u32;
         }
     }
@@ -540,57 +554,84 @@ impl Gradient {
         }
     }
 
-    /// A height difference in units → pixels × 256 (saturating at 2^20,
-    /// i.e. "far"; a flat pixel is infinitely far from every level).
-    fn to_px256(&self, units: u32) -> u32 {
+    /// A height difference in units → pixels × 256, when that is below
+    /// `limit` (≤ 2^13); `None` otherwise, without dividing. A flat pixel
+    /// is infinitely far from every level.
+    fn px256_below(&self, units: u32, limit: u32) -> Option<u32> {
         let u = units >> self.k;
-        if self.g == 0 || u >= 1 << 20 {
-            return 1 << 20;
+        // u < 2^20 keeps u·2^11 in u32; limit · g < 2^13 · 2^16.
+        if self.g == 0 || u >= 1 << 20 || u << 11 >= limit * self.g {
+            return None;
         }
-        ((u << 11) / self.g).min(1 << 20)
+        Some((u << 11) / self.g)
     }
 }
 
-/// Anti-aliased coverage (0..=256) of the line along level `level` at this
-/// pixel. The line exists only where the 3×3 neighbourhood straddles the
-/// level (`lo < level <= hi`: a level separates heights below it from
-/// heights at or above it), so flat ground lying exactly on a level stays clean.
-fn line_coverage(g: &Gradient, h: i32, lo: i32, hi: i32, level: i32, half_width: u32) -> u32 {
-    if !(lo < level && level <= hi) {
-        return 0;
-    }
-    let d = g.to_px256(h.abs_diff(level)); // |h − L| ≤ 2^28 by the height bound
-    // A box-filtered line: full inside the half width, linear over one pixel.
-    (half_width + 128).saturating_sub(d).min(FULL)
+/// A level a line may be drawn along, with its distance from the pixel.
+struct Level {
+    level: i32,
+    /// |h − level| in height units (≤ 2^27 by the bounds).
+    dist: u32,
+    index: bool,
 }
 
-fn contour(p: &ShadeParams, g: &Gradient, h: i32, lo: i32, hi: i32, colour: u32) -> u32 {
+/// The contour level nearest to `h` (ties go to the lower one), or `None`
+/// where sea level's contour is left to the coastline. One floor division.
+fn nearest_level(p: &ShadeParams, h: i32) -> Option<Level> {
     let interval = p.contour_interval as i32;
-    let r = floor_mod(h - p.contour_base, interval);
-    let level = if r <= interval - r {
-        h - r
+    let q = floor_div(h - p.contour_base, interval); // |q·I| ≤ 2^27 + 2^27
+    let below = p.contour_base + q * interval;
+    let r = h - below; // 0 ≤ r < I
+    let (level, k) = if r <= interval - r {
+        (below, q)
     } else {
-        h - r + interval
+        (below + interval, q + 1)
     };
     if p.flags & flags::SEA != 0 && level == p.contour_base {
-        return colour; // sea level: the coastline stands for it
+        return None;
     }
-    let k = floor_div(level - p.contour_base, interval);
-    let index = p.contour_index_every != 0 && floor_mod(k, p.contour_index_every as i32) == 0;
-    let (half_width, line) = if index {
+    Some(Level {
+        level,
+        dist: h.abs_diff(level),
+        index: p.contour_index_every != 0 && floor_mod(k, p.contour_index_every as i32) == 0,
+    })
+}
+
+/// Whether a level separates the 3×3 neighbourhood: a level divides heights
+/// below it from heights at or above it (`lo < level <= hi`), so flat ground
+/// lying exactly on a level draws nothing.
+fn straddles(lo: i32, hi: i32, level: i32) -> bool {
+    lo < level && level <= hi
+}
+
+/// Anti-aliased coverage (0..=256) of a line `dist` height units away:
+/// the distance in pixels is `dist / |∇h|`, and a box-filtered line is
+/// full inside its half width and falls off linearly over one pixel.
+fn line_coverage(g: &Gradient, dist: u32, half_width: u32) -> u32 {
+    let reach = half_width + 128; // ≤ 2^13
+    match g.px256_below(dist, reach) {
+        Some(d) => (reach - d).min(FULL),
+        None => 0,
+    }
+}
+
+fn contour(p: &ShadeParams, g: &Gradient, l: &Level, colour: u32) -> u32 {
+    let (half_width, line) = if l.index {
         (p.index_half_width, p.index_colour)
     } else {
         (p.contour_half_width, p.contour_colour)
     };
-    let mut cov = line_coverage(g, h, lo, hi, level, half_width);
+    let mut cov = line_coverage(g, l.dist, half_width);
     if cov == 0 {
         return colour;
     }
-    if !index && p.contour_min_spacing > 0 {
+    if !l.index && p.contour_min_spacing > 0 {
         // Spacing between neighbouring levels, in 1/256 px: fade the minor
         // lines from full at `min_spacing` to nothing at half of it.
-        let spacing = g.to_px256(p.contour_interval);
         let half = p.contour_min_spacing / 2;
+        let spacing = g
+            .px256_below(p.contour_interval, p.contour_min_spacing)
+            .unwrap_or(p.contour_min_spacing);
         let fade = (spacing.saturating_sub(half) * FULL / half.max(1)).min(FULL);
         cov = (cov * fade) >> 8;
     }
@@ -661,19 +702,19 @@ pub fn floor_mod(a: i32, d: i32) -> i32 {
     if r < 0 { r + d } else { r }
 }
 
-/// `floor(sqrt(n))`, bit by bit (16 fixed steps of the classic method).
+/// `floor(sqrt(n))`, bit by bit: 16 fixed steps of the classic method,
+/// written with selects instead of branches (the data decide each step, so
+/// a branch would mispredict half the time; WGSL's `select` does the same).
 #[inline]
 pub fn isqrt(n: u32) -> u32 {
     let mut rem = n;
     let mut root = 0u32;
     let mut bit = 1u32 << 30;
     while bit != 0 {
-        if rem >= root + bit {
-            rem -= root + bit;
-            root = (root >> 1) + bit;
-        } else {
-            root >>= 1;
-        }
+        let t = root + bit;
+        let take = rem >= t;
+        rem = if take { rem - t } else { rem };
+        root = (root >> 1) + if take { bit } else { 0 };
         bit >>= 2;
     }
     root

@@ -95,17 +95,23 @@ pub fn pack(rgb: [u8; 3], alpha: u8) -> u32 {
 }
 
 /// The tint table for heights `lo_units ..= lo_units + span_units`:
-/// returns `(step, table)` with entry `k` coloured at the centre of
-/// `[lo + k·step, lo + (k+1)·step)`. `span_units >= 1`.
+/// returns `(shift, table)` with entry `k` coloured at the centre of
+/// `[lo + k·2^shift, lo + (k+1)·2^shift)`. The step is a power of two so the
+/// kernel indexes with a shift, not a division; the smallest one covering
+/// the span in [`LUT_LEN`] entries (so 512 to 1024 of them fall inside it).
 pub fn table(palette: &Palette, span_units: u32) -> (u32, Vec<u32>) {
-    let step = span_units.div_ceil(LUT_LEN as u32).max(1);
+    let step = span_units
+        .div_ceil(LUT_LEN as u32)
+        .max(1)
+        .next_power_of_two();
+    let shift = step.trailing_zeros();
     let lut = (0..LUT_LEN)
         .map(|k| {
             let t = (k as f64 + 0.5) * step as f64 / span_units as f64;
             pack(palette.sample(t), 255)
         })
         .collect();
-    (step, lut)
+    (shift, lut)
 }
 
 #[cfg(test)]
@@ -131,9 +137,10 @@ mod tests {
 
     #[test]
     fn table_covers_the_span() {
-        let (step, lut) = table(&Palette::natural(), 1_500_000);
+        let (shift, lut) = table(&Palette::natural(), 1_500_000);
         assert_eq!(lut.len(), LUT_LEN);
-        assert!(step as usize * LUT_LEN >= 1_500_000);
+        assert!((1usize << shift) * LUT_LEN >= 1_500_000);
+        assert!((1usize << shift) * LUT_LEN < 2 * 1_500_000);
         assert_eq!(lut[0] >> 24, 255);
         // Snow at the top, green at the bottom.
         let top = lut[LUT_LEN - 1].to_le_bytes();

@@ -47,7 +47,7 @@ pub struct Args {
     /// Longest side of the preview in pixels; larger inputs are averaged down.
     #[arg(long, value_name = "PX", default_value_t = 2048)]
     max_size: usize,
-    /// Smaller inputs are enlarged by a whole factor to at least this size.
+    /// Smaller inputs are enlarged by a whole factor toward this size (at most --max-size).
     #[arg(long, value_name = "PX", default_value_t = 512)]
     min_size: usize,
     /// Show water below this level [default: 0 m, if the heights cross it].
