@@ -186,7 +186,7 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         if gx.min(gy) < MIN_GRID_PX {
             return Err(RenderError::Option {
                 option: "grid",
-                value: format!("{:?}", o.grid),
+                value: grid_text(o.grid),
                 allowed: format!(
                     "lines at least {MIN_GRID_PX} px apart; at this preview size they would be {:.2} px apart",
                     gx.min(gy)
@@ -250,6 +250,14 @@ pub fn quantize(m: f64) -> i32 {
     }
     let lim = shade::MAX_ABS_HEIGHT as f64;
     (m * UNITS_PER_M).round().clamp(-lim, lim) as i32
+}
+
+fn grid_text(g: Grid) -> String {
+    match g {
+        Grid::Off => "off".into(),
+        Grid::Cells(n) => format!("every {n} cells"),
+        Grid::Metres(m) => format!("every {m} m"),
+    }
 }
 
 /// Pixels → 1/256 pixel.
@@ -358,7 +366,7 @@ fn check_options(o: &RenderOptions) -> Result<(), RenderError> {
     }
     match o.grid {
         Grid::Cells(v) | Grid::Metres(v) if !(v.is_finite() && v > 0.0) => {
-            return bad("grid", format!("{:?}", o.grid), "a positive spacing");
+            return bad("grid", grid_text(o.grid), "a positive spacing");
         }
         _ => {}
     }

@@ -371,7 +371,7 @@ pub fn shade_pixel(p: &ShadeParams, b: &ShadeBuffers, x: u32, y: u32) -> u32 {
     // 2. Horn sums: 8 × the gradient in height units per pixel. On the
     // image border the replicated column spans one pixel instead of two, so
     // the one-sided sum is doubled (edges shade like the interior).
-    // |sum| ≤ 2^29 inside, ≤ 2 · 4 · 2^27 = 2^30 doubled.
+    // Each side is ≤ 4 · 2^26, so |sum| ≤ 2^29, and ≤ 2^30 doubled.
     let mut gx = (ne + 2 * ea + se) - (nw + 2 * we + sw);
     let mut gy = (sw + 2 * s + se) - (nw + 2 * n + ne);
     if xe - xw == 1 {

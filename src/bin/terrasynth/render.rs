@@ -4,18 +4,24 @@ use crate::{CliResult, args::Input};
 use std::path::PathBuf;
 use terrasynth::render::{self, Contours, Grid, RenderOptions, Sea, TypeMask, TypeOverlay};
 
-/// Draws a shaded relief map of a heightfield: multi-directional hillshade,
-/// colours by elevation (greens low, browns, rock, snow high; blue water when
-/// the heights cross sea level), brown contour lines with a thicker index
-/// line every fifth, and optionally a grid, red where heights leave a range,
-/// and coloured terrain types. Hatched grey marks missing data.
-///
-/// Large inputs are shrunk to --max-size pixels, small ones enlarged to at
-/// least --min-size; a line on stderr says which contour interval was used.
-///
-/// Example: terrasynth render alps.png -o alps-preview.png --grid-m 1000
+/// What the picture shows, printed after the options.
+const ABOUT_THE_MAP: &str = "\
+The map: a shaded relief lit from the north-west, coloured by elevation
+(greens low, then tans and browns, rock grey and snow high; blue water
+below sea level when the heights cross 0 m), brown contour lines with a
+thicker index line every fifth, and hatched grey where data is missing.
+Optional: a white grid, red where heights leave --range, and terrain types
+in colour (the legend is printed). A line on stderr says which contour
+interval was used. Inputs larger than --max-size are averaged down;
+smaller ones are enlarged.
+
+Examples:
+  terrasynth render alps.png -o alps-preview.png
+  terrasynth render alps.png -o check.png --range 400:3200 --grid-m 1000
+  terrasynth render dem.png -o types.png --types dem_types.png";
+
 #[derive(clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(after_help = ABOUT_THE_MAP)]
 pub struct Args {
     /// Input heightfield (any readable format).
     input: PathBuf,
