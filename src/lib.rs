@@ -16,6 +16,7 @@ pub mod heightfield;
 pub mod io;
 pub mod poisson;
 pub mod progress;
+pub mod render;
 pub mod resample;
 
 pub use error::{Error, Result, SizeError};

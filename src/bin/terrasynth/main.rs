@@ -5,6 +5,7 @@ mod convert;
 mod db;
 mod info;
 mod progress;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -29,6 +30,8 @@ enum Command {
     /// Build or inspect an exemplar database.
     #[command(subcommand)]
     Db(db::Command),
+    /// Draw a shaded relief map (PNG) of a heightfield.
+    Render(render::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -40,6 +43,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Db(c) => db::run(c),
+        Command::Render(a) => render::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
