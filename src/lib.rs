@@ -11,6 +11,7 @@
 pub mod error;
 pub mod heightfield;
 pub mod io;
+pub mod procedural;
 pub mod progress;
 
 pub use error::{Error, Result, SizeError};

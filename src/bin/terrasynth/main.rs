@@ -2,6 +2,7 @@
 
 mod args;
 mod convert;
+mod generate;
 mod info;
 mod progress;
 
@@ -25,6 +26,8 @@ enum Command {
     Info(info::Args),
     /// Convert a heightfield between formats (chosen by extension).
     Convert(convert::Args),
+    /// Generate a procedural terrain in a default exemplar style (see --list).
+    Generate(generate::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -35,6 +38,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Generate(a) => generate::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
