@@ -348,7 +348,7 @@ fn hills(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield,
         rounds: [0, 0, 2, 5, 30, 0],
         fluvial_steps: [0, 0, 3, 5, 5, 0],
         thermal_steps: 3,
-        creep: [2, 4, 2, 0, 0, 0],
+        creep: [6, 12, 6, 2, 0, 0],
         detail_m: [1.5, 3.0, 0.0, 0.0, 50.0, 0.0],
         ridged_detail: false,
     };
@@ -396,7 +396,10 @@ fn canyon(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield
     };
     const FLOOR_M: f64 = 1200.0;
     const DEPTH_M: f64 = 900.0;
-    const STEPS: u32 = 4;
+    const STEPS: u32 = 5;
+    /// Heights above `1/LIFT` of the range become one flat top: the highest
+    /// ground ends in flat mesas instead of smooth summits.
+    const LIFT: f64 = 1.08;
     const RISER: f64 = 0.2;
     /// Share of the unterraced surface kept, so treads are not dead flat.
     const TREAD_SLOPE: f64 = 0.1;
@@ -404,7 +407,7 @@ fn canyon(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield
     let mut hf = evolve(&recipe, size, seed, progress)?;
     remap::normalize(&mut hf);
     remap::map(&mut hf, |t| {
-        let b = remap::bias(0.8, t);
+        let b = (remap::bias(0.65, t) * LIFT).min(1.0);
         let t = remap::terrace(b, STEPS, RISER) * (1.0 - TREAD_SLOPE) + b * TREAD_SLOPE;
         FLOOR_M + DEPTH_M * t
     });
