@@ -7,7 +7,7 @@
 //! - [`warp`]: domain warping; [`remap`]: bias, gain, terracing;
 //! - [`thermal`] and [`hydraulic`]: erosion as Jacobi iterations;
 //! - [`fluvial`]: stream-power incision along the drainage network;
-//! - [`creep`]: linear hillslope diffusion;
+//! - [`mod@creep`]: linear hillslope diffusion;
 //! - [`types`]: terrain-type masks derived from a heightfield.
 //!
 //! [`styles`] combines them into the embedded default exemplars in `data/`.

@@ -3,7 +3,7 @@
 //!
 //! Noise alone does not look like terrain: real landscapes are organised by
 //! their drainage, every valley leading into a larger one. So each style is
-//! *evolved* ([`evolve`]): a warped fBm pattern of tectonic uplift raises the
+//! *evolved*: a warped fBm pattern of tectonic uplift raises the
 //! land while stream-power incision ([`fluvial_erode`]) cuts the drainage
 //! network, thermal erosion keeps hillslopes at their talus angle and soil
 //! creep rounds them, coarse to fine over 4–5 resolution levels (fresh noise
