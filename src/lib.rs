@@ -15,6 +15,7 @@ pub mod hash;
 pub mod heightfield;
 pub mod io;
 pub mod poisson;
+pub mod procedural;
 pub mod progress;
 pub mod render;
 pub mod resample;

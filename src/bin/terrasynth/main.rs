@@ -3,6 +3,7 @@
 mod args;
 mod convert;
 mod db;
+mod generate;
 mod info;
 mod progress;
 mod render;
@@ -32,6 +33,8 @@ enum Command {
     Db(db::Command),
     /// Draw a shaded relief map (PNG) of a heightfield.
     Render(render::Args),
+    /// Generate a procedural terrain in a default exemplar style (see --list).
+    Generate(generate::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => convert::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),
+        Command::Generate(a) => generate::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

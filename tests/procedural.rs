@@ -1,0 +1,589 @@
+//! The procedural toolbox: laws of each building block, and the default
+//! exemplars in `data/` recreated byte for byte (by the library and by the
+//! CLI) at any thread count.
+
+use proptest::prelude::*;
+use std::path::{Path, PathBuf};
+use terrasynth::Heightfield;
+use terrasynth::io::{self, WriteOptions};
+use terrasynth::procedural::fluvial::Routing;
+use terrasynth::procedural::styles::{DEFAULT_SEED, DEFAULT_SIZE};
+use terrasynth::procedural::types::TerrainType;
+use terrasynth::procedural::*;
+use terrasynth::progress::Silent;
+
+fn data_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data")
+}
+
+/// A rough test terrain: fBm in metres on a `n`² grid of `cell` metres.
+fn terrain(n: usize, cell: f64, relief: f64, seed: u32) -> Heightfield {
+    let f = Fractal {
+        octaves: 6,
+        h: 0.7,
+        ..Fractal::new(seed, 1.0 / (16.0 * cell))
+    };
+    let a = f.amplitude_sum();
+    Heightfield::from_fn(n, n, cell, |x, y| {
+        (relief * f.sample(x as f64 * cell, y as f64 * cell) / a) as f32
+    })
+    .unwrap()
+}
+
+fn sum(values: impl Iterator<Item = f64>) -> f64 {
+    values.sum()
+}
+
+fn total(hf: &Heightfield) -> f64 {
+    sum(hf.data().iter().map(|&v| v as f64))
+}
+
+/// Steepest slope between 8-neighbours minus `talus`, as a height excess in metres.
+fn max_excess(hf: &Heightfield, talus: f64) -> f64 {
+    let mut worst = f64::NEG_INFINITY;
+    for y in 0..hf.height() {
+        for x in 0..hf.width() {
+            for (dx, dy) in [(1isize, 0isize), (0, 1), (1, 1), (1, -1)] {
+                let (nx, ny) = (x as isize + dx, y as isize + dy);
+                if nx < 0 || ny < 0 || nx >= hf.width() as isize || ny >= hf.height() as isize {
+                    continue;
+                }
+                let d = if dx != 0 && dy != 0 {
+                    std::f64::consts::SQRT_2
+                } else {
+                    1.0
+                };
+                let diff = (hf.get(x, y) - hf.get(nx as usize, ny as usize)).abs() as f64;
+                worst = worst.max(diff - talus * hf.cell_size() * d);
+            }
+        }
+    }
+    worst
+}
+
+// ---------------------------------------------------------------- noise
+
+#[test]
+fn noise_spans_the_unit_range_and_vanishes_on_the_lattice() {
+    let mut max = 0.0f64;
+    for i in 0..200_000u32 {
+        let (x, y) = (
+            (i % 500) as f64 * 0.173 - 40.0,
+            (i / 500) as f64 * 0.131 + 7.0,
+        );
+        let n = gradient_noise(11, x, y);
+        assert!(n.abs() <= 1.0, "noise({x}, {y}) = {n}");
+        max = max.max(n.abs());
+    }
+    assert!(max > 0.8, "noise should use its range, max |n| = {max}");
+    for (x, y) in [(0, 0), (3, -7), (-100, 55)] {
+        assert_eq!(gradient_noise(5, x as f64, y as f64), 0.0);
+    }
+    assert_ne!(gradient_noise(1, 0.5, 0.5), gradient_noise(2, 0.5, 0.5));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Gradient noise is Lipschitz: a step of 1e-4 lattice units moves it
+    /// by at most 1e-3 (the gradient is bounded by a few units).
+    #[test]
+    fn noise_is_continuous(x in -1.0e4f64..1.0e4, y in -1.0e4f64..1.0e4, seed: u32) {
+        let n = gradient_noise(seed, x, y);
+        let eps = 1e-4;
+        prop_assert!((gradient_noise(seed, x + eps, y) - n).abs() < 1e-3);
+        prop_assert!((gradient_noise(seed, x, y + eps) - n).abs() < 1e-3);
+    }
+
+    #[test]
+    fn fractal_sums_stay_within_the_amplitude_sum(
+        x in -1.0e5f64..1.0e5, y in -1.0e5f64..1.0e5, h in 0.0f64..2.0, lac in 1.5f64..3.0,
+        octaves in 1u32..10, seed: u32,
+    ) {
+        for shape in [Shape::Plain, Shape::Ridged, Shape::Billowy] {
+            let f = Fractal { h, lacunarity: lac, octaves, shape, ..Fractal::new(seed, 0.01) };
+            let a = f.amplitude_sum();
+            let v = f.sample(x, y);
+            let (lo, hi) = shape.range();
+            prop_assert!(v >= lo * a - 1e-9 && v <= hi * a + 1e-9, "{shape:?}: {v} outside ±{a}");
+            let m = Multifractal { fractal: f.clone(), offset: 0.3, gain: 1.5 };
+            let mv = m.sample(x, y);
+            prop_assert!(mv >= lo * a - 1e-9 && mv <= hi * a + 1e-9);
+        }
+    }
+
+    #[test]
+    fn bias_and_gain_are_monotone_with_fixed_ends(b in 0.01f64..0.99, t in 0.0f64..1.0, dt in 0.0f64..0.1) {
+        let t2 = (t + dt).min(1.0);
+        prop_assert!(remap::bias(b, t) <= remap::bias(b, t2));
+        prop_assert!(remap::gain(b, t) <= remap::gain(b, t2) + 1e-15);
+        prop_assert_eq!(remap::bias(b, 0.0), 0.0);
+        prop_assert_eq!(remap::bias(b, 1.0), 1.0);
+        prop_assert!((remap::gain(b, 0.5) - 0.5).abs() < 1e-15);
+        prop_assert!((remap::bias(0.5, t) - t).abs() < 1e-15);
+    }
+}
+
+// ------------------------------------------------------------------ fBm
+
+/// The documented convention, measured: octaves are uncorrelated, so the
+/// variance of the sum is the single-octave variance times Σ a_i², with
+/// a_i = λ^(−H·i).
+#[test]
+fn fbm_variance_follows_the_amplitude_convention() {
+    let variance = |f: &Fractal| {
+        let (mut s, mut s2, n) = (0.0, 0.0, 250_000);
+        for i in 0..n {
+            let (x, y) = ((i % 500) as f64 * 7.31, (i / 500) as f64 * 7.77);
+            let v = f.sample(x, y);
+            s += v;
+            s2 += v * v;
+        }
+        s2 / n as f64 - (s / n as f64) * (s / n as f64)
+    };
+    let one = Fractal {
+        octaves: 1,
+        ..Fractal::new(4, 1.0 / 40.0)
+    };
+    let four = Fractal {
+        octaves: 4,
+        h: 0.5,
+        lacunarity: 2.0,
+        ..one.clone()
+    };
+    let a = four.amplitudes();
+    for (i, ai) in a.iter().enumerate() {
+        assert!((ai - 2f64.powf(-0.5 * i as f64)).abs() < 1e-14);
+    }
+    let predicted = variance(&one) * a.iter().map(|a| a * a).sum::<f64>();
+    let measured = variance(&four);
+    assert!(
+        (measured / predicted - 1.0).abs() < 0.1,
+        "variance {measured}, convention predicts {predicted}"
+    );
+}
+
+#[test]
+fn multifractal_reduces_to_fbm_and_weights_detail_by_height() {
+    let f = Fractal {
+        octaves: 6,
+        shape: Shape::Ridged,
+        ..Fractal::new(3, 0.02)
+    };
+    let plain = Multifractal {
+        fractal: f.clone(),
+        offset: 1.0,
+        gain: 0.0,
+    };
+    let coarse_only = Multifractal {
+        fractal: f.clone(),
+        offset: 0.0,
+        gain: 0.0,
+    };
+    let hetero = Multifractal {
+        fractal: f.clone(),
+        offset: 0.0,
+        gain: 1.0,
+    };
+    let (mut high, mut low) = ((0.0, 0), (0.0, 0));
+    for i in 0..20_000 {
+        let (x, y) = ((i % 200) as f64 * 2.9, (i / 200) as f64 * 3.1);
+        let detail = hetero.sample_octaves(x, y, 1, 6).abs();
+        match f.sample_octaves(x, y, 0, 1) {
+            c if c > 0.8 => high = (high.0 + detail, high.1 + 1),
+            c if c < 0.4 => low = (low.0 + detail, low.1 + 1),
+            _ => {}
+        }
+    }
+    let (high, low) = (high.0 / high.1 as f64, low.0 / low.1 as f64);
+    assert!(high > 2.0 * low, "detail on crests {high} vs in lows {low}");
+    for i in 0..500 {
+        let (x, y) = (i as f64 * 3.7, i as f64 * -1.3);
+        assert_eq!(plain.sample(x, y), f.sample(x, y));
+        assert_eq!(coarse_only.sample(x, y), f.sample_octaves(x, y, 0, 1));
+        assert!(
+            (plain.sample_octaves(x, y, 0, 2) + plain.sample_octaves(x, y, 2, 6)
+                - plain.sample(x, y))
+            .abs()
+                < 1e-12
+        );
+    }
+}
+
+// -------------------------------------------------------------- erosion
+
+fn talus(t: f64) -> ThermalParams {
+    ThermalParams {
+        talus: t,
+        rate: 0.5,
+        variation: 0.0,
+        seed: 0,
+    }
+}
+
+#[test]
+fn thermal_erosion_converges_to_the_talus_slope_and_conserves_mass() {
+    let mut hf = terrain(48, 10.0, 400.0, 1);
+    let before = total(&hf);
+    assert!(
+        max_excess(&hf, 0.6) > 20.0,
+        "the test terrain must be too steep"
+    );
+    thermal_erode(&mut hf, &talus(0.6), 600, &Silent).unwrap();
+    assert!(
+        max_excess(&hf, 0.6) < 0.05,
+        "slopes exceed the talus by {} m after convergence",
+        max_excess(&hf, 0.6)
+    );
+    assert!(((total(&hf) - before) / before.abs().max(1.0)).abs() < 1e-6);
+}
+
+#[test]
+fn thermal_erosion_leaves_stable_slopes_alone() {
+    let hf = terrain(32, 10.0, 20.0, 2);
+    assert!(max_excess(&hf, 0.6) < 0.0);
+    let mut eroded = hf.clone();
+    thermal_erode(&mut eroded, &talus(0.6), 50, &Silent).unwrap();
+    assert_eq!(eroded, hf);
+}
+
+#[test]
+fn varying_talus_is_bounded_by_its_range() {
+    let mut hf = terrain(48, 10.0, 400.0, 3);
+    let p = ThermalParams {
+        talus: 0.5,
+        rate: 0.5,
+        variation: 0.4,
+        seed: 9,
+    };
+    let before = total(&hf);
+    thermal_erode(&mut hf, &p, 600, &Silent).unwrap();
+    assert!(max_excess(&hf, 0.5 * 1.4) < 0.05);
+    assert!(max_excess(&hf, 0.5 * 0.6) > 1.0, "the talus should vary");
+    assert!(((total(&hf) - before) / before.abs().max(1.0)).abs() < 1e-6);
+}
+
+fn rain(boundary: Boundary) -> HydraulicParams {
+    HydraulicParams {
+        rain: 0.01,
+        evaporation: 0.02,
+        flow_rate: 0.125,
+        capacity: 2.0,
+        dissolve: 0.3,
+        deposit: 0.3,
+        boundary,
+    }
+}
+
+/// Terrain + suspended sediment (+ what drained off an open edge) never
+/// changes; water changes exactly by rain, evaporation and drainage.
+#[test]
+fn hydraulic_erosion_conserves_mass_up_to_its_budget() {
+    for boundary in [Boundary::Closed, Boundary::Open] {
+        let hf = terrain(64, 30.0, 300.0, 4);
+        let mut sim = Hydraulic::new(&hf, rain(boundary)).unwrap();
+        let solid = sum(sim.terrain()) + sum(sim.sediment());
+        for _ in 0..150 {
+            sim.step();
+        }
+        let b = sim.budget();
+        assert!(b.rained > 0.0 && b.evaporated > 0.0);
+        let solid_after = sum(sim.terrain()) + sum(sim.sediment()) + b.drained_sediment;
+        assert!(
+            ((solid_after - solid) / solid.abs()).abs() < 1e-12,
+            "{boundary:?}: terrain + sediment {solid} -> {solid_after}"
+        );
+        let water = sum(sim.water()) + b.evaporated + b.drained_water - b.rained;
+        assert!(
+            water.abs() < 1e-9 * b.rained,
+            "{boundary:?}: water unaccounted {water}"
+        );
+        assert!(sum(sim.sediment()) > 0.0, "the flow must carry sediment");
+        if boundary == Boundary::Closed {
+            assert_eq!((b.drained_water, b.drained_sediment), (0.0, 0.0));
+        } else {
+            assert!(b.drained_water > 0.0);
+        }
+    }
+}
+
+#[test]
+fn hydraulic_erosion_moves_material_downhill() {
+    let mut hf = terrain(64, 30.0, 300.0, 5);
+    let before = hf.clone();
+    hydraulic_erode(&mut hf, &rain(Boundary::Closed), 200, &Silent).unwrap();
+    assert_ne!(hf, before);
+    // closed edge: everything stays, the settled sediment included
+    assert!(((total(&hf) - total(&before)) / total(&before).abs()).abs() < 1e-6);
+    let (lo, hi) = (before.stats().unwrap(), hf.stats().unwrap());
+    assert!(hi.max <= lo.max, "erosion must not raise the highest peak");
+}
+
+#[test]
+fn fluvial_erosion_drains_every_cell_to_the_edge() {
+    let mut hf = terrain(64, 30.0, 300.0, 6);
+    let p = FluvialParams {
+        erodibility: 0.05,
+        epsilon: 0.01,
+        routing: Routing::Random(3),
+    };
+    let max_before = hf.stats().unwrap().max;
+    fluvial_erode(&mut hf, &p, None, 5, &Silent).unwrap();
+    assert!(hf.stats().unwrap().max <= max_before);
+    // no closed depression is left: every interior cell has a lower neighbour
+    for y in 1..63 {
+        for x in 1..63 {
+            let h = hf.get(x, y);
+            let lower = (-1..=1).any(|dy: isize| {
+                (-1..=1).any(|dx: isize| {
+                    hf.get((x as isize + dx) as usize, (y as isize + dy) as usize) < h
+                })
+            });
+            assert!(lower, "pit at ({x}, {y})");
+        }
+    }
+}
+
+#[test]
+fn creep_conserves_mass_and_smooths() {
+    let mut hf = terrain(48, 10.0, 100.0, 7);
+    let roughness = |hf: &Heightfield| {
+        let mut s = 0.0;
+        for y in 0..hf.height() {
+            for x in 1..hf.width() {
+                s += ((hf.get(x, y) - hf.get(x - 1, y)) as f64).powi(2);
+            }
+        }
+        s
+    };
+    let (mass, rough) = (total(&hf), roughness(&hf));
+    creep(&mut hf, 0.5, 20, &Silent).unwrap();
+    assert!(((total(&hf) - mass) / mass.abs().max(1.0)).abs() < 1e-6);
+    assert!(roughness(&hf) < 0.5 * rough);
+}
+
+#[test]
+fn erosion_refuses_nodata_and_bad_parameters() {
+    let mut hf = terrain(16, 10.0, 50.0, 8);
+    hf.set(3, 5, f32::NAN);
+    let e = thermal_erode(&mut hf.clone(), &talus(0.5), 1, &Silent).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ProceduralError::NoData {
+                count: 1,
+                x: 3,
+                y: 5
+            }
+        ),
+        "{e}"
+    );
+    assert!(hydraulic_erode(&mut hf.clone(), &rain(Boundary::Open), 1, &Silent).is_err());
+    assert!(creep(&mut hf, 0.5, 1, &Silent).is_err());
+    let mut ok = terrain(16, 10.0, 50.0, 8);
+    let e = thermal_erode(
+        &mut ok,
+        &ThermalParams {
+            rate: 0.9,
+            ..talus(0.5)
+        },
+        1,
+        &Silent,
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string().contains("rate") && e.to_string().contains("(0, 0.5]"),
+        "{e}"
+    );
+    let e = hydraulic_erode(
+        &mut ok,
+        &HydraulicParams {
+            flow_rate: 0.5,
+            ..rain(Boundary::Open)
+        },
+        1,
+        &Silent,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("flow_rate"), "{e}");
+}
+
+// ----------------------------------------------------------- type masks
+
+#[test]
+fn types_follow_the_terrain() {
+    // a flat plateau (left), a 60° wall, a valley cut into the low ground (right)
+    let hf = Heightfield::from_fn(160, 160, 30.0, |x, _| {
+        if x < 60 {
+            1000.0
+        } else if x < 66 {
+            1000.0 - (x - 59) as f32 * 52.0
+        } else {
+            let d = (x as f32 - 120.0).abs();
+            688.0 + (d * 4.0).min(120.0)
+        }
+    })
+    .unwrap();
+    let mask = TypeMask::classify(&hf);
+    assert_eq!(mask.get(20, 80), TerrainType::Plateau);
+    assert_eq!(mask.get(62, 80), TerrainType::Cliff);
+    assert_eq!(mask.get(120, 80), TerrainType::ValleyFloor);
+    let counts = mask.counts();
+    assert_eq!(counts.iter().sum::<usize>(), 160 * 160);
+}
+
+#[test]
+fn type_mask_files_have_the_shared_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let (hf, mask) = Style::Hills.generate(64, 1, &Silent).unwrap();
+    let dem = dir.path().join("h.png");
+    io::write(&hf, &dem, &WriteOptions::default()).unwrap();
+    mask.write_beside(&dem, "test").unwrap();
+    let png = std::fs::read(dir.path().join("h_types.png")).unwrap();
+    let decoder = png::Decoder::new(std::io::Cursor::new(png));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), (64, 64));
+    assert_eq!(
+        (info.color_type, info.bit_depth),
+        (png::ColorType::Grayscale, png::BitDepth::Eight)
+    );
+    assert_eq!(&buf[..64 * 64], mask.data());
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("h_types.json")).unwrap()).unwrap();
+    assert_eq!(json["dem"], "h.png");
+    assert_eq!(json["types"]["2"], "valley floor");
+    let fractions: f64 = json["fractions"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_f64().unwrap())
+        .sum();
+    assert!((fractions - 1.0).abs() < 0.01);
+}
+
+// --------------------------------------------------------------- styles
+
+#[test]
+fn styles_are_named_and_checked() {
+    assert_eq!(Style::from_name("canyon").unwrap(), Style::Canyon);
+    let e = Style::from_name("moon").unwrap_err().to_string();
+    assert!(e.contains("alpine, canyon, hills"), "{e}");
+    assert!(Style::Alpine.generate(8, 1, &Silent).is_err());
+    // the smallest size works for every style
+    for s in Style::ALL {
+        let (hf, mask) = s.generate(32, 5, &Silent).unwrap();
+        assert_eq!((hf.width(), mask.width()), (32, 32));
+        assert_eq!(hf.nodata_count(), 0);
+    }
+}
+
+/// The same bits with one thread and with two, for every style and for
+/// each row-parallel block.
+#[test]
+fn thread_count_never_changes_a_bit() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut out: Vec<Vec<u32>> = Vec::new();
+            for s in Style::ALL {
+                let (hf, mask) = s.generate(96, 77, &Silent).unwrap();
+                out.push(hf.data().iter().map(|v| v.to_bits()).collect());
+                out.push(mask.data().iter().map(|&t| t as u32).collect());
+            }
+            let mut hf = terrain(80, 30.0, 500.0, 9);
+            hydraulic_erode(&mut hf, &rain(Boundary::Open), 30, &Silent).unwrap();
+            thermal_erode(
+                &mut hf,
+                &ThermalParams {
+                    variation: 0.3,
+                    seed: 4,
+                    ..talus(0.5)
+                },
+                30,
+                &Silent,
+            )
+            .unwrap();
+            creep(&mut hf, 0.3, 10, &Silent).unwrap();
+            out.push(hf.data().iter().map(|v| v.to_bits()).collect());
+            out
+        })
+    };
+    assert_eq!(run(1), run(2));
+}
+
+/// Writes a style's four files into `dir` exactly as `generate` does.
+fn write_style(style: Style, dir: &Path) -> PathBuf {
+    let (hf, mask) = style.generate(DEFAULT_SIZE, DEFAULT_SEED, &Silent).unwrap();
+    let out = dir.join(format!("{}.png", style.name()));
+    io::write(&hf, &out, &WriteOptions::default()).unwrap();
+    mask.write_beside(&out, &style.types_method(DEFAULT_SIZE, DEFAULT_SEED))
+        .unwrap();
+    out
+}
+
+fn assert_same_files(style: Style, dir: &Path) {
+    for suffix in ["png", "json", "_types.png", "_types.json"] {
+        let name = if suffix.starts_with('_') {
+            format!("{}{suffix}", style.name())
+        } else {
+            format!("{}.{suffix}", style.name())
+        };
+        let made = std::fs::read(dir.join(&name)).unwrap();
+        let committed = std::fs::read(data_dir().join(&name)).unwrap();
+        assert!(
+            made == committed,
+            "{name} differs from data/{name}: if the generator was changed on purpose, look at the \
+             new terrain and regenerate with `cargo run --release -- generate --style {} -o data/{}.png`",
+            style.name(),
+            style.name()
+        );
+    }
+}
+
+#[test]
+fn default_exemplars_are_recreated_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    for style in Style::ALL {
+        write_style(style, dir.path());
+        assert_same_files(style, dir.path());
+    }
+}
+
+#[test]
+fn cli_generate_recreates_an_exemplar() {
+    let exe = env!("CARGO_BIN_EXE_terrasynth");
+    let dir = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(exe)
+        .args(["generate", "--style", "hills", "-o"])
+        .arg(dir.path().join("hills.png"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_same_files(Style::Hills, dir.path());
+
+    let list = std::process::Command::new(exe)
+        .args(["generate", "--list"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(list.stdout).unwrap();
+    for s in Style::ALL {
+        assert!(text.contains(s.name()), "{text}");
+    }
+    let bad = std::process::Command::new(exe)
+        .args(["generate", "--style", "moon", "-o"])
+        .arg(dir.path().join("x.png"))
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown style"));
+    assert!(!dir.path().join("x.png").exists());
+}
