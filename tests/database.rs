@@ -110,11 +110,11 @@ fn mode_one_is_the_weighted_mean_height() {
         for y in (0..r.height).step_by(3) {
             for x in (r.x0..r.x0 + r.width).step_by(5) {
                 let mut mean = 0.0;
-                for k in 0..25 {
+                for (k, gk) in g.iter().enumerate() {
                     let sx = (x as i64 + (k % 5) as i64 - 2)
                         .clamp(r.x0 as i64, (r.x0 + r.width - 1) as i64);
                     let sy = (y as i64 + (k / 5) as i64 - 2).clamp(0, r.height as i64 - 1);
-                    mean += g[k] * heights[r.index(sx as u32, sy as u32)] as f64;
+                    mean += gk * heights[r.index(sx as u32, sy as u32)] as f64;
                 }
                 let m1 = appearance::unpack_texel(l.appearance[r.index(x, y)])[0] as i32
                     - appearance::MODE1_BIAS;

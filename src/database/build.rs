@@ -49,6 +49,14 @@ impl Default for BuildOptions {
     }
 }
 
+/// One level's arrays, before they are laid out in the file.
+struct LevelArrays {
+    appearance: Vec<u64>,
+    similar: Vec<u32>,
+    types: Vec<u8>,
+    seeds: Vec<u32>,
+}
+
 /// What a build noticed.
 #[derive(Debug, Clone, Default)]
 pub struct BuildReport {
@@ -199,7 +207,7 @@ pub fn build(
     let total: u64 = plan.iter().map(|l| l.texels()).sum();
     progress.start("analysing exemplars", total * 2);
     let mut level_meta = Vec::with_capacity(levels + 1);
-    let mut arrays: Vec<(Vec<u64>, Vec<u32>, Vec<u8>, Vec<u32>)> = Vec::with_capacity(levels + 1);
+    let mut arrays: Vec<LevelArrays> = Vec::with_capacity(levels + 1);
     for (i, lay) in plan.iter().enumerate() {
         let grids: Vec<&Grid> = pyramids.iter().map(|p| &p[i]).collect();
         let pca = appearance::pca(&grids, &q);
@@ -244,7 +252,12 @@ pub fn build(
             mean_match_distance,
             seed_counts,
         });
-        arrays.push((texels, similar, tlevel, seeds));
+        arrays.push(LevelArrays {
+            appearance: texels,
+            similar,
+            types: tlevel,
+            seeds,
+        });
     }
     progress.finish();
 
@@ -273,7 +286,8 @@ pub fn build(
             bytes: bytemuck::cast_slice(&heights0),
         },
     ];
-    for (i, (a, s, t, sd)) in arrays.iter().enumerate() {
+    for (i, arr) in arrays.iter().enumerate() {
+        let (a, s, t, sd) = (&arr.appearance, &arr.similar, &arr.types, &arr.seeds);
         let level = i as u32;
         sections.push(Section {
             kind: Kind::Appearance,

@@ -48,16 +48,6 @@ pub enum FormatError {
     Unwritable(String),
 }
 
-impl FormatError {
-    pub(crate) fn truncated(what: &'static str, expected: u64, found: usize) -> Self {
-        FormatError::Truncated {
-            what,
-            expected,
-            found: found as u64,
-        }
-    }
-}
-
 /// A file that could not be read or written.
 #[non_exhaustive]
 #[derive(Debug, Error)]

@@ -157,10 +157,8 @@ fn input_format(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Format,
         Some(f) => f,
         None => Format::from_path(path).ok_or_else(|| IoError::unknown_format(path))?,
     };
-    Ok(match format {
-        Format::Png16 | Format::Png8 => png::sniff_depth(bytes).unwrap_or(format),
-        other => other,
-    })
+    // PNG bit depth decides between the two PNG readers.
+    Ok(png::sniff_depth(bytes).unwrap_or(format))
 }
 
 /// Reads a heightfield file (and its sidecar when the format uses one).
