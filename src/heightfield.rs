@@ -359,6 +359,9 @@ mod tests {
             })
         );
         assert!(hf.crop(3, 0, 2, 1).is_err());
-        assert_eq!(hf.view(0, 2, 4, 1).unwrap().row(0), &[20.0, 21.0, 22.0, 23.0]);
+        assert_eq!(
+            hf.view(0, 2, 4, 1).unwrap().row(0),
+            &[20.0, 21.0, 22.0, 23.0]
+        );
     }
 }

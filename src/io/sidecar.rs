@@ -35,7 +35,11 @@ impl HeightMapping {
     pub fn spanning(min: f64, max: f64, max_code: u32) -> HeightMapping {
         HeightMapping {
             offset_m: min,
-            scale_m: if max > min { (max - min) / max_code as f64 } else { 0.0 },
+            scale_m: if max > min {
+                (max - min) / max_code as f64
+            } else {
+                0.0
+            },
         }
     }
 
@@ -61,8 +65,13 @@ pub struct Sidecar {
 impl Sidecar {
     pub fn parse(bytes: &[u8]) -> Result<Sidecar, FormatError> {
         let bad = |m: String| FormatError::InvalidSidecar(m);
-        let v: Value = serde_json::from_slice(bytes)
-            .map_err(|e| bad(format!("not JSON (line {}, column {}): {e}", e.line(), e.column())))?;
+        let v: Value = serde_json::from_slice(bytes).map_err(|e| {
+            bad(format!(
+                "not JSON (line {}, column {}): {e}",
+                e.line(),
+                e.column()
+            ))
+        })?;
         let top = v
             .as_object()
             .ok_or_else(|| bad("expected a JSON object at the top level".into()))?;
@@ -71,7 +80,11 @@ impl Sidecar {
             Some(_) => return Err(bad("height_mapping must be an object".into())),
             None => top,
         };
-        let field = if std::ptr::eq(hm, top) { "" } else { "height_mapping." };
+        let field = if std::ptr::eq(hm, top) {
+            ""
+        } else {
+            "height_mapping."
+        };
         let offset_m = number(hm, "offset_m", field)?.unwrap_or(0.0);
         let scale_m = number(hm, "scale_m", field)?
             .ok_or_else(|| bad(format!("missing {field}scale_m (metres per sample unit)")))?;
@@ -95,7 +108,10 @@ impl Sidecar {
 
     /// Checks the sidecar against the dimensions found in the data file.
     pub fn check_size(&self, width: usize, height: usize) -> Result<(), FormatError> {
-        for (name, declared, actual) in [("width", self.width, width), ("height", self.height, height)] {
+        for (name, declared, actual) in [
+            ("width", self.width, width),
+            ("height", self.height, height),
+        ] {
             if let Some(d) = declared
                 && d != actual
             {
@@ -136,7 +152,9 @@ fn number(obj: &Map<String, Value>, key: &str, prefix: &str) -> Result<Option<f6
         None | Some(Value::Null) => Ok(None),
         Some(Value::Number(n)) => match n.as_f64() {
             Some(f) if f.is_finite() => Ok(Some(f)),
-            _ => Err(FormatError::InvalidSidecar(format!("{prefix}{key} is not a finite number"))),
+            _ => Err(FormatError::InvalidSidecar(format!(
+                "{prefix}{key} is not a finite number"
+            ))),
         },
         Some(other) => Err(FormatError::InvalidSidecar(format!(
             "{prefix}{key} must be a number, found {other}"
@@ -167,10 +185,25 @@ mod tests {
     #[test]
     fn reads_nested_and_flat_mappings() {
         let s = Sidecar::parse(br#"{"cell_size_m": 30.5, "width": 4, "height_mapping": {"offset_m": -5, "scale_m": 0.5}}"#).unwrap();
-        assert_eq!(s.mapping, HeightMapping { offset_m: -5.0, scale_m: 0.5 });
-        assert_eq!((s.cell_size_m, s.width, s.height), (Some(30.5), Some(4), None));
+        assert_eq!(
+            s.mapping,
+            HeightMapping {
+                offset_m: -5.0,
+                scale_m: 0.5
+            }
+        );
+        assert_eq!(
+            (s.cell_size_m, s.width, s.height),
+            (Some(30.5), Some(4), None)
+        );
         let s = Sidecar::parse(br#"{"offset_m": 1, "scale_m": 2}"#).unwrap();
-        assert_eq!(s.mapping, HeightMapping { offset_m: 1.0, scale_m: 2.0 });
+        assert_eq!(
+            s.mapping,
+            HeightMapping {
+                offset_m: 1.0,
+                scale_m: 2.0
+            }
+        );
     }
 
     #[test]
@@ -178,7 +211,10 @@ mod tests {
         for (text, needle) in [
             (&b"[1]"[..], "object"),
             (b"{", "not JSON"),
-            (br#"{"height_mapping": {"offset_m": 0}}"#, "height_mapping.scale_m"),
+            (
+                br#"{"height_mapping": {"offset_m": 0}}"#,
+                "height_mapping.scale_m",
+            ),
             (br#"{"scale_m": "x"}"#, "scale_m must be a number"),
             (br#"{"scale_m": -1}"#, "expected >= 0"),
             (br#"{"scale_m": 1, "cell_size_m": 0}"#, "cell_size_m"),

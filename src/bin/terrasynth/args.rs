@@ -38,7 +38,8 @@ pub fn parse_format(s: &str) -> Result<Format, String> {
 
 /// Parses `WxH` (e.g. `1024x768`); each side in 1..=65535.
 pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
-    let err = || format!("invalid size {s:?}: expected WxH with each side in 1..=65535, e.g. 1024x1024");
+    let err =
+        || format!("invalid size {s:?}: expected WxH with each side in 1..=65535, e.g. 1024x1024");
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
     let w: usize = w.trim().parse().map_err(|_| err())?;
     let h: usize = h.trim().parse().map_err(|_| err())?;

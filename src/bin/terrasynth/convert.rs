@@ -1,6 +1,9 @@
 //! `terrasynth convert`: heightfield format conversion.
 
-use crate::{CliResult, args::{Input, parse_format}};
+use crate::{
+    CliResult,
+    args::{Input, parse_format},
+};
 use std::path::PathBuf;
 use terrasynth::io::{self, Format, WriteOptions};
 
@@ -27,6 +30,11 @@ pub fn run(a: Args) -> CliResult {
             ..Default::default()
         },
     )?;
-    eprintln!("wrote {} ({} x {})", a.output.display(), hf.width(), hf.height());
+    eprintln!(
+        "wrote {} ({} x {})",
+        a.output.display(),
+        hf.width(),
+        hf.height()
+    );
     Ok(())
 }

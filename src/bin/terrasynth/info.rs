@@ -17,7 +17,9 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let hf = a.input.read(&a.file)?;
     let stats = hf.stats();
-    let (min, max, mean) = stats.map_or((None, None, None), |s| (Some(s.min), Some(s.max), Some(s.mean)));
+    let (min, max, mean) = stats.map_or((None, None, None), |s| {
+        (Some(s.min), Some(s.max), Some(s.mean))
+    });
     let nodata = hf.nodata_count();
     if a.json {
         let v = serde_json::json!({

@@ -25,7 +25,12 @@ impl terrasynth::progress::Progress for Bar {
                 .progress_chars("=> "),
         );
         bar.set_message(stage.to_string());
-        if let Some(old) = self.bar.lock().unwrap_or_else(|p| p.into_inner()).replace(bar) {
+        if let Some(old) = self
+            .bar
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .replace(bar)
+        {
             old.finish_and_clear();
         }
     }

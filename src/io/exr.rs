@@ -1,0 +1,187 @@
+//! OpenEXR heightfields: one 32-bit float channel, NaN = nodata.
+//!
+//! Reading takes the single layer's channel named `Y` (OpenEXR's luminance,
+//! the usual name for greyscale data), or the only channel when there is
+//! one; any other layout is refused with the channel names listed, rather
+//! than guessing which of several channels holds heights. F16 channels are
+//! widened to f32 exactly; U32 channels are refused (heights are not counts,
+//! and large u32 values do not fit f32). The data window's position is
+//! ignored: the grid starts at its top-left sample.
+//!
+//! The cell size travels in a custom `double` layer attribute
+//! [`CELL_SIZE_ATTRIBUTE`]; files without it get the default cell size.
+//! Written files use lossless ZIP compression (16 scan lines per block).
+
+use super::limits::{DEFLATE_RATIO, check_justified};
+use super::sidecar::DEFAULT_CELL_SIZE_M;
+use super::{Encoded, FormatError};
+use crate::heightfield::{Heightfield, check_dims};
+use exr::meta::MetaData;
+use exr::prelude::*;
+// The prelude exports its own `Result`; ours carries a `FormatError`.
+use std::io::Cursor;
+use std::result::Result;
+
+/// Layer attribute holding the cell size in metres (OpenEXR type `double`).
+pub const CELL_SIZE_ATTRIBUTE: &str = "cellSizeMetres";
+
+const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+
+pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
+    if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
+        return Err(FormatError::bad_magic("OpenEXR magic 76 2F 31 01", bytes));
+    }
+    // Headers first: the declared size and channels are checked before any
+    // pixel buffer exists.
+    let meta = MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_error)?;
+    let header = match meta.headers.as_slice() {
+        [one] => one,
+        many => {
+            return Err(FormatError::Unsupported {
+                what: "EXR part count",
+                found: many.len().to_string(),
+                supported: "a single-part image",
+            });
+        }
+    };
+    if header.deep {
+        return Err(FormatError::Unsupported {
+            what: "EXR data",
+            found: "deep samples".into(),
+            supported: "flat images",
+        });
+    }
+    let (w, h) = (header.layer_size.width(), header.layer_size.height());
+    check_dims(w, h)?;
+    let channels = &header.channels.list;
+    let bytes_per_pixel: u64 = channels
+        .iter()
+        .map(|c| match c.sample_type {
+            SampleType::F16 => 2,
+            SampleType::F32 | SampleType::U32 => 4,
+        })
+        .sum();
+    check_justified(w, h, bytes_per_pixel, bytes.len(), DEFLATE_RATIO)?;
+
+    let channel = match channels.iter().find(|c| c.name.eq("Y")) {
+        Some(c) => c,
+        None if channels.len() == 1 => &channels[0],
+        None => {
+            let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+            return Err(FormatError::Unsupported {
+                what: "EXR channels",
+                found: names.join(", "),
+                supported: "a channel named Y, or exactly one channel",
+            });
+        }
+    };
+    if channel.sample_type == SampleType::U32 {
+        return Err(FormatError::Unsupported {
+            what: "EXR sample type",
+            found: format!("u32 in channel {}", channel.name),
+            supported: "f32 or f16",
+        });
+    }
+    if channel.sampling != Vec2(1, 1) {
+        return Err(FormatError::Unsupported {
+            what: "EXR channel subsampling",
+            found: format!("{:?} in channel {}", channel.sampling, channel.name),
+            supported: "one sample per pixel",
+        });
+    }
+    let cell = cell_size(header)?;
+
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required(channel.name.clone())
+        .collect_pixels(
+            move |size, _| vec![0f32; size.area()],
+            move |data: &mut Vec<f32>, pos, (v,): (f32,)| data[pos.y() * w + pos.x()] = v,
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(exr_error)?;
+    let data = image.layer_data.channel_data.pixels;
+    // The reader re-parses the headers; a file whose second parse disagrees
+    // with the first is corrupt, not a different image.
+    if data.len() != w * h {
+        return Err(FormatError::Corrupt(format!(
+            "EXR pixel count {} does not match the data window {w}x{h}",
+            data.len()
+        )));
+    }
+    Ok(Heightfield::from_vec(w, h, cell, data)?)
+}
+
+fn cell_size(header: &exr::meta::header::Header) -> Result<f64, FormatError> {
+    let value = match header
+        .own_attributes
+        .other
+        .get(&Text::from(CELL_SIZE_ATTRIBUTE))
+    {
+        None => return Ok(DEFAULT_CELL_SIZE_M),
+        Some(AttributeValue::F64(v)) => *v,
+        Some(AttributeValue::F32(v)) => *v as f64,
+        Some(other) => {
+            return Err(FormatError::Metadata(format!(
+                "EXR attribute {CELL_SIZE_ATTRIBUTE} must be a double, found {other:?}"
+            )));
+        }
+    };
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(FormatError::Metadata(format!(
+            "EXR attribute {CELL_SIZE_ATTRIBUTE} is {value}: expected a finite cell size > 0 m"
+        )))
+    }
+}
+
+pub(super) fn encode(hf: &Heightfield) -> Result<Encoded, FormatError> {
+    let (w, h) = (hf.width(), hf.height());
+    let data = hf.data();
+    let mut attributes = LayerAttributes::default();
+    attributes.other.insert(
+        Text::from(CELL_SIZE_ATTRIBUTE),
+        AttributeValue::F64(hf.cell_size()),
+    );
+    let layer = Layer::new(
+        (w, h),
+        attributes,
+        Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        },
+        SpecificChannels::build()
+            .with_channel("Y")
+            .with_pixel_fn(|pos: Vec2<usize>| (data[pos.y() * w + pos.x()],)),
+    );
+    let mut out = Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(&mut out)
+        .map_err(|e| FormatError::Unwritable(format!("EXR: {e}")))?;
+    Ok(Encoded {
+        bytes: out.into_inner(),
+        sidecar: None,
+    })
+}
+
+fn exr_error(e: exr::error::Error) -> FormatError {
+    match e {
+        exr::error::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            FormatError::EndsEarly("EXR data")
+        }
+        exr::error::Error::NotSupported(what) => FormatError::Unsupported {
+            what: "EXR feature",
+            found: what.into_owned(),
+            supported: "flat scan-line or tiled images",
+        },
+        other => FormatError::Corrupt(format!("EXR: {other}")),
+    }
+}
