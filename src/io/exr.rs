@@ -174,7 +174,8 @@ pub(super) fn encode(hf: &Heightfield) -> Result<Encoded, FormatError> {
 
 fn exr_error(e: exr::error::Error) -> FormatError {
     match e {
-        exr::error::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+        // exr turns an unexpected end of file into this message.
+        exr::error::Error::Invalid(m) if m == "reference to missing bytes" => {
             FormatError::EndsEarly("EXR data")
         }
         exr::error::Error::NotSupported(what) => FormatError::Unsupported {

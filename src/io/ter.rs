@@ -34,7 +34,7 @@ impl<'a> Cursor<'a> {
         let Some(end) = end else {
             return Err(FormatError::truncated(
                 what,
-                (self.pos + n) as u64,
+                self.pos.saturating_add(n) as u64,
                 self.bytes.len(),
             ));
         };
@@ -105,10 +105,8 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
                 check_dims(w, h)?;
                 let scale = c.i16("the ALTW chunk")?;
                 let base = c.i16("the ALTW chunk")?;
+                // `take` checks the byte count before anything is allocated.
                 let need = w * h * 2;
-                if need > bytes.len() - c.pos {
-                    return Err(FormatError::not_justified(w, h, bytes.len()));
-                }
                 let samples = c.take(need, "the ALTW samples")?;
                 heights = Some((w, h, scale, base, samples));
                 // Chunks are 4-byte aligned: an odd sample count leaves 2 pad bytes.

@@ -6,7 +6,11 @@ use terrasynth::io::Format;
 
 /// Every format that can be written.
 pub fn writable() -> Vec<Format> {
-    Format::ALL.iter().copied().filter(|f| f.can_write()).collect()
+    Format::ALL
+        .iter()
+        .copied()
+        .filter(|f| f.can_write())
+        .collect()
 }
 
 /// The file extension we use for a format.
@@ -45,7 +49,9 @@ pub fn precision(f: Format, min: f32, max: f32, cell: f64) -> f64 {
         Format::Png16 | Format::R16 => range / 65534.0 / 2.0 + 2.0 * f32_eps,
         Format::Ter => {
             let unit = cell as f32 as f64;
-            let scale = ((range / unit / 2.0 + 1.0) * 65536.0 / 32767.0).ceil().max(1.0);
+            let scale = ((range / unit / 2.0 + 1.0) * 65536.0 / 32767.0)
+                .ceil()
+                .max(1.0);
             scale / 65536.0 * unit / 2.0 + 4.0 * f32_eps
         }
         other => panic!("{other} is not writable"),
@@ -54,13 +60,20 @@ pub fn precision(f: Format, min: f32, max: f32, cell: f64) -> f64 {
 
 /// Asserts that `b` equals `a` within `tol` (NaN must match NaN).
 pub fn assert_close(a: &Heightfield, b: &Heightfield, tol: f64, what: &str) {
-    assert_eq!((a.width(), a.height()), (b.width(), b.height()), "{what}: size");
+    assert_eq!(
+        (a.width(), a.height()),
+        (b.width(), b.height()),
+        "{what}: size"
+    );
     for (i, (&x, &y)) in a.data().iter().zip(b.data()).enumerate() {
         if x.is_nan() || y.is_nan() {
             assert!(x.is_nan() && y.is_nan(), "{what}: sample {i}: {x} vs {y}");
         } else {
             let d = (x as f64 - y as f64).abs();
-            assert!(d <= tol, "{what}: sample {i}: {x} vs {y} (|d| = {d} > {tol})");
+            assert!(
+                d <= tol,
+                "{what}: sample {i}: {x} vs {y} (|d| = {d} > {tol})"
+            );
         }
     }
 }
@@ -70,7 +83,9 @@ pub fn assert_close(a: &Heightfield, b: &Heightfield, tol: f64, what: &str) {
 pub fn sample(width: usize, height: usize, cell: f64, nodata: bool) -> Heightfield {
     let mut hf = Heightfield::from_fn(width, height, cell, |x, y| {
         let (x, y) = (x as f32, y as f32);
-        -12.5 + 3.25 * x - 1.75 * y + 0.125 * (x * y) + if (x + y) as usize % 3 == 0 { 0.3 } else { 0.0 }
+        -12.5 + 3.25 * x - 1.75 * y
+            + 0.125 * (x * y)
+            + if (x + y) as usize % 3 == 0 { 0.3 } else { 0.0 }
     })
     .unwrap();
     if nodata {
