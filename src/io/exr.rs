@@ -12,7 +12,7 @@
 //! [`CELL_SIZE_ATTRIBUTE`]; files without it get the default cell size.
 //! Written files use lossless ZIP compression (16 scan lines per block).
 
-use super::limits::{DEFLATE_RATIO, check_justified};
+use super::limits::{DEFLATE_RATIO, PACKBITS_RATIO, check_justified};
 use super::sidecar::DEFAULT_CELL_SIZE_M;
 use super::{Encoded, FormatError};
 use crate::heightfield::{Heightfield, check_dims};
@@ -61,7 +61,18 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
             SampleType::F32 | SampleType::U32 => 4,
         })
         .sum();
-    check_justified(w, h, bytes_per_pixel, bytes.len(), DEFLATE_RATIO)?;
+    check_justified(
+        w,
+        h,
+        bytes_per_pixel,
+        bytes.len(),
+        max_ratio(header.compression),
+    )?;
+    // The offset table (8 bytes per block) precedes the pixels and is read
+    // whole: it must fit in the file too.
+    if (header.chunk_count as u64).saturating_mul(8) > bytes.len() as u64 {
+        return Err(FormatError::not_justified(w, h, bytes.len()));
+    }
 
     let channel = match channels.iter().find(|c| c.name.eq("Y")) {
         Some(c) => c,
@@ -114,6 +125,20 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
         )));
     }
     Ok(Heightfield::from_vec(w, h, cell, data)?)
+}
+
+/// The most a block can expand when decompressed, by codec.
+fn max_ratio(c: Compression) -> u64 {
+    match c {
+        Compression::Uncompressed => 1,
+        // A 2-byte run emits at most 128 bytes.
+        Compression::RLE => PACKBITS_RATIO,
+        // Deflate of 24-bit values that expand back to 32-bit floats.
+        Compression::PXR24 => DEFLATE_RATIO * 4 / 3,
+        // Deflate, PIZ's Huffman run codes (~410x), B44's fixed blocks, DWA's
+        // lossless fallbacks: deflate's bound covers them all.
+        _ => DEFLATE_RATIO,
+    }
 }
 
 fn cell_size(header: &exr::meta::header::Header) -> Result<f64, FormatError> {
