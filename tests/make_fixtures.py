@@ -265,6 +265,9 @@ def malformed():
     t[33550] = (12, [1.0, 1.0, 0.0])
     case("tiff_odd_unit.tif", tiff(t, pix), "Unsupported", "EPSG 9036")
     case("tiff_tag_past_end.tif", tiff_tag_past_end(), "Metadata", "past the end")
+    # Found by the fuzzer: a BigTIFF directory offset near 2^64 overflowed.
+    case("tiff_bigtiff_far_ifd.tif", b"II+\0\x08\0\0\0" + b"\xff" * 8, "Truncated",
+         "the first TIFF directory needs 18446744073709551615 bytes")
 
     # SRTM
     case("hgt_wrong_size.hgt", b"\0" * 1000, "DimensionMismatch", "this file has 1000")

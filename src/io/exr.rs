@@ -27,6 +27,9 @@ pub const CELL_SIZE_ATTRIBUTE: &str = "cellSizeMetres";
 
 const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 
+/// Blocks below which decompression runs on the calling thread.
+const PARALLEL_MIN_BLOCKS: usize = 64;
+
 pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(FormatError::bad_magic("OpenEXR magic 76 2F 31 01", bytes));
@@ -102,23 +105,32 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
     }
     let cell = cell_size(header)?;
 
-    let image = read()
+    let reader = read()
         .no_deep_data()
         .largest_resolution_level()
         .specific_channels()
         .required(channel.name.clone())
         .collect_pixels(
-            move |size, _| vec![0f32; size.area()],
-            move |data: &mut Vec<f32>, pos, (v,): (f32,)| data[pos.y() * w + pos.x()] = v,
+            |size, _| (size.width(), vec![0f32; size.area()]),
+            |(width, data): &mut (usize, Vec<f32>), pos, (v,): (f32,)| {
+                data[pos.y() * *width + pos.x()] = v
+            },
         )
         .first_valid_layer()
-        .all_attributes()
+        .all_attributes();
+    // exr builds a thread pool per parallel read: worth it only for many blocks.
+    let reader = if header.chunk_count >= PARALLEL_MIN_BLOCKS {
+        reader
+    } else {
+        reader.non_parallel()
+    };
+    let image = reader
         .from_buffered(Cursor::new(bytes))
         .map_err(exr_error)?;
-    let data = image.layer_data.channel_data.pixels;
+    let (width, data) = image.layer_data.channel_data.pixels;
     // The reader re-parses the headers; a file whose second parse disagrees
     // with the first is corrupt, not a different image.
-    if data.len() != w * h {
+    if width != w || data.len() != w * h {
         return Err(FormatError::Corrupt(format!(
             "EXR pixel count {} does not match the data window {w}x{h}",
             data.len()

@@ -8,7 +8,20 @@
 //!   write never leaves a partial file behind). Their [`IoError`] names the file.
 //!
 //! Every reader checks declared sizes against [`crate::heightfield::check_dims`]
-//! and against what the file's length can justify *before* allocating.
+//! and against what the file's length can justify *before* allocating
+//! (see `limits.rs`).
+//!
+//! | format | ext | read | write | samples | nodata | metadata kept | round-trip precision |
+//! |---|---|---|---|---|---|---|---|
+//! | png16 | .png + .json | yes | yes | u16 | code 0 (sidecar `nodata_value`) | cell size, metre mapping | (max−min)/65535/2 |
+//! | png8 | .png + .json | yes | — | u8 | sidecar `nodata_value` | cell size, metre mapping | — |
+//! | exr | .exr | yes | yes | f32 (f16 read) | NaN | cell size (`cellSizeMetres`) | exact |
+//! | tiff | .tif .tiff | yes | yes | i16, u16, f32 read; f32 written | `GDAL_NODATA`, NaN | cell size, georeference | exact |
+//! | hgt | .hgt | yes | — | i16 BE, 1201² / 3601² | −32768 | cell size from the product | — |
+//! | asc | .asc | yes | yes | decimal text | `NODATA_value` | cell size, georeference | exact |
+//! | r16 | .r16 .raw + .json | yes | yes | u16 LE | refused | size, cell size, metre mapping | (max−min)/65535/2 |
+//! | r32 | .r32 + .json | yes | yes | f32 LE | NaN | size, cell size | exact |
+//! | ter | .ter | yes | yes | i16 LE | refused | cell size (f32) | ≈ (max−min+cell)/131070 |
 
 mod asc;
 mod atomic;

@@ -104,7 +104,7 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
     let (cell, georef) = placement(&mut dec, &geo)?;
 
     let is_void = |v: f64| v.is_nan() || nodata == Some(v);
-    let data: Vec<f32> = match dec.read_image().map_err(tiff_error)? {
+    let mut data: Vec<f32> = match dec.read_image().map_err(tiff_error)? {
         DecodingResult::I16(v) => v.iter().map(|&s| void_or(s as f64, is_void)).collect(),
         DecodingResult::U16(v) => v.iter().map(|&s| void_or(s as f64, is_void)).collect(),
         DecodingResult::F32(v) => {
@@ -128,7 +128,8 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
     if data.len() < w * h {
         return Err(FormatError::EndsEarly("TIFF image data"));
     }
-    let mut hf = Heightfield::from_vec(w, h, cell, data[..w * h].to_vec())?;
+    data.truncate(w * h);
+    let mut hf = Heightfield::from_vec(w, h, cell, data)?;
     hf.set_georef(georef);
     Ok(hf)
 }
@@ -282,8 +283,9 @@ fn prescan(bytes: &[u8]) -> Result<(), FormatError> {
         Some(b"MM") => false,
         _ => return Err(FormatError::bad_magic(MAGIC, bytes)),
     };
+    // Offsets come from the file: any of them may point past its end.
     let u16_at = |o: usize| -> Option<u64> {
-        let b: [u8; 2] = bytes.get(o..o + 2)?.try_into().ok()?;
+        let b: [u8; 2] = bytes.get(o..o.checked_add(2)?)?.try_into().ok()?;
         Some(if le {
             u16::from_le_bytes(b)
         } else {
@@ -291,7 +293,7 @@ fn prescan(bytes: &[u8]) -> Result<(), FormatError> {
         } as u64)
     };
     let u32_at = |o: usize| -> Option<u64> {
-        let b: [u8; 4] = bytes.get(o..o + 4)?.try_into().ok()?;
+        let b: [u8; 4] = bytes.get(o..o.checked_add(4)?)?.try_into().ok()?;
         Some(if le {
             u32::from_le_bytes(b)
         } else {
@@ -299,7 +301,7 @@ fn prescan(bytes: &[u8]) -> Result<(), FormatError> {
         } as u64)
     };
     let u64_at = |o: usize| -> Option<u64> {
-        let b: [u8; 8] = bytes.get(o..o + 8)?.try_into().ok()?;
+        let b: [u8; 8] = bytes.get(o..o.checked_add(8)?)?.try_into().ok()?;
         Some(if le {
             u64::from_le_bytes(b)
         } else {
@@ -330,12 +332,8 @@ fn prescan(bytes: &[u8]) -> Result<(), FormatError> {
     } else {
         (u32_at(4).ok_or_else(|| short("the TIFF header"))?, 2, 12, 4)
     };
-    let n = if big {
-        u64_at(ifd as usize)
-    } else {
-        u16_at(ifd as usize)
-    }
-    .ok_or(FormatError::Truncated {
+    let at = usize::try_from(ifd).unwrap_or(usize::MAX);
+    let n = if big { u64_at(at) } else { u16_at(at) }.ok_or(FormatError::Truncated {
         what: "the first TIFF directory",
         expected: ifd.saturating_add(count_len),
         found: len,

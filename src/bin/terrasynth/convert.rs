@@ -9,9 +9,16 @@ use terrasynth::io::{self, Format, WriteOptions};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Input heightfield.
+    /// Input heightfield; the format follows the extension.
     input: PathBuf,
     /// Output heightfield; the format follows the extension.
+    ///
+    /// .png: 16-bit greyscale + JSON sidecar with the metre mapping (8-bit is
+    /// read only). .exr: 32-bit float. .tif/.tiff: GeoTIFF (int16, uint16,
+    /// float32 read; float32 written). .hgt: SRTM tile (read only). .asc:
+    /// ESRI ASCII grid. .r16/.raw: little-endian u16 + sidecar. .r32:
+    /// little-endian f32 + sidecar. .ter: Terragen. R16 and Terragen cannot
+    /// store nodata.
     output: PathBuf,
     /// Output format, when the extension does not say it.
     #[arg(long = "out-format", value_parser = parse_format)]
