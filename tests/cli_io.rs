@@ -71,3 +71,24 @@ fn convert_refuses_nodata_where_the_format_cannot_keep_it() {
         (Some(4), Some(2))
     );
 }
+
+#[test]
+fn convert_fills_nodata_on_request() {
+    let src = repo("tests/fixtures/centre.asc");
+    let dir = tempfile::tempdir().unwrap();
+    let ter = dir.path().join("filled.ter");
+    let out = terrasynth(&[
+        "convert",
+        "--fill-nodata",
+        src.to_str().unwrap(),
+        ter.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("filled 2 nodata samples"), "{err}");
+    let hf = terrasynth::io::read(&ter, &Default::default()).unwrap();
+    assert_eq!(hf.nodata_count(), 0);
+    // Harmonic fill stays within the heights around each hole (1..12 m).
+    let s = hf.stats().unwrap();
+    assert!(s.min >= 0.99 && s.max <= 12.01, "{s:?}");
+}

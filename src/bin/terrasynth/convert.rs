@@ -23,12 +23,24 @@ pub struct Args {
     /// Output format, when the extension does not say it.
     #[arg(long = "out-format", value_parser = parse_format)]
     out_format: Option<Format>,
+    /// Fill nodata samples before writing, by harmonic (Laplace)
+    /// interpolation from the valid heights around each hole: the smoothest
+    /// surface through the rim, never above or below it. Needed to write
+    /// nodata to formats that cannot store it (R16, Terragen).
+    #[arg(long)]
+    fill_nodata: bool,
     #[command(flatten)]
     read: Input,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let hf = a.read.read(&a.input)?;
+    let mut hf = a.read.read(&a.input)?;
+    if a.fill_nodata {
+        let report = terrasynth::fill::fill_nodata(&mut hf)?;
+        if report.filled > 0 {
+            eprintln!("filled {} nodata samples", report.filled);
+        }
+    }
     io::write(
         &hf,
         &a.output,
