@@ -44,8 +44,57 @@ pub enum FormatError {
     Syntax { line: usize, message: String },
     #[error("corrupt data: {0}")]
     Corrupt(String),
+    #[error("invalid metadata: {0}")]
+    Metadata(String),
     #[error("cannot write: {0}")]
     Unwritable(String),
+    #[error(
+        "cannot write: {format} cannot store nodata, and the heightfield has {count} nodata samples; fill them first (terrasynth convert --fill-nodata) or write a format that keeps nodata (exr, tiff, asc, r32, png16)"
+    )]
+    NodataUnwritable { format: super::Format, count: usize },
+}
+
+impl FormatError {
+    pub(crate) fn truncated(what: &'static str, expected: u64, found: usize) -> Self {
+        FormatError::Truncated {
+            what,
+            expected,
+            found: found as u64,
+        }
+    }
+
+    /// A bad signature, showing the first bytes that were found instead.
+    pub(crate) fn bad_magic(expected: &'static str, bytes: &[u8]) -> Self {
+        let s: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02X}")).collect();
+        FormatError::BadMagic {
+            expected,
+            found: if s.is_empty() {
+                "an empty file".into()
+            } else {
+                s.join(" ")
+            },
+        }
+    }
+
+    /// The declared size is more than `file_len` bytes can hold.
+    pub(crate) fn not_justified(width: usize, height: usize, file_len: usize) -> Self {
+        FormatError::SizeNotJustified {
+            width: width as u64,
+            height: height as u64,
+            file_len: file_len as u64,
+        }
+    }
+
+    /// Refuses to write nodata to a format that cannot store it.
+    pub(crate) fn check_no_nodata(
+        hf: &crate::heightfield::Heightfield,
+        format: super::Format,
+    ) -> Result<(), FormatError> {
+        match hf.nodata_count() {
+            0 => Ok(()),
+            count => Err(FormatError::NodataUnwritable { format, count }),
+        }
+    }
 }
 
 /// A file that could not be read or written.

@@ -8,16 +8,40 @@
 //!   write never leaves a partial file behind). Their [`IoError`] names the file.
 //!
 //! Every reader checks declared sizes against [`crate::heightfield::check_dims`]
-//! and against what the file's length can justify *before* allocating.
+//! and against what the file's length can justify *before* allocating
+//! (see `limits.rs`).
+//!
+//! | format | ext | read | write | samples | nodata | metadata kept | round-trip precision |
+//! |---|---|---|---|---|---|---|---|
+//! | png16 | .png + .json | yes | yes | u16 | code 0 (sidecar `nodata_value`) | cell size, metre mapping | (max−min)/65535/2 |
+//! | png8 | .png + .json | yes | — | u8 | sidecar `nodata_value` | cell size, metre mapping | — |
+//! | exr | .exr | yes | yes | f32 (f16 read) | NaN | cell size (`cellSizeMetres`) | exact |
+//! | tiff | .tif .tiff | yes | yes | i16, u16, f32 read; f32 written | `GDAL_NODATA`, NaN | cell size, georeference | exact |
+//! | hgt | .hgt | yes | — | i16 BE, 1201² / 3601² | −32768 | cell size from the product | — |
+//! | asc | .asc | yes | yes | decimal text | `NODATA_value` | cell size, georeference | exact |
+//! | r16 | .r16 .raw + .json | yes | yes | u16 LE | refused | size, cell size, metre mapping | (max−min)/65535/2 |
+//! | r32 | .r32 + .json | yes | yes | f32 LE | NaN | size, cell size | exact |
+//! | ter | .ter | yes | yes | i16 LE | refused | cell size (f32) | ≈ (max−min+cell)/131070 |
 
+mod asc;
 mod atomic;
 mod error;
+mod exr;
+mod hgt;
+mod limits;
 mod png;
+mod quantize;
+mod raw;
 mod sidecar;
+mod ter;
+mod tiff;
 
 pub use atomic::write_atomic;
 pub use error::{FormatError, IoError};
-pub use sidecar::{HeightMapping, Sidecar};
+pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
+pub use hgt::ARC_SECOND_M;
+pub use sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
+pub use tiff::METRES_PER_DEGREE;
 
 use crate::heightfield::Heightfield;
 use std::path::{Path, PathBuf};
@@ -29,17 +53,48 @@ pub enum Format {
     Png16,
     /// 8-bit greyscale PNG (read only); metres via the sidecar or the default mapping.
     Png8,
+    /// OpenEXR, one 32-bit float channel (`Y` or the only one); NaN = nodata.
+    Exr,
+    /// GeoTIFF / TIFF: int16, uint16, float32 read; float32 written.
+    Tiff,
+    /// SRTM `.hgt` tile, 1201² or 3601² big-endian i16 (read only).
+    Hgt,
+    /// ESRI ASCII grid.
+    Asc,
+    /// Headerless little-endian u16 (Unity / Unreal); metres via the sidecar.
+    R16,
+    /// Headerless little-endian f32 metres.
+    R32,
+    /// Terragen terrain file.
+    Ter,
 }
 
 impl Format {
     /// Every format, in the order `--help` lists them.
-    pub const ALL: &'static [Format] = &[Format::Png16, Format::Png8];
+    pub const ALL: &'static [Format] = &[
+        Format::Png16,
+        Format::Png8,
+        Format::Exr,
+        Format::Tiff,
+        Format::Hgt,
+        Format::Asc,
+        Format::R16,
+        Format::R32,
+        Format::Ter,
+    ];
 
     /// The name used on the command line (`--format`).
     pub fn name(self) -> &'static str {
         match self {
             Format::Png16 => "png16",
             Format::Png8 => "png8",
+            Format::Exr => "exr",
+            Format::Tiff => "tiff",
+            Format::Hgt => "hgt",
+            Format::Asc => "asc",
+            Format::R16 => "r16",
+            Format::R32 => "r32",
+            Format::Ter => "ter",
         }
     }
 
@@ -49,22 +104,33 @@ impl Format {
 
     /// The format a path's extension implies. `.png` means 16-bit on output;
     /// on input the PNG's own bit depth decides between [`Format::Png16`] and
-    /// [`Format::Png8`].
+    /// [`Format::Png8`]. `.raw` means R16, the Unity / Unreal convention.
     pub fn from_path(path: &Path) -> Option<Format> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-        match ext.as_str() {
-            "png" => Some(Format::Png16),
-            _ => None,
-        }
+        Some(match ext.as_str() {
+            "png" => Format::Png16,
+            "exr" => Format::Exr,
+            "tif" | "tiff" => Format::Tiff,
+            "hgt" => Format::Hgt,
+            "asc" => Format::Asc,
+            "r16" | "raw" => Format::R16,
+            "r32" => Format::R32,
+            "ter" => Format::Ter,
+            _ => return None,
+        })
     }
 
     pub fn can_write(self) -> bool {
-        !matches!(self, Format::Png8)
+        !matches!(self, Format::Png8 | Format::Hgt)
     }
 
-    /// Formats that store heights as integers and need a sidecar to mean metres.
+    /// Formats whose JSON sidecar (`<stem>.json`) gives metres, size or cell
+    /// size: the integer formats, and the headerless raw ones.
     pub fn uses_sidecar(self) -> bool {
-        matches!(self, Format::Png16 | Format::Png8)
+        matches!(
+            self,
+            Format::Png16 | Format::Png8 | Format::R16 | Format::R32
+        )
     }
 
     /// Comma-separated names, for error messages.
@@ -100,7 +166,7 @@ pub struct WriteOptions {
     /// Overrides the format implied by the extension.
     pub format: Option<Format>,
     /// Height range mapped onto the integer range of quantized formats
-    /// (PNG16); by default the data's own min..max, so no precision is wasted.
+    /// (PNG16, R16); by default the data's own min..max, so no precision is wasted.
     pub height_range: Option<(f64, f64)>,
 }
 
@@ -113,8 +179,16 @@ pub fn decode(
     opts: &ReadOptions,
 ) -> Result<Heightfield, FormatError> {
     let sidecar = sidecar.map(Sidecar::parse).transpose()?;
+    let sc = sidecar.as_ref();
     let mut hf = match format {
-        Format::Png16 | Format::Png8 => png::decode(bytes, sidecar.as_ref())?,
+        Format::Png16 | Format::Png8 => png::decode(bytes, sc)?,
+        Format::Exr => exr::decode(bytes)?,
+        Format::Tiff => tiff::decode(bytes)?,
+        Format::Hgt => hgt::decode(bytes)?,
+        Format::Asc => asc::decode(bytes)?,
+        Format::R16 => raw::decode16(bytes, sc, opts.size)?,
+        Format::R32 => raw::decode32(bytes, sc, opts.size)?,
+        Format::Ter => ter::decode(bytes)?,
     };
     if let Some(cell) = opts.cell_size {
         hf.set_cell_size(cell)?;
@@ -139,8 +213,14 @@ pub fn encode(
 ) -> Result<Encoded, FormatError> {
     match format {
         Format::Png16 => png::encode16(hf, opts.height_range),
-        Format::Png8 => Err(FormatError::Unwritable(format!(
-            "{format} is read-only; write png16 instead"
+        Format::Exr => exr::encode(hf),
+        Format::Tiff => tiff::encode(hf),
+        Format::Asc => asc::encode(hf),
+        Format::R16 => raw::encode16(hf, opts.height_range),
+        Format::R32 => raw::encode32(hf),
+        Format::Ter => ter::encode(hf),
+        Format::Png8 | Format::Hgt => Err(FormatError::Unwritable(format!(
+            "{format} is read-only; write png16, exr, tiff, asc, r16, r32 or ter instead"
         ))),
     }
 }
@@ -157,8 +237,11 @@ fn input_format(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Format,
         Some(f) => f,
         None => Format::from_path(path).ok_or_else(|| IoError::unknown_format(path))?,
     };
-    // PNG bit depth decides between the two PNG readers.
-    Ok(png::sniff_depth(bytes).unwrap_or(format))
+    // For PNG, the file's own bit depth decides between the two readers.
+    Ok(match format {
+        Format::Png16 | Format::Png8 => png::sniff_depth(bytes).unwrap_or(format),
+        other => other,
+    })
 }
 
 /// Reads a heightfield file (and its sidecar when the format uses one).

@@ -6,14 +6,12 @@
 //! when present it gets code 0, recorded as `nodata_value` in the sidecar,
 //! and valid heights use codes 1..=65535.
 
-use super::sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
+use super::limits::{DEFLATE_RATIO, check_justified};
+use super::quantize::{dequantize, quantize16};
+use super::sidecar::Sidecar;
 use super::{Encoded, FormatError};
 use crate::heightfield::{Heightfield, check_dims};
 use std::io::Cursor;
-
-/// Upper bound of deflate's compression ratio (RFC 1951: a 258-byte match
-/// per ~2 bits); a file shorter than size/1032 cannot hold the image.
-const MAX_DEFLATE_RATIO: u64 = 1032;
 
 /// The bit depth of a greyscale PNG, to choose between 8- and 16-bit decoding.
 pub(super) fn sniff_depth(bytes: &[u8]) -> Option<super::Format> {
@@ -29,10 +27,10 @@ pub(super) fn sniff_depth(bytes: &[u8]) -> Option<super::Format> {
 pub(super) fn decode(bytes: &[u8], sidecar: Option<&Sidecar>) -> Result<Heightfield, FormatError> {
     const SIG: &[u8] = b"\x89PNG\r\n\x1a\n";
     if bytes.len() < SIG.len() || &bytes[..SIG.len()] != SIG {
-        return Err(FormatError::BadMagic {
-            expected: "PNG signature 89 50 4E 47 0D 0A 1A 0A",
-            found: hex_prefix(bytes),
-        });
+        return Err(FormatError::bad_magic(
+            "PNG signature 89 50 4E 47 0D 0A 1A 0A",
+            bytes,
+        ));
     }
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::IDENTITY);
@@ -59,14 +57,7 @@ pub(super) fn decode(bytes: &[u8], sidecar: Option<&Sidecar>) -> Result<Heightfi
         }
     };
     check_dims(w, h)?;
-    let raw = (w as u64) * (h as u64) * (bits as u64 / 8);
-    if raw > bytes.len() as u64 * MAX_DEFLATE_RATIO + 4096 {
-        return Err(FormatError::SizeNotJustified {
-            width: w as u64,
-            height: h as u64,
-            file_len: bytes.len() as u64,
-        });
-    }
+    check_justified(w, h, bits as u64 / 8, bytes.len(), DEFLATE_RATIO)?;
     if let Some(sc) = sidecar {
         sc.check_size(w, h)?;
     }
@@ -78,68 +69,24 @@ pub(super) fn decode(bytes: &[u8], sidecar: Option<&Sidecar>) -> Result<Heightfi
     ];
     reader.next_frame(&mut buf).map_err(png_error)?;
 
-    let mapping = sidecar
-        .map(|s| s.mapping)
-        .unwrap_or_else(|| HeightMapping::default_for_bits(bits));
-    let nodata = sidecar.and_then(|s| s.nodata_value);
-    let cell = sidecar
-        .and_then(|s| s.cell_size_m)
-        .unwrap_or(DEFAULT_CELL_SIZE_M);
-    let to_m = |v: u16| -> f32 {
-        if nodata == Some(v as f64) {
-            f32::NAN
-        } else {
-            mapping.to_metres(v as f64) as f32
-        }
-    };
-    let data: Vec<f32> = if bits == 16 {
-        buf.chunks_exact(2)
-            .take(w * h)
-            .map(|c| to_m(u16::from_be_bytes([c[0], c[1]])))
-            .collect()
+    if bits == 16 {
+        let codes = buf
+            .chunks_exact(2)
+            .map(|c| u16::from_be_bytes([c[0], c[1]]));
+        dequantize(w, h, codes, bits, sidecar)
     } else {
-        buf.iter().take(w * h).map(|&v| to_m(v as u16)).collect()
-    };
-    Ok(Heightfield::from_vec(w, h, cell, data)?)
+        dequantize(w, h, buf.iter().map(|&v| v as u16), bits, sidecar)
+    }
 }
 
 pub(super) fn encode16(
     hf: &Heightfield,
     range: Option<(f64, f64)>,
 ) -> Result<Encoded, FormatError> {
-    let has_nodata = hf.nodata_count() > 0;
-    let (min, max) = match (range, hf.stats()) {
-        (Some(r), _) => r,
-        (None, Some(s)) => (s.min as f64, s.max as f64),
-        (None, None) => (0.0, 0.0),
-    };
-    if !(min.is_finite() && max.is_finite() && min <= max) {
-        return Err(FormatError::Unwritable(format!(
-            "height range {min}..{max} is invalid: expected finite min <= max"
-        )));
-    }
-    // With nodata, code 0 is reserved for it and heights use 1..=65535.
-    let (lo, max_code) = if has_nodata {
-        (1u32, 65534u32)
-    } else {
-        (0, 65535)
-    };
-    let m = HeightMapping::spanning(min, max, max_code);
-    let mapping = HeightMapping {
-        offset_m: m.offset_m - lo as f64 * m.scale_m,
-        scale_m: m.scale_m,
-    };
-    let mut bytes = Vec::with_capacity(hf.len() * 2);
-    for &v in hf.data() {
-        let code = if v.is_nan() {
-            0
-        } else if m.scale_m > 0.0 {
-            let c = ((v as f64 - m.offset_m) / m.scale_m).round();
-            lo + c.clamp(0.0, max_code as f64) as u32
-        } else {
-            lo
-        };
-        bytes.extend_from_slice(&(code as u16).to_be_bytes());
+    let q = quantize16(hf, range)?;
+    let mut bytes = Vec::with_capacity(q.codes.len() * 2);
+    for c in &q.codes {
+        bytes.extend_from_slice(&c.to_be_bytes());
     }
     let mut out = Vec::new();
     {
@@ -152,16 +99,9 @@ pub(super) fn encode16(
         w.write_image_data(&bytes)
             .map_err(|e| FormatError::Unwritable(e.to_string()))?;
     }
-    let sidecar = Sidecar {
-        mapping,
-        cell_size_m: Some(hf.cell_size()),
-        width: Some(hf.width()),
-        height: Some(hf.height()),
-        nodata_value: has_nodata.then_some(0.0),
-    };
     Ok(Encoded {
         bytes: out,
-        sidecar: Some(sidecar.to_json(min, max)),
+        sidecar: Some(q.sidecar),
     })
 }
 
@@ -171,14 +111,5 @@ fn png_error(e: png::DecodingError) -> FormatError {
             FormatError::EndsEarly("PNG stream")
         }
         other => FormatError::Corrupt(format!("PNG: {other}")),
-    }
-}
-
-fn hex_prefix(bytes: &[u8]) -> String {
-    let s: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02X}")).collect();
-    if s.is_empty() {
-        "an empty file".into()
-    } else {
-        s.join(" ")
     }
 }

@@ -9,19 +9,38 @@ use terrasynth::io::{self, Format, WriteOptions};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Input heightfield.
+    /// Input heightfield; the format follows the extension.
     input: PathBuf,
     /// Output heightfield; the format follows the extension.
+    ///
+    /// .png: 16-bit greyscale + JSON sidecar with the metre mapping (8-bit is
+    /// read only). .exr: 32-bit float. .tif/.tiff: GeoTIFF (int16, uint16,
+    /// float32 read; float32 written). .hgt: SRTM tile (read only). .asc:
+    /// ESRI ASCII grid. .r16/.raw: little-endian u16 + sidecar. .r32:
+    /// little-endian f32 + sidecar. .ter: Terragen. R16 and Terragen cannot
+    /// store nodata.
     output: PathBuf,
     /// Output format, when the extension does not say it.
     #[arg(long = "out-format", value_parser = parse_format)]
     out_format: Option<Format>,
+    /// Fill nodata samples before writing, by harmonic (Laplace)
+    /// interpolation from the valid heights around each hole: the smoothest
+    /// surface through the rim, never above or below it. Needed to write
+    /// nodata to formats that cannot store it (R16, Terragen).
+    #[arg(long)]
+    fill_nodata: bool,
     #[command(flatten)]
     read: Input,
 }
 
 pub fn run(a: Args) -> CliResult {
-    let hf = a.read.read(&a.input)?;
+    let mut hf = a.read.read(&a.input)?;
+    if a.fill_nodata {
+        let report = terrasynth::fill::fill_nodata(&mut hf)?;
+        if report.filled > 0 {
+            eprintln!("filled {} nodata samples", report.filled);
+        }
+    }
     io::write(
         &hf,
         &a.output,

@@ -1,0 +1,246 @@
+//! ESRI ASCII grids (`.asc`, read/write).
+//!
+//! Header: one `keyword value` pair per line, keywords in any order and any
+//! case: `ncols`, `nrows`, `cellsize` (required), `xllcorner` | `xllcenter`
+//! and `yllcorner` | `yllcenter` (optional, both or neither),
+//! `NODATA_value` (optional). Values follow, rows north to south, separated
+//! by any whitespace (rows may wrap across lines). Samples equal to
+//! `NODATA_value`, or spelled `nan`, become NaN. The cell size is taken to
+//! be metres; the lower-left corner becomes the [`Georef`] (which names the
+//! top-left corner). Errors name the line.
+//!
+//! Writing uses Rust's shortest round-trip float formatting, so every f32
+//! reads back bit-exact; `NODATA_value` is written only when there is
+//! nodata, with a value that no sample has.
+
+use super::{Encoded, FormatError};
+use crate::heightfield::{Georef, Heightfield, check_dims};
+use std::fmt::Write as _;
+
+const KEYWORDS: &str =
+    "ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter, cellsize, NODATA_value";
+
+#[derive(Default)]
+struct Header {
+    ncols: Option<usize>,
+    nrows: Option<usize>,
+    xll: Option<(f64, bool)>,
+    yll: Option<(f64, bool)>,
+    cellsize: Option<f64>,
+    nodata: Option<f64>,
+}
+
+pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
+    let syntax = |line: usize, message: String| FormatError::Syntax { line, message };
+    let mut header = Header::default();
+    let mut offset = 0;
+    let mut line_no = 0;
+    // Header lines start with a keyword (a letter); the first line that
+    // does not is the first row of values.
+    while offset < bytes.len() {
+        let end = bytes[offset..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |p| offset + p + 1);
+        let line = &bytes[offset..end];
+        let first = line
+            .split(|b| b.is_ascii_whitespace())
+            .find(|t| !t.is_empty());
+        if first.is_some_and(|t| !is_keyword_like(t)) {
+            break;
+        }
+        line_no += 1;
+        offset = end;
+        if first.is_none() {
+            continue;
+        }
+        let text = std::str::from_utf8(line)
+            .map_err(|_| syntax(line_no, "header line is not UTF-8 text".into()))?;
+        let mut tokens = text.split_ascii_whitespace();
+        let (Some(key), Some(value), None) = (tokens.next(), tokens.next(), tokens.next()) else {
+            return Err(syntax(
+                line_no,
+                format!("expected `keyword value`, found {:?}", text.trim()),
+            ));
+        };
+        parse_keyword(&mut header, key, value).map_err(|m| syntax(line_no, m))?;
+    }
+
+    let first_data_line = line_no + 1;
+    let missing = |what: &str| {
+        syntax(
+            first_data_line,
+            format!("header has no {what} before the values (keywords: {KEYWORDS})"),
+        )
+    };
+    let w = header.ncols.ok_or_else(|| missing("ncols"))?;
+    let h = header.nrows.ok_or_else(|| missing("nrows"))?;
+    let cell = header.cellsize.ok_or_else(|| missing("cellsize"))?;
+    check_dims(w, h)?;
+    // Every value takes at least one digit and one separator (the last
+    // needs no separator): refuse before allocating.
+    let remaining = bytes.len() - offset;
+    if (w as u64) * (h as u64) * 2 > remaining as u64 + 1 {
+        return Err(FormatError::not_justified(w, h, bytes.len()));
+    }
+    let georef = match (header.xll, header.yll) {
+        (None, None) => None,
+        (Some((x, xc)), Some((y, yc))) => {
+            let x = if xc { x - cell / 2.0 } else { x };
+            let y = if yc { y - cell / 2.0 } else { y };
+            Some(Georef {
+                origin_x: x,
+                origin_y: y + h as f64 * cell,
+            })
+        }
+        _ => {
+            return Err(missing(
+                "xllcorner and yllcorner (one is given without the other)",
+            ));
+        }
+    };
+
+    let n = w * h;
+    let nodata = header.nodata.map(|v| v as f32);
+    let mut data = Vec::with_capacity(n);
+    for line in bytes[offset..].split(|&b| b == b'\n') {
+        line_no += 1;
+        for token in line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|t| !t.is_empty())
+        {
+            let v = std::str::from_utf8(token)
+                .ok()
+                .and_then(|t| t.parse::<f32>().ok())
+                .ok_or_else(|| {
+                    syntax(
+                        line_no,
+                        format!("invalid number {:?}", String::from_utf8_lossy(token)),
+                    )
+                })?;
+            if data.len() == n {
+                return Err(syntax(
+                    line_no,
+                    format!("more values than ncols x nrows = {w} x {h} = {n}"),
+                ));
+            }
+            data.push(if v.is_nan() || Some(v) == nodata {
+                f32::NAN
+            } else {
+                v
+            });
+        }
+    }
+    if data.len() < n {
+        // `split` yields one empty piece after a final newline.
+        let last = if bytes.ends_with(b"\n") {
+            line_no - 1
+        } else {
+            line_no
+        };
+        return Err(syntax(
+            last,
+            format!(
+                "the grid ends early: expected ncols x nrows = {n} values, found {}",
+                data.len()
+            ),
+        ));
+    }
+    let mut hf = Heightfield::from_vec(w, h, cell, data)?;
+    hf.set_georef(georef);
+    Ok(hf)
+}
+
+/// Header lines start with a word; `nan` and `inf` are values, not words.
+fn is_keyword_like(token: &[u8]) -> bool {
+    token[0].is_ascii_alphabetic()
+        && std::str::from_utf8(token).map_or(true, |t| t.parse::<f32>().is_err())
+}
+
+fn parse_keyword(header: &mut Header, key: &str, value: &str) -> Result<(), String> {
+    let number = || -> Result<f64, String> {
+        value
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{key} is {value:?}: expected a finite number"))
+    };
+    let count = || -> Result<usize, String> {
+        value
+            .parse::<usize>()
+            .ok()
+            .filter(|&v| v >= 1)
+            .ok_or_else(|| format!("{key} is {value:?}: expected a whole number >= 1"))
+    };
+    let k = key.to_ascii_lowercase();
+    let already = match k.as_str() {
+        "ncols" => header.ncols.replace(count()?).is_some(),
+        "nrows" => header.nrows.replace(count()?).is_some(),
+        "xllcorner" | "xllcenter" => header.xll.replace((number()?, k == "xllcenter")).is_some(),
+        "yllcorner" | "yllcenter" => header.yll.replace((number()?, k == "yllcenter")).is_some(),
+        "cellsize" => {
+            let c = number()?;
+            if c <= 0.0 {
+                return Err(format!("cellsize is {value}: expected a value > 0"));
+            }
+            header.cellsize.replace(c).is_some()
+        }
+        "nodata_value" => header.nodata.replace(number()?).is_some(),
+        _ => {
+            return Err(format!(
+                "unknown header keyword {key:?} (expected {KEYWORDS})"
+            ));
+        }
+    };
+    if already {
+        return Err(format!("{key} is given twice"));
+    }
+    Ok(())
+}
+
+pub(super) fn encode(hf: &Heightfield) -> Result<Encoded, FormatError> {
+    let (w, h, c) = (hf.width(), hf.height(), hf.cell_size());
+    let g = hf.georef().unwrap_or(Georef {
+        origin_x: 0.0,
+        origin_y: h as f64 * c,
+    });
+    let mut s = String::with_capacity(hf.len() * 9 + 200);
+    // Writing to a String cannot fail.
+    let _ = write!(
+        s,
+        "ncols {w}\nnrows {h}\nxllcorner {}\nyllcorner {}\ncellsize {c}\n",
+        g.origin_x,
+        g.origin_y - h as f64 * c
+    );
+    let nodata = match hf.stats() {
+        _ if hf.nodata_count() == 0 => None,
+        None => Some(-9999.0),
+        // -9999 by convention; below or above every sample if that is taken.
+        Some(st) => Some(
+            [-9999.0f32, (st.min - 1.0).floor(), (st.max + 1.0).ceil()]
+                .into_iter()
+                .find(|n| n.is_finite() && !hf.data().contains(n))
+                .ok_or_else(|| {
+                    FormatError::Unwritable(
+                        "no finite value is free to mark nodata in ESRI ASCII".into(),
+                    )
+                })?,
+        ),
+    };
+    if let Some(n) = nodata {
+        let _ = writeln!(s, "NODATA_value {n}");
+    }
+    for y in 0..h {
+        for (x, &v) in hf.row(y).iter().enumerate() {
+            if x > 0 {
+                s.push(' ');
+            }
+            let _ = write!(s, "{}", if v.is_nan() { nodata.unwrap_or(v) } else { v });
+        }
+        s.push('\n');
+    }
+    Ok(Encoded {
+        bytes: s.into_bytes(),
+        sidecar: None,
+    })
+}

@@ -1,0 +1,139 @@
+//! Headerless raw heightfields: R16 (little-endian u16, the Unity / Unreal
+//! convention) and R32 (little-endian f32 metres), rows north to south.
+//!
+//! Dimensions come from, in order: [`super::ReadOptions::size`], the JSON
+//! sidecar's `width` and `height`, or — when the sample count is a perfect
+//! square, as engine heightmaps usually are — the square root. Anything else
+//! is a dimension mismatch, never a guess.
+//!
+//! R16 samples get metres from the sidecar mapping, or the 16-bit default
+//! (decimetres) without one; writing spreads the data's range over
+//! 0..=65535 and records the mapping in the sidecar, like PNG16. R16 cannot
+//! store nodata (engines read every code as a height), so writing refuses
+//! NaN. R32 stores metres directly, NaN included (as is a sidecar
+//! `nodata_value`); its sidecar carries the size and cell size with an
+//! identity mapping.
+
+use super::quantize::{dequantize, quantize16};
+use super::sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
+use super::{Encoded, Format, FormatError};
+use crate::heightfield::{Heightfield, check_dims};
+
+pub(super) fn decode16(
+    bytes: &[u8],
+    sidecar: Option<&Sidecar>,
+    size: Option<(usize, usize)>,
+) -> Result<Heightfield, FormatError> {
+    let (w, h) = dimensions(bytes.len(), 2, "R16", sidecar, size)?;
+    let codes = bytes
+        .chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]));
+    dequantize(w, h, codes, 16, sidecar)
+}
+
+pub(super) fn decode32(
+    bytes: &[u8],
+    sidecar: Option<&Sidecar>,
+    size: Option<(usize, usize)>,
+) -> Result<Heightfield, FormatError> {
+    let (w, h) = dimensions(bytes.len(), 4, "R32", sidecar, size)?;
+    let mapping = sidecar.map_or(
+        HeightMapping {
+            offset_m: 0.0,
+            scale_m: 1.0,
+        },
+        |s| s.mapping,
+    );
+    let identity = mapping.offset_m == 0.0 && mapping.scale_m == 1.0;
+    let nodata = sidecar.and_then(|s| s.nodata_value).map(|n| n as f32);
+    let data = bytes
+        .chunks_exact(4)
+        .map(|c| {
+            let v = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+            if v.is_nan() || Some(v) == nodata {
+                f32::NAN
+            } else if identity {
+                v
+            } else {
+                mapping.to_metres(v as f64) as f32
+            }
+        })
+        .collect();
+    let cell = sidecar
+        .and_then(|s| s.cell_size_m)
+        .unwrap_or(DEFAULT_CELL_SIZE_M);
+    Ok(Heightfield::from_vec(w, h, cell, data)?)
+}
+
+/// The grid size of a raw file of `len` bytes, checked against the byte count.
+fn dimensions(
+    len: usize,
+    bytes_per_sample: usize,
+    name: &str,
+    sidecar: Option<&Sidecar>,
+    size: Option<(usize, usize)>,
+) -> Result<(usize, usize), FormatError> {
+    let from_sidecar = sidecar.and_then(|s| s.width.zip(s.height));
+    let (w, h, source) = match (size, from_sidecar) {
+        (Some((w, h)), _) => (w, h, "the given size"),
+        (None, Some((w, h))) => (w, h, "the sidecar"),
+        (None, None) => {
+            if len == 0 || len % bytes_per_sample != 0 {
+                return Err(FormatError::DimensionMismatch(format!(
+                    "{len} bytes is not a whole number of {bytes_per_sample}-byte {name} samples"
+                )));
+            }
+            let n = len / bytes_per_sample;
+            let side = n.isqrt();
+            if side * side != n {
+                return Err(FormatError::DimensionMismatch(format!(
+                    "{n} {name} samples do not form a square; give the size (--in-size WxH) or a sidecar with width and height"
+                )));
+            }
+            (side, side, "the square sample count")
+        }
+    };
+    check_dims(w, h)?;
+    if let Some(s) = sidecar {
+        s.check_size(w, h)?;
+    }
+    let need = w * h * bytes_per_sample;
+    if need != len {
+        return Err(FormatError::DimensionMismatch(format!(
+            "{w}x{h} from {source} needs {need} bytes of {name} ({bytes_per_sample} per sample), the file has {len}"
+        )));
+    }
+    Ok((w, h))
+}
+
+pub(super) fn encode16(
+    hf: &Heightfield,
+    range: Option<(f64, f64)>,
+) -> Result<Encoded, FormatError> {
+    FormatError::check_no_nodata(hf, Format::R16)?;
+    let q = quantize16(hf, range)?;
+    Ok(Encoded {
+        bytes: q.codes.iter().flat_map(|c| c.to_le_bytes()).collect(),
+        sidecar: Some(q.sidecar),
+    })
+}
+
+pub(super) fn encode32(hf: &Heightfield) -> Result<Encoded, FormatError> {
+    let sidecar = Sidecar {
+        mapping: HeightMapping {
+            offset_m: 0.0,
+            scale_m: 1.0,
+        },
+        cell_size_m: Some(hf.cell_size()),
+        width: Some(hf.width()),
+        height: Some(hf.height()),
+        nodata_value: None,
+    };
+    let (min, max) = hf
+        .stats()
+        .map_or((0.0, 0.0), |s| (s.min as f64, s.max as f64));
+    Ok(Encoded {
+        bytes: hf.data().iter().flat_map(|v| v.to_le_bytes()).collect(),
+        sidecar: Some(sidecar.to_json(min, max)),
+    })
+}

@@ -1,0 +1,94 @@
+//! Helpers shared by the io integration tests.
+#![allow(dead_code)]
+
+use terrasynth::Heightfield;
+use terrasynth::io::Format;
+
+/// Every format that can be written.
+pub fn writable() -> Vec<Format> {
+    Format::ALL
+        .iter()
+        .copied()
+        .filter(|f| f.can_write())
+        .collect()
+}
+
+/// The file extension we use for a format.
+pub fn extension(f: Format) -> &'static str {
+    match f {
+        Format::Png16 | Format::Png8 => "png",
+        Format::Exr => "exr",
+        Format::Tiff => "tif",
+        Format::Hgt => "hgt",
+        Format::Asc => "asc",
+        Format::R16 => "r16",
+        Format::R32 => "r32",
+        Format::Ter => "ter",
+    }
+}
+
+/// Whether a format keeps nodata through a round trip.
+pub fn stores_nodata(f: Format) -> bool {
+    !matches!(f, Format::R16 | Format::Ter)
+}
+
+/// The largest error a round trip through `f` may introduce, in metres, for
+/// valid heights in `[min, max]` with cell size `cell`:
+/// - exr, tiff, asc, r32: exact (0);
+/// - png16, r16: half a quantization step, (max − min) / 65535 / 2 (65534
+///   with nodata), plus f32 rounding of the result;
+/// - ter: half a step of HeightScale / 65536 terrain units, where the
+///   writer's HeightScale covers (max − min + cell) / 2 on each side of the
+///   base height, plus f32 rounding.
+pub fn precision(f: Format, min: f32, max: f32, cell: f64) -> f64 {
+    let range = (max - min) as f64;
+    let f32_eps = (min.abs().max(max.abs()) as f64) * f32::EPSILON as f64;
+    match f {
+        Format::Exr | Format::Tiff | Format::Asc | Format::R32 => 0.0,
+        Format::Png16 | Format::R16 => range / 65534.0 / 2.0 + 2.0 * f32_eps,
+        Format::Ter => {
+            let unit = cell as f32 as f64;
+            let scale = ((range / unit / 2.0 + 1.0) * 65536.0 / 32767.0)
+                .ceil()
+                .max(1.0);
+            scale / 65536.0 * unit / 2.0 + 4.0 * f32_eps
+        }
+        other => panic!("{other} is not writable"),
+    }
+}
+
+/// Asserts that `b` equals `a` within `tol` (NaN must match NaN).
+pub fn assert_close(a: &Heightfield, b: &Heightfield, tol: f64, what: &str) {
+    assert_eq!(
+        (a.width(), a.height()),
+        (b.width(), b.height()),
+        "{what}: size"
+    );
+    for (i, (&x, &y)) in a.data().iter().zip(b.data()).enumerate() {
+        if x.is_nan() || y.is_nan() {
+            assert!(x.is_nan() && y.is_nan(), "{what}: sample {i}: {x} vs {y}");
+        } else {
+            let d = (x as f64 - y as f64).abs();
+            assert!(
+                d <= tol,
+                "{what}: sample {i}: {x} vs {y} (|d| = {d} > {tol})"
+            );
+        }
+    }
+}
+
+/// A small heightfield with structure: negative and positive heights, a
+/// fractional part, and an optional nodata hole.
+pub fn sample(width: usize, height: usize, cell: f64, nodata: bool) -> Heightfield {
+    let mut hf = Heightfield::from_fn(width, height, cell, |x, y| {
+        let (x, y) = (x as f32, y as f32);
+        -12.5 + 3.25 * x - 1.75 * y
+            + 0.125 * (x * y)
+            + if (x + y) as usize % 3 == 0 { 0.3 } else { 0.0 }
+    })
+    .unwrap();
+    if nodata {
+        hf.set(width / 2, height / 2, f32::NAN);
+    }
+    hf
+}
