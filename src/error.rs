@@ -48,6 +48,8 @@ pub enum Error {
     #[error(transparent)]
     Database(#[from] crate::database::DbError),
     #[error(transparent)]
+    Synth(#[from] crate::synth::SynthError),
+    #[error(transparent)]
     Poisson(#[from] crate::poisson::PoissonError),
 }
 

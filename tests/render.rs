@@ -291,24 +291,24 @@ fn type_masks_read_from_png_with_names() {
     img.put_pixel(1, 0, image::Luma([4]));
     img.save(&path).unwrap();
     std::fs::write(dir.path().join("m.json"), r#"{"types": {"4": "canyon"}}"#).unwrap();
-    let m = TypeMask::read_png(&path).unwrap();
+    let m = TypeMask::read(&path).unwrap();
     assert_eq!((m.width(), m.height()), (3, 2));
-    assert_eq!(m.indices(), &[0, 4, 0, 0, 0, 0]);
-    assert_eq!(m.names()[&4], "canyon");
+    assert_eq!(m.indices, &[0, 4, 0, 0, 0, 0]);
+    assert_eq!(m.names[&4], "canyon");
 
     // Not 8-bit greyscale, truncated, or with bad names: a clear error.
     let rgb = dir.path().join("rgb.png");
     image::RgbImage::new(2, 2).save(&rgb).unwrap();
-    let e = TypeMask::read_png(&rgb).unwrap_err().to_string();
+    let e = TypeMask::read(&rgb).unwrap_err().to_string();
     assert!(
         e.contains("rgb.png") && e.contains("8-bit greyscale"),
         "{e}"
     );
     let cut = dir.path().join("cut.png");
     std::fs::write(&cut, &std::fs::read(&path).unwrap()[..40]).unwrap();
-    assert!(TypeMask::read_png(&cut).is_err());
+    assert!(TypeMask::read(&cut).is_err());
     std::fs::write(dir.path().join("m.json"), "{").unwrap();
-    let e = TypeMask::read_png(&path).unwrap_err().to_string();
+    let e = TypeMask::read(&path).unwrap_err().to_string();
     assert!(e.contains("m.json"), "{e}");
 }
 
@@ -583,8 +583,8 @@ fn every_shared_dem_renders_with_its_types() {
         };
         let hf =
             terrasynth::io::read(&dir.join(format!("{stem}.png")), &Default::default()).unwrap();
-        let mask = TypeMask::read_png(&path).unwrap();
-        assert!(!mask.names().is_empty(), "{stem}: type names");
+        let mask = TypeMask::read(&path).unwrap();
+        assert!(!mask.names.is_empty(), "{stem}: type names");
         let o = RenderOptions {
             types: Some(TypeOverlay::new(mask)),
             grid: Grid::Metres(5000.0),

@@ -35,8 +35,6 @@ pub enum DbError {
     },
     #[error("too many terrain types ({0}): at most 32 (type sets are 32-bit masks)")]
     TooManyTypes(usize),
-    #[error("type mask {path}: {message}")]
-    TypeMask { path: PathBuf, message: String },
     #[error("{path}: {message}")]
     File { path: PathBuf, message: String },
     #[error("{path}: {source}")]

@@ -110,7 +110,8 @@ pub fn unpack(c: u32) -> (u32, u32) {
 }
 
 /// Lays out exemplars of level-0 sizes `sizes` for levels `0..=levels`.
-/// Returns `None` if the virtual atlas would exceed [`MAX_ATLAS_SIDE`].
+/// Returns `None` if the virtual atlas would exceed [`MAX_ATLAS_SIDE`] or a
+/// level would hold more than `i32::MAX` texels.
 pub fn plan(sizes: &[(u32, u32)], levels: usize) -> Option<Vec<LevelLayout>> {
     let align = 1u64 << levels;
     let mut x0s = Vec::with_capacity(sizes.len());
@@ -136,7 +137,9 @@ pub fn plan(sizes: &[(u32, u32)], levels: usize) -> Option<Vec<LevelLayout>> {
             ah = ah.max(r.height as u64);
             rects.push(r);
         }
-        if aw >= MAX_ATLAS_SIDE as u64 || ah >= MAX_ATLAS_SIDE as u64 {
+        // Texel indices must fit an i32 (synthesis and the GPU mirror
+        // address with 32-bit signed arithmetic).
+        if aw >= MAX_ATLAS_SIDE as u64 || ah >= MAX_ATLAS_SIDE as u64 || offset > i32::MAX as u64 {
             return None;
         }
         out.push(LevelLayout {

@@ -3,17 +3,14 @@
 //! and for each type a short pre-drawn list of coordinates serves seeding
 //! when all correction candidates are rejected.
 //!
-//! Masks are 8-bit index images with an optional JSON naming the indices, in
-//! the layout of `../shared/dem/<name>_types.{png,json}`:
-//! `{"types": {"0": "sea", "1": "flat", ...}}`. Types are identified across
-//! exemplars *by name*, so "mountains" in two masks is one type. An exemplar
-//! without a mask is of type `unlabelled`.
+//! Masks are [`crate::io::TypeMask`]s (8-bit index PNG + names JSON). Types
+//! are identified across exemplars *by name*, so "mountains" in two masks is
+//! one type. An exemplar without a mask is of type `unlabelled`.
 
 use super::error::DbError;
 use super::layout::{LevelLayout, pack};
 use crate::hash::hash4;
-use std::collections::BTreeMap;
-use std::path::Path;
+pub use crate::io::TypeMask;
 
 /// Most types in one database: target sets are u32 bit masks (DESIGN §3).
 pub const MAX_TYPES: usize = 32;
@@ -23,96 +20,6 @@ pub const SEEDS_PER_TYPE: usize = 64;
 pub const NO_SEED: u32 = u32::MAX;
 /// The type of exemplars given without a mask.
 pub const UNLABELLED: &str = "unlabelled";
-
-/// One exemplar's type mask: an index per texel, and the names of the indices.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TypeMask {
-    pub width: usize,
-    pub height: usize,
-    pub indices: Vec<u8>,
-    /// Index → name. Indices found in the image but not named here get
-    /// `type<index>`.
-    pub names: BTreeMap<u8, String>,
-}
-
-impl TypeMask {
-    /// Reads an 8-bit greyscale index PNG and its `<stem>.json` if present.
-    pub fn read(path: &Path) -> Result<TypeMask, DbError> {
-        let err = |message: String| DbError::TypeMask {
-            path: path.to_path_buf(),
-            message,
-        };
-        let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
-        let mut dec = png::Decoder::new(std::io::Cursor::new(&bytes));
-        dec.set_transformations(png::Transformations::IDENTITY);
-        let mut reader = dec
-            .read_info()
-            .map_err(|e| err(format!("not a readable PNG: {e}")))?;
-        let info = reader.info();
-        let (w, h) = (info.width as usize, info.height as usize);
-        if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Eight {
-            return Err(err(format!(
-                "expected an 8-bit greyscale index image, found {:?} {:?}",
-                info.color_type, info.bit_depth
-            )));
-        }
-        crate::heightfield::check_dims(w, h).map_err(|e| err(e.to_string()))?;
-        if (w * h) as u64 > bytes.len() as u64 * 1032 + 4096 {
-            return Err(err(format!(
-                "declared size {w}x{h} is not justified by the file length"
-            )));
-        }
-        let mut buf = vec![0u8; reader.output_buffer_size().unwrap_or(0)];
-        reader
-            .next_frame(&mut buf)
-            .map_err(|e| err(format!("corrupt PNG data: {e}")))?;
-        buf.truncate(w * h);
-        let json = path.with_extension("json");
-        let names = match std::fs::read(&json) {
-            Ok(b) => parse_names(&b).map_err(|m| DbError::TypeMask {
-                path: json.clone(),
-                message: m,
-            })?,
-            Err(_) => BTreeMap::new(),
-        };
-        Ok(TypeMask {
-            width: w,
-            height: h,
-            indices: buf,
-            names,
-        })
-    }
-
-    fn name_of(&self, index: u8) -> String {
-        self.names
-            .get(&index)
-            .cloned()
-            .unwrap_or_else(|| format!("type{index}"))
-    }
-}
-
-/// Parses `{"types": {"0": "sea", ...}}`.
-fn parse_names(bytes: &[u8]) -> Result<BTreeMap<u8, String>, String> {
-    let v: serde_json::Value =
-        serde_json::from_slice(bytes).map_err(|e| format!("not JSON: {e}"))?;
-    let Some(types) = v.get("types") else {
-        return Ok(BTreeMap::new());
-    };
-    let obj = types
-        .as_object()
-        .ok_or("\"types\" must map indices to names")?;
-    let mut out = BTreeMap::new();
-    for (k, name) in obj {
-        let idx: u8 = k
-            .parse()
-            .map_err(|_| format!("types key {k:?} is not an index in 0..=255"))?;
-        let name = name
-            .as_str()
-            .ok_or_else(|| format!("types.{k} must be a string"))?;
-        out.insert(idx, name.to_string());
-    }
-    Ok(out)
-}
 
 /// Maps every exemplar's local indices to global type ids (by name, in order
 /// of first appearance). Returns the names and per-exemplar T⁰ (global ids).
@@ -265,21 +172,5 @@ mod tests {
             unify(&[Some(&a)], &[(3, 1)], &["a".into()]),
             Err(DbError::MaskSize { .. })
         ));
-    }
-
-    #[test]
-    fn reads_shared_masks() {
-        let p = Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/dem/riviera_coast_types.png"
-        ));
-        if !p.exists() {
-            eprintln!("skipping: {} not found", p.display());
-            return;
-        }
-        let m = TypeMask::read(p).unwrap();
-        assert_eq!((m.width, m.height), (600, 600));
-        assert_eq!(m.names.get(&0).map(String::as_str), Some("sea"));
-        assert!(m.indices.iter().all(|&i| i <= 3));
     }
 }

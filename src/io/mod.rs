@@ -35,6 +35,7 @@ mod raw;
 mod sidecar;
 mod ter;
 mod tiff;
+pub mod type_mask;
 
 pub use atomic::write_atomic;
 pub use error::{FormatError, IoError};
@@ -42,6 +43,7 @@ pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
 pub use hgt::ARC_SECOND_M;
 pub use sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
 pub use tiff::METRES_PER_DEGREE;
+pub use type_mask::TypeMask;
 
 use crate::heightfield::Heightfield;
 use std::path::{Path, PathBuf};

@@ -204,7 +204,7 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         Some(t) => {
             p.flags |= flags::TYPES;
             let m = &t.mask;
-            let idx = resample::nearest(m.indices(), m.width(), m.height(), ow, oh);
+            let idx = resample::nearest(&m.indices, m.width, m.height, ow, oh);
             let packed = idx
                 .chunks(4)
                 .map(|c| {
@@ -398,10 +398,10 @@ fn check_options(o: &RenderOptions) -> Result<(), RenderError> {
 }
 
 fn check_types(hf: &Heightfield, t: &TypeOverlay) -> Result<(), RenderError> {
-    if (t.mask.width(), t.mask.height()) != (hf.width(), hf.height()) {
+    if (t.mask.width, t.mask.height) != (hf.width(), hf.height()) {
         return Err(RenderError::TypesSize {
-            mask_width: t.mask.width(),
-            mask_height: t.mask.height(),
+            mask_width: t.mask.width,
+            mask_height: t.mask.height,
             width: hf.width(),
             height: hf.height(),
         });

@@ -49,3 +49,25 @@ pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
         Err(err())
     }
 }
+
+/// Loads `--db`, or the embedded default database (built and cached on
+/// first use, with a progress bar and a one-line notice).
+pub fn load_database(
+    db: Option<&Path>,
+) -> Result<terrasynth::database::Database, terrasynth::database::DbError> {
+    use terrasynth::database::{Database, default};
+    match db {
+        Some(p) => Database::load(p),
+        None => {
+            let dir = default::cache_dir();
+            if !default::cache_path(&dir).exists() {
+                eprintln!(
+                    "building the default database from the embedded exemplars ({}); cached in {}",
+                    default::names().join(", "),
+                    dir.display()
+                );
+            }
+            Ok(default::load_or_build(&dir, &crate::progress::Bar::new())?.0)
+        }
+    }
+}

@@ -7,6 +7,7 @@ mod generate;
 mod info;
 mod progress;
 mod render;
+mod synth;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -31,6 +32,8 @@ enum Command {
     /// Build or inspect an exemplar database.
     #[command(subcommand)]
     Db(db::Command),
+    /// Synthesize a terrain from real exemplars (the embedded ones by default).
+    Synth(synth::Args),
     /// Draw a shaded relief map (PNG) of a heightfield.
     Render(render::Args),
     /// Generate a procedural terrain in a default exemplar style (see --list).
@@ -47,6 +50,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => convert::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),
+        Command::Synth(a) => synth::run(a),
         Command::Generate(a) => generate::run(a),
     };
     match result {

@@ -76,7 +76,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     let hf = a.read.read(&a.input)?;
-    let types = a.types.as_deref().map(TypeMask::read_png).transpose()?;
+    let types = a.types.as_deref().map(TypeMask::read).transpose()?;
     let legend: Vec<String> = types
         .as_ref()
         .map(|m| {
@@ -84,7 +84,7 @@ pub fn run(a: Args) -> CliResult {
                 .into_iter()
                 .map(|i| {
                     let [r, g, b] = render::types::type_colour(i);
-                    let name = m.names().get(&i).map_or("", String::as_str);
+                    let name = m.names.get(&i).map_or("", String::as_str);
                     format!("{i} {name} #{r:02x}{g:02x}{b:02x}")
                 })
                 .collect()

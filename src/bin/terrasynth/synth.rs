@@ -1,0 +1,101 @@
+//! `terrasynth synth`: synthesize a terrain from an exemplar database.
+
+use crate::CliResult;
+use crate::args::{load_database, parse_size};
+use std::path::PathBuf;
+use terrasynth::io::{self, WriteOptions};
+use terrasynth::render::{self, RenderOptions};
+use terrasynth::synth::{Params, Synthesizer};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Exemplar database (.tsdb, from `db build`); default: the embedded one.
+    #[arg(long)]
+    db: Option<PathBuf>,
+    /// Output size WxH (any size, e.g. 1024x1024 or 777x333).
+    #[arg(long, value_parser = parse_size, default_value = "1024x1024")]
+    size: (usize, usize),
+    /// Random seed: the same seed and inputs give the same bytes.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Output heightfield (format from the extension: .exr, .png, .tif, .r16, .ter, .asc…).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Also write a shaded-relief preview PNG.
+    #[arg(long)]
+    preview: Option<PathBuf>,
+    /// Also write the finest level's exemplar coordinates as a PNG
+    /// (red = x, green = y within the exemplar, blue = which exemplar; paper Fig. 3).
+    #[arg(long)]
+    coords: Option<PathBuf>,
+    /// Jitter amplitude r in texels (paper default 0.4; 0 reproduces the exemplar).
+    #[arg(long, default_value_t = 0.4)]
+    jitter: f64,
+    /// Correction passes per level.
+    #[arg(long, default_value_t = 2)]
+    passes: u32,
+    /// Exemplar (index) whose centre the synthesis starts from.
+    #[arg(long, default_value_t = 0)]
+    start_exemplar: usize,
+}
+
+pub fn run(a: Args) -> CliResult {
+    let db = load_database(a.db.as_deref())?;
+    let params = Params {
+        jitter: a.jitter,
+        passes: a.passes,
+        start_exemplar: a.start_exemplar,
+        keep_levels: a.coords.is_some(),
+    };
+    let synth = Synthesizer::new(&db, params)?;
+    let (w, h) = a.size;
+    let result = synth.run(w, h, a.seed)?;
+    io::write(&result.heightfield, &a.output, &WriteOptions::default())?;
+    let s = result.heightfield.stats().expect("synthesis has no nodata");
+    eprintln!(
+        "wrote {} ({w} x {h}, seed {}): heights {:.1} .. {:.1} m in {:.0} ms",
+        a.output.display(),
+        a.seed,
+        s.min,
+        s.max,
+        result.timings.total.as_secs_f64() * 1e3
+    );
+    if let Some(p) = &a.preview {
+        let preview = render::render(&result.heightfield, &RenderOptions::default())?;
+        render::write_png(p, &preview.image)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &a.coords {
+        let l0 = &result.levels[0];
+        let level = db.level(0);
+        let mut img = image::RgbaImage::new(w as u32, h as u32);
+        for y in 0..h {
+            for x in 0..w {
+                let c = l0.coords[y * l0.width + x];
+                let (tx, ty) = (
+                    c.x >> terrasynth::synth::fixed::FRAC_BITS,
+                    c.y >> terrasynth::synth::fixed::FRAC_BITS,
+                );
+                let e = level
+                    .layout
+                    .exemplar_at(level.columns, tx as u32, ty as u32)
+                    .unwrap_or(0);
+                let r = level.layout.rects[e];
+                let n = level.layout.rects.len().max(2) - 1;
+                img.put_pixel(
+                    x as u32,
+                    y as u32,
+                    image::Rgba([
+                        ((tx as u32 - r.x0) * 255 / r.width.max(1)) as u8,
+                        (ty as u32 * 255 / r.height.max(1)) as u8,
+                        (e * 255 / n) as u8,
+                        255,
+                    ]),
+                );
+            }
+        }
+        render::write_png(p, &img)?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,161 @@
+//! The embedded default database: the exemplars in `data/` (made by the
+//! crate's own generator, `terrasynth generate`) are compiled into the
+//! binary, so `terrasynth synth` works on a fresh machine with no files.
+//!
+//! Analysing them takes seconds, so the database is built on first use and
+//! cached in the user's cache directory under a name that hashes the
+//! embedded bytes, the crate version and [`BUILD_REVISION`]: a new binary
+//! never reuses a stale cache. A cache that fails to load is rebuilt; a
+//! cache that cannot be written only costs a rebuild next time.
+
+use super::{BuildOptions, Database, DbError, ExemplarInput, build, file::FORMAT_VERSION};
+use crate::io::{self, Format, ReadOptions, TypeMask};
+use crate::progress::Progress;
+use std::path::{Path, PathBuf};
+
+/// Bump when the build algorithm changes its output (PatchMatch, PCA…).
+pub const BUILD_REVISION: u32 = 1;
+
+struct Embedded {
+    name: &'static str,
+    dem: &'static [u8],
+    sidecar: &'static [u8],
+    mask: &'static [u8],
+    names: &'static [u8],
+}
+
+macro_rules! embed {
+    ($name:literal) => {
+        Embedded {
+            name: $name,
+            dem: include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/", $name, ".png")),
+            sidecar: include_bytes!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/data/",
+                $name,
+                ".json"
+            )),
+            mask: include_bytes!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/data/",
+                $name,
+                "_types.png"
+            )),
+            names: include_bytes!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/data/",
+                $name,
+                "_types.json"
+            )),
+        }
+    };
+}
+
+const EMBEDDED: [Embedded; 3] = [embed!("alpine"), embed!("canyon"), embed!("hills")];
+
+/// Names of the embedded exemplars, in database order.
+pub fn names() -> Vec<&'static str> {
+    EMBEDDED.iter().map(|e| e.name).collect()
+}
+
+/// The embedded exemplars, decoded.
+pub fn inputs() -> Vec<ExemplarInput> {
+    EMBEDDED
+        .iter()
+        .map(|e| ExemplarInput {
+            name: e.name.to_string(),
+            heights: io::decode(
+                e.dem,
+                Format::Png16,
+                Some(e.sidecar),
+                &ReadOptions::default(),
+            )
+            .expect("embedded exemplars are valid (tested)"),
+            types: Some(
+                TypeMask::decode(e.mask, Some(e.names)).expect("embedded masks are valid (tested)"),
+            ),
+        })
+        .collect()
+}
+
+/// Builds the default database in memory.
+pub fn build_default(progress: &dyn Progress) -> Result<Database, DbError> {
+    Ok(build(inputs(), &BuildOptions::default(), progress)?.0)
+}
+
+/// Where the default database is cached in `dir`.
+pub fn cache_path(dir: &Path) -> PathBuf {
+    let mut h = crc32fast::Hasher::new();
+    for e in &EMBEDDED {
+        for part in [e.dem, e.sidecar, e.mask, e.names] {
+            h.update(&(part.len() as u64).to_le_bytes());
+            h.update(part);
+        }
+    }
+    h.update(env!("CARGO_PKG_VERSION").as_bytes());
+    h.update(&FORMAT_VERSION.to_le_bytes());
+    h.update(&BUILD_REVISION.to_le_bytes());
+    dir.join(format!("default-{:08x}.tsdb", h.finalize()))
+}
+
+/// `$TERRASYNTH_CACHE_DIR`, else `$XDG_CACHE_HOME/terrasynth`, else
+/// `~/.cache/terrasynth`, else the system temporary directory.
+pub fn cache_dir() -> PathBuf {
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    env("TERRASYNTH_CACHE_DIR")
+        .or_else(|| env("XDG_CACHE_HOME").map(|p| p.join("terrasynth")))
+        .or_else(|| env("HOME").map(|p| p.join(".cache").join("terrasynth")))
+        .unwrap_or_else(|| std::env::temp_dir().join("terrasynth"))
+}
+
+/// Loads the default database cached in `dir` (normally [`cache_dir`]),
+/// building and caching it if needed. Returns the database and whether it
+/// was just built.
+pub fn load_or_build(dir: &Path, progress: &dyn Progress) -> Result<(Database, bool), DbError> {
+    let path = cache_path(dir);
+    if let Ok(db) = Database::load(&path) {
+        return Ok((db, false));
+    }
+    let db = build_default(progress)?;
+    if std::fs::create_dir_all(dir).is_ok() {
+        // A cache we cannot write only means building again next time.
+        let _ = db.save(&path);
+    }
+    Ok((db, true))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_exemplars_decode_with_types() {
+        let inputs = inputs();
+        assert_eq!(inputs.len(), 3);
+        for e in &inputs {
+            let m = e.types.as_ref().unwrap();
+            assert_eq!((m.width, m.height), (e.heights.width(), e.heights.height()));
+            assert!(!m.names.is_empty(), "{}: named types", e.name);
+            assert_eq!(e.heights.nodata_count(), 0);
+        }
+    }
+
+    #[test]
+    fn cache_is_used_and_a_corrupt_cache_is_rebuilt() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("cache");
+        let silent = &crate::progress::Silent;
+        let (a, built) = load_or_build(&dir, silent).unwrap();
+        assert!(built && cache_path(&dir).exists());
+        let (b, built) = load_or_build(&dir, silent).unwrap();
+        assert!(!built);
+        assert!(a.file_bytes() == b.file_bytes());
+        std::fs::write(cache_path(&dir), b"junk").unwrap();
+        let (c, built) = load_or_build(&dir, silent).unwrap();
+        assert!(built && c.file_bytes() == a.file_bytes());
+    }
+}

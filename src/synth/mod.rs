@@ -1,0 +1,294 @@
+//! Coarse-to-fine parallel synthesis (paper §4, DESIGN §3, §5, §6).
+//!
+//! Levels M..0 of any output size: level M is 2×2, initialised at the centre
+//! of the start exemplar; each finer level is `upsample_jitter` of the one
+//! above and, at levels ≤ L (the database's coarsest), `passes` correction
+//! passes of four interleaved subpasses; `reconstruct` turns level 0 into
+//! metres. Every stage is integer arithmetic and every random choice a hash,
+//! so the output bytes depend only on the database, the parameters and the
+//! seed — never on the thread count.
+
+pub mod atlas;
+pub mod fixed;
+pub mod stages;
+pub mod state;
+
+use crate::database::Database;
+use crate::heightfield::Heightfield;
+use atlas::AtlasLevel;
+use fixed::{Coord, FRAC_BITS};
+use stages::correct::{self, CorrectParams, SUBPASSES};
+use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
+use stages::upsample_jitter::{self, Step, UpsampleParams};
+use state::{State, level_size, top_level};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Synthesis settings (paper defaults).
+#[derive(Debug, Clone)]
+pub struct Params {
+    /// Jitter amplitude r of eq. 1, in texels (0 = none; paper: 0.4).
+    pub jitter: f64,
+    /// Correction passes per level (paper: 2), each of four subpasses.
+    pub passes: u32,
+    /// Exemplar whose centre initialises the coarsest level.
+    pub start_exemplar: usize,
+    /// Keep every level's S and V in the result, for inspection.
+    pub keep_levels: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            jitter: 0.4,
+            passes: 2,
+            start_exemplar: 0,
+            keep_levels: false,
+        }
+    }
+}
+
+/// Invalid synthesis requests.
+#[non_exhaustive]
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SynthError {
+    #[error("jitter {0} is invalid: expected 0..=4 texels")]
+    Jitter(f64),
+    #[error("passes {0} is invalid: expected 0..=16")]
+    Passes(u32),
+    #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
+    StartExemplar { index: usize, count: usize },
+    #[error(transparent)]
+    Size(#[from] crate::error::SizeError),
+}
+
+/// One level's final state, kept when [`Params::keep_levels`] is set.
+#[derive(Debug, Clone)]
+pub struct LevelMaps {
+    pub level: usize,
+    pub width: usize,
+    pub height: usize,
+    /// Exemplar coordinates (fixed point; atlas units of this level, or of
+    /// level L above it).
+    pub coords: Vec<Coord>,
+    /// Height offsets, in database units.
+    pub offsets: Vec<i32>,
+}
+
+/// Where the time went.
+#[derive(Debug, Clone, Default)]
+pub struct Timings {
+    /// Per level (index = level): upsample, correct, total.
+    pub levels: Vec<LevelTiming>,
+    pub reconstruct: Duration,
+    pub total: Duration,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LevelTiming {
+    pub upsample: Duration,
+    pub correct: Duration,
+}
+
+/// The result of a synthesis.
+#[derive(Debug, Clone)]
+pub struct Synthesis {
+    pub heightfield: Heightfield,
+    /// Levels M..0 when kept (index = level).
+    pub levels: Vec<LevelMaps>,
+    pub timings: Timings,
+}
+
+/// Synthesizes terrain from one database.
+pub struct Synthesizer<'db> {
+    db: &'db Database,
+    params: Params,
+    atlas: Vec<AtlasLevel<'db>>,
+    jitter: i32,
+}
+
+impl<'db> Synthesizer<'db> {
+    pub fn new(db: &'db Database, params: Params) -> Result<Self, SynthError> {
+        if !(0.0..=4.0).contains(&params.jitter) {
+            return Err(SynthError::Jitter(params.jitter));
+        }
+        if params.passes > 16 {
+            return Err(SynthError::Passes(params.passes));
+        }
+        let count = db.meta().exemplars.len();
+        if params.start_exemplar >= count {
+            return Err(SynthError::StartExemplar {
+                index: params.start_exemplar,
+                count,
+            });
+        }
+        let atlas = (0..db.level_count())
+            .map(|i| AtlasLevel::new(db, i))
+            .collect();
+        let jitter = (params.jitter * (1 << FRAC_BITS) as f64).round() as i32;
+        Ok(Synthesizer {
+            db,
+            params,
+            atlas,
+            jitter,
+        })
+    }
+
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The coarsest database level L.
+    fn coarsest(&self) -> usize {
+        self.db.level_count() - 1
+    }
+
+    /// Synthesizes a `width × height` heightfield.
+    pub fn synthesize(
+        &self,
+        width: usize,
+        height: usize,
+        seed: u32,
+    ) -> Result<Heightfield, SynthError> {
+        Ok(self.run(width, height, seed)?.heightfield)
+    }
+
+    /// Synthesizes and returns timings (and levels, if kept).
+    pub fn run(&self, width: usize, height: usize, seed: u32) -> Result<Synthesis, SynthError> {
+        crate::heightfield::check_dims(width, height)?;
+        let t0 = Instant::now();
+        let m = top_level(width, height);
+        let l = self.coarsest();
+        let mut timings = Timings {
+            levels: vec![LevelTiming::default(); m + 1],
+            ..Default::default()
+        };
+        let mut kept = Vec::new();
+        let mut state = self.initial(width, height, m);
+        for level in (0..=m).rev() {
+            if level < m {
+                let t = Instant::now();
+                let (w, h) = level_size(width, height, level);
+                let child = State::new(w, h);
+                let params = UpsampleParams {
+                    seed,
+                    level: level as u32,
+                    jitter: self.jitter,
+                    step: self.step(level, l),
+                };
+                let atlas = (level <= l && level < l).then(|| &self.atlas[level]);
+                upsample_jitter::upsample_jitter(&state, &child, atlas, &params);
+                state = child;
+                timings.levels[level].upsample = t.elapsed();
+            }
+            if level <= l {
+                let t = Instant::now();
+                for _pass in 0..self.params.passes {
+                    for &(px, py) in &SUBPASSES {
+                        correct::correct(&self.atlas[level], &state, &CorrectParams { px, py });
+                    }
+                }
+                timings.levels[level].correct = t.elapsed();
+            }
+            if self.params.keep_levels {
+                kept.push(LevelMaps {
+                    level,
+                    width: state.width,
+                    height: state.height,
+                    coords: state.coords(),
+                    offsets: state.offsets(),
+                });
+            }
+        }
+        kept.reverse();
+        let t = Instant::now();
+        let fixed = reconstruct::reconstruct(&self.atlas[0], self.db.heights(), &state);
+        let heightfield = self.to_metres(&fixed, state.width, width, height)?;
+        timings.reconstruct = t.elapsed();
+        timings.total = t0.elapsed();
+        Ok(Synthesis {
+            heightfield,
+            levels: kept,
+            timings,
+        })
+    }
+
+    /// How level `level` is made from the one above.
+    fn step(&self, level: usize, l: usize) -> Step {
+        if level < l {
+            Step::Pyramid
+        } else if level > l {
+            Step::Virtual {
+                shift: (level - l) as u32,
+            }
+        } else {
+            let c = &self.atlas[l].columns;
+            let r = self.atlas[l].level.layout.rects[self.params.start_exemplar];
+            let col = c[r.x0 as usize];
+            Step::Wrap {
+                min_x: col.min_x,
+                max_x: col.max_x,
+                min_y: crate::database::layout::MARGIN as i32,
+                max_y: col.max_y,
+            }
+        }
+    }
+
+    /// Level M: the start exemplar's centre, spread so that each level
+    /// halves the spacing (at level ≤ L, an exact copy of the centre).
+    fn initial(&self, width: usize, height: usize, m: usize) -> State {
+        let l = self.coarsest();
+        let at = m.min(l);
+        let r = self.atlas[at].level.layout.rects[self.params.start_exemplar];
+        let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
+        let (w, h) = level_size(width, height, m);
+        let st = State::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                // Offset from the level's centre, in half texels of level m.
+                let (hx, hy) = (2 * x as i32 + 1 - w as i32, 2 * y as i32 + 1 - h as i32);
+                let to_fixed = |half: i32| -> i32 {
+                    if m > l {
+                        // In level-L units: a level-m texel is 2^(m−L) of them.
+                        (half << FRAC_BITS) << (m - l - 1)
+                    } else {
+                        half << (FRAC_BITS - 1)
+                    }
+                };
+                let s = Coord {
+                    x: (cx << FRAC_BITS) + to_fixed(hx),
+                    y: (cy << FRAC_BITS) + to_fixed(hy),
+                };
+                st.set(y * w + x, s, 0);
+            }
+        }
+        st
+    }
+
+    /// Level-0 fixed-point heights → metres, cropped to the requested size
+    /// (levels are at least 2×2).
+    fn to_metres(
+        &self,
+        fixed: &[i32],
+        stride: usize,
+        width: usize,
+        height: usize,
+    ) -> Result<Heightfield, SynthError> {
+        let q = self.db.quantization();
+        let cell = self.db.meta().exemplars[self.params.start_exemplar].cell_size_m;
+        let scale = q.scale_m / (1 << HEIGHT_FRAC_BITS) as f64;
+        Ok(Heightfield::from_fn(width, height, cell, |x, y| {
+            (q.offset_m + scale * fixed[y * stride + x] as f64) as f32
+        })?)
+    }
+
+    /// Synthesis memory per output pixel: the finest level's state, the
+    /// level above it (alive during upsampling), the fixed-point heights and
+    /// the output heightfield.
+    pub fn bytes_per_pixel(width: usize, height: usize) -> f64 {
+        let (w0, h0) = level_size(width, height, 0);
+        let (w1, h1) = level_size(width, height, 1);
+        let bytes = (w0 * h0 + w1 * h1) * State::BYTES_PER_PIXEL + w0 * h0 * 4 + width * height * 4;
+        bytes as f64 / (width * height) as f64
+    }
+}

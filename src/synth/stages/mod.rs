@@ -1,0 +1,6 @@
+//! The synthesis stages: each a pure function over flat buffers, named like
+//! its WGSL mirror in `kernels/` (DESIGN §3).
+
+pub mod correct;
+pub mod reconstruct;
+pub mod upsample_jitter;

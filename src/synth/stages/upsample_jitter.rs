@@ -1,0 +1,157 @@
+//! Stage `upsample_jitter` (paper eq. 1–2): each pixel of level i+1 seeds
+//! its 2×2 children at level i, `S(2p + c) = 2·S(p) + c + r·H(2p + c)`,
+//! `V(2p + c) = V(p)`, with `H` a stateless hash in [−1, 1]² (DESIGN §6).
+//!
+//! (The paper writes children at `2p ± ½` in OpenCL's half-integer texel
+//! convention; with texel centres at integers that is `2p + c`, c ∈ {0,1}²,
+//! matching how the exemplar pyramid pairs texel x with children 2x, 2x+1.)
+//!
+//! Levels above the database's coarsest level L have no exemplar data; their
+//! coordinates are kept in level-L units, where "doubling" is adding
+//! `(c + r·H)·2^(i−L)` (the same map, expressed at level L). Entering level
+//! L they wrap toroidally into the start exemplar's interior, so an output
+//! larger than the exemplar starts from a jittered, tiled copy that the
+//! correction at level L then rearranges. Below L, children are clamped into
+//! their exemplar's interior (the parent's exemplar: jitter never moves a
+//! child across exemplars because exemplars are ≥ 2 texels apart).
+
+use crate::database::layout::MARGIN;
+use crate::hash::hash4;
+use crate::synth::atlas::AtlasLevel;
+use crate::synth::fixed::{Coord, FRAC_BITS};
+use crate::synth::state::State;
+use rayon::prelude::*;
+
+/// How children relate to parents at this step.
+#[derive(Debug, Clone, Copy)]
+pub enum Step {
+    /// Both levels are at or below L: children are `2·S + c + j`, clamped
+    /// into the interior of their exemplar at the child level.
+    Pyramid,
+    /// The child level is above L: coordinates stay in level-L units and
+    /// move by `(c + j) << shift` (shift = child level − L).
+    Virtual { shift: u32 },
+    /// The child level is L itself and the parent is above it: as `Virtual`
+    /// with shift 0, then wrap into the rectangle (inclusive texel bounds).
+    Wrap {
+        min_x: i32,
+        max_x: i32,
+        min_y: i32,
+        max_y: i32,
+    },
+}
+
+/// Parameters of one upsampling (the WGSL mirror takes the same numbers).
+#[derive(Debug, Clone, Copy)]
+pub struct UpsampleParams {
+    pub seed: u32,
+    /// The child level's index.
+    pub level: u32,
+    /// Jitter amplitude r in fixed point (r · 2^FRAC_BITS).
+    pub jitter: i32,
+    pub step: Step,
+}
+
+/// The jitter offset of a child pixel: two values in [−r, r) (fixed point).
+#[inline(always)]
+pub fn jitter(seed: u32, level: u32, x: u32, y: u32, r: i32) -> (i32, i32) {
+    let h = hash4(seed, level, x, y);
+    let jx = (h & 0xFFFF) as i32 - 32768;
+    let jy = (h >> 16) as i32 - 32768;
+    // |j · r| ≤ 2^15 · 2^10 < 2^31; >> is an arithmetic (floor) shift.
+    ((jx * r) >> 15, (jy * r) >> 15)
+}
+
+/// Fills `child` from `parent`. `atlas` is the child level's atlas (used by
+/// [`Step::Pyramid`] to clamp).
+pub fn upsample_jitter(
+    parent: &State,
+    child: &State,
+    atlas: Option<&AtlasLevel<'_>>,
+    p: &UpsampleParams,
+) {
+    let (cw, pw) = (child.width, parent.width);
+    (0..child.height).into_par_iter().for_each(|y| {
+        for x in 0..cw {
+            let pi = (y / 2) * pw + x / 2;
+            let (cx, cy) = ((x & 1) as i32, (y & 1) as i32);
+            let s = parent.s(pi);
+            let (jx, jy) = jitter(p.seed, p.level, x as u32, y as u32, p.jitter);
+            let off_x = (cx << FRAC_BITS) + jx;
+            let off_y = (cy << FRAC_BITS) + jy;
+            let out = match p.step {
+                Step::Pyramid => {
+                    let a = atlas.expect("pyramid steps have an atlas");
+                    let c = Coord {
+                        x: 2 * s.x + off_x,
+                        y: 2 * s.y + off_y,
+                    };
+                    clamp(a, c)
+                }
+                Step::Virtual { shift } => Coord {
+                    x: s.x + (off_x << shift),
+                    y: s.y + (off_y << shift),
+                },
+                Step::Wrap {
+                    min_x,
+                    max_x,
+                    min_y,
+                    max_y,
+                } => Coord {
+                    x: wrap(s.x + off_x, min_x, max_x),
+                    y: wrap(s.y + off_y, min_y, max_y),
+                },
+            };
+            child.set(y * cw + x, out, parent.v(pi));
+        }
+    });
+}
+
+/// Clamps a fixed-point coordinate into the interior of the exemplar its
+/// rounded position falls in.
+#[inline(always)]
+fn clamp(a: &AtlasLevel<'_>, c: Coord) -> Coord {
+    let tx = crate::synth::fixed::round(c.x);
+    let col = &a.columns[tx as usize];
+    Coord {
+        x: c.x.clamp(col.min_x << FRAC_BITS, col.max_x << FRAC_BITS),
+        y: c.y
+            .clamp((MARGIN as i32) << FRAC_BITS, col.max_y << FRAC_BITS),
+    }
+}
+
+/// Toroidal wrap of a fixed-point value into texels `[min, max]`.
+#[inline(always)]
+fn wrap(v: i32, min: i32, max: i32) -> i32 {
+    let period = (max - min + 1) << FRAC_BITS;
+    (min << FRAC_BITS) + (v - (min << FRAC_BITS)).rem_euclid(period)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_stays_within_r_and_is_centred() {
+        let r = (0.4 * (1 << FRAC_BITS) as f64).round() as i32;
+        let (mut sx, mut n) = (0i64, 0i64);
+        for y in 0..64 {
+            for x in 0..64 {
+                let (jx, jy) = jitter(7, 3, x, y, r);
+                assert!((-r..r).contains(&jx) && (-r..r).contains(&jy));
+                sx += jx as i64;
+                n += 1;
+            }
+        }
+        assert!((sx as f64 / n as f64).abs() < 2.0);
+        assert_eq!(jitter(7, 3, 5, 5, 0), (0, 0));
+    }
+
+    #[test]
+    fn wrap_is_periodic_inside_bounds() {
+        let one = 1 << FRAC_BITS;
+        assert_eq!(wrap(5 * one, 2, 9), 5 * one);
+        assert_eq!(wrap(10 * one, 2, 9), 2 * one);
+        assert_eq!(wrap(one + 3, 2, 9), 9 * one + 3);
+    }
+}

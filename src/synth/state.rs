@@ -1,0 +1,92 @@
+//! Per-level synthesis state: exemplar coordinates S and height offsets V.
+//!
+//! The buffers are arrays of relaxed atomics. A correction subpass updates
+//! its pixels in place while reading their neighbours (which belong to other
+//! subpasses, DESIGN §5), exactly like a GPU kernel writing a storage buffer;
+//! relaxed loads and stores compile to plain moves, and make that sharing
+//! safe Rust without a copy of the state per subpass.
+
+use super::fixed::Coord;
+use std::sync::atomic::{AtomicI32, AtomicU64, Ordering::Relaxed};
+
+/// Size of a synthesis level: `max(2, ⌈W / 2^i⌉)` per axis, so that every
+/// level has the 2×2 neighbourhood the correction reflects at its borders.
+pub fn level_size(width: usize, height: usize, level: usize) -> (usize, usize) {
+    let f = |n: usize| n.div_ceil(1 << level).max(2);
+    (f(width), f(height))
+}
+
+/// The coarsest synthesis level M: the first whose size is 2×2.
+pub fn top_level(width: usize, height: usize) -> usize {
+    let mut m = 0;
+    while level_size(width, height, m) != (2, 2) {
+        m += 1;
+    }
+    m
+}
+
+/// S and V of one level.
+pub struct State {
+    pub width: usize,
+    pub height: usize,
+    s: Vec<AtomicU64>,
+    v: Vec<AtomicI32>,
+}
+
+impl State {
+    pub fn new(width: usize, height: usize) -> State {
+        let n = width * height;
+        State {
+            width,
+            height,
+            s: (0..n).map(|_| AtomicU64::new(0)).collect(),
+            v: (0..n).map(|_| AtomicI32::new(0)).collect(),
+        }
+    }
+    #[inline(always)]
+    pub fn s(&self, i: usize) -> Coord {
+        Coord::unpack(self.s[i].load(Relaxed))
+    }
+    #[inline(always)]
+    pub fn v(&self, i: usize) -> i32 {
+        self.v[i].load(Relaxed)
+    }
+    #[inline(always)]
+    pub fn set(&self, i: usize, s: Coord, v: i32) {
+        self.s[i].store(s.pack(), Relaxed);
+        self.v[i].store(v, Relaxed);
+    }
+    /// A copy of the coordinates, row-major.
+    pub fn coords(&self) -> Vec<Coord> {
+        self.s
+            .iter()
+            .map(|a| Coord::unpack(a.load(Relaxed)))
+            .collect()
+    }
+    /// A copy of the offsets, row-major.
+    pub fn offsets(&self) -> Vec<i32> {
+        self.v.iter().map(|a| a.load(Relaxed)).collect()
+    }
+    /// Bytes held per pixel (for memory reports).
+    pub const BYTES_PER_PIXEL: usize = 12;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_sizes_cover_any_output() {
+        assert_eq!(level_size(1024, 1024, 0), (1024, 1024));
+        assert_eq!(level_size(777, 333, 3), (98, 42));
+        assert_eq!(level_size(1, 1, 0), (2, 2));
+        assert_eq!(top_level(1024, 1024), 9);
+        assert_eq!(top_level(1, 1), 0);
+        assert_eq!(top_level(3, 2049), 11);
+        for m in 0..12 {
+            let (w, h) = level_size(3, 2049, m);
+            let (cw, ch) = level_size(3, 2049, m + 1);
+            assert!(2 * cw >= w && 2 * ch >= h, "children must cover level {m}");
+        }
+    }
+}
