@@ -292,7 +292,7 @@ fn type_masks_read_from_png_with_names() {
     img.save(&path).unwrap();
     std::fs::write(dir.path().join("m.json"), r#"{"types": {"4": "canyon"}}"#).unwrap();
     let m = TypeMask::read(&path).unwrap();
-    assert_eq!((m.width(), m.height()), (3, 2));
+    assert_eq!((m.width, m.height), (3, 2));
     assert_eq!(m.indices, &[0, 4, 0, 0, 0, 0]);
     assert_eq!(m.names[&4], "canyon");
 

@@ -217,6 +217,13 @@ mod tests {
         let back = TypeMask::decode(&m.encode_png(), Some(&json)).unwrap();
         assert_eq!(back, m);
         assert_eq!(back.present(), vec![0, 1, 2]);
+        let other = br#"{"types": {"0": "sea", "3": "mountains"}, "x": 1}"#;
+        assert_eq!(
+            TypeMask::decode(&m.encode_png(), Some(other))
+                .unwrap()
+                .name_of(3),
+            "mountains"
+        );
         assert_eq!(back.name_of(2), "type2");
         let p = Path::new(concat!(
             env!("CARGO_MANIFEST_DIR"),

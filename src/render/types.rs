@@ -51,24 +51,3 @@ impl TypeOverlay {
         TypeOverlay { mask, colours }
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_parse_and_refuse_bad_indices() {
-        let n = parse_names(br#"{"types": {"0": "sea", "3": "mountains"}, "x": 1}"#).unwrap();
-        assert_eq!(n[&3], "mountains");
-        assert!(parse_names(br#"{"types": {"255": "none"}}"#).is_err());
-        assert!(parse_names(br#"{"types": {"a": "b"}}"#).is_err());
-        assert!(parse_names(b"[]").is_err());
-    }
-
-    #[test]
-    fn present_lists_indices() {
-        let m = TypeMask::new(2, 2, vec![3, 255, 0, 3]).unwrap();
-        assert_eq!(m.present(), vec![0, 3]);
-        assert!(TypeMask::new(2, 2, vec![0; 3]).is_err());
-    }
-}
