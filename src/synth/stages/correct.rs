@@ -28,7 +28,9 @@
 //!
 //! Reads never touch another pixel of the same subpass (neighbours at odd
 //! offsets, or at (±2, ±1)/(±1, ±2)), and borders reflect by 2 so parity is
-//! kept: subpasses run in place, in parallel, deterministically.
+//! kept: subpasses run in place, in parallel, deterministically. Outside
+//! the level, coordinates are extrapolated from the reflected pixel (see
+//! [`neighbour`]).
 
 use crate::database::appearance::unpack_texel;
 use crate::synth::atlas::AtlasLevel;
@@ -116,57 +118,81 @@ fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u3
     (s * kappa, h)
 }
 
+/// What a neighbour contributes: the texel its coordinate points at (as
+/// seen from where the neighbour should be), the fraction of that
+/// coordinate, and its offset V.
+struct Neighbour {
+    tx: i32,
+    ty: i32,
+    frac: (i32, i32),
+    v: i32,
+}
+
+/// Reads the neighbour at (x, y), which may lie outside the level.
+///
+/// Outside pixels read their parity-preserving reflection r (so a subpass
+/// still never reads its own class) and *extrapolate* its coordinate back to
+/// where the missing pixel would be: `round(S(r)) + ((x, y) − r)`, clamped to
+/// stay one texel inside the exemplar. A coherent patch thus continues past
+/// the border instead of folding back on itself, which would make border
+/// pixels mismatch and seed offsets V that diffuse inward level after level.
+#[inline(always)]
+fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> Neighbour {
+    let (w, h) = (st.width as i32, st.height as i32);
+    let (rx, ry) = (reflect(x, w), reflect(y, h));
+    let i = (ry * w + rx) as usize;
+    let s = st.s(i);
+    let (sx, sy) = (round(s.x), round(s.y));
+    let frac = (s.x - (sx << FRAC_BITS), s.y - (sy << FRAC_BITS));
+    let (mut tx, mut ty) = (sx, sy);
+    if (rx, ry) != (x, y) {
+        let col = &atlas.columns[sx as usize];
+        // Interior bounds widened by one: lookups at ±1 stay in the exemplar.
+        tx = (sx + x - rx).clamp(col.min_x - 1, col.max_x + 1);
+        ty = (sy + y - ry).clamp(1, col.max_y + 1);
+    }
+    Neighbour {
+        tx,
+        ty,
+        frac,
+        v: st.v(i),
+    }
+}
+
 /// Corrects one pixel; returns its new coordinate and offset.
 #[inline(always)]
 fn correct_pixel(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> (Coord, i32) {
-    let (w, h) = (st.width as i32, st.height as i32);
-    let at = |x: i32, y: i32| (reflect(y, h) * w + reflect(x, w)) as usize;
-
     let mut ns: Neighbourhood = [[0; 4]; 4];
     for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
         for (vx, vy) in [(0, 0), (dx, 0), (0, dy)] {
-            let i = at(x + dx + vx, y + dy + vy);
-            let s = st.s(i);
-            let t = atlas.appearance(round(s.x) - vx, round(s.y) - vy);
-            add_texel(&mut ns[k], t, st.v(i));
+            let n = neighbour(atlas, st, x + dx + vx, y + dy + vy);
+            add_texel(&mut ns[k], atlas.appearance(n.tx - vx, n.ty - vy), n.v);
         }
     }
 
     let mut best = (u32::MAX, Coord::default(), 0i32);
     let mut seen = [(i32::MIN, i32::MIN); 9];
-    for (n, &(dx, dy)) in DELTAS.iter().enumerate() {
-        let s = st.s(at(x + dx, y + dy));
-        let (rx, ry) = (round(s.x), round(s.y));
-        let frac = (s.x - (rx << FRAC_BITS), s.y - (ry << FRAC_BITS));
-        let u = (rx - dx, ry - dy);
-        if seen[..n].contains(&u) {
+    for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
+        let n = neighbour(atlas, st, x + dx, y + dy);
+        let u = (n.tx - dx, n.ty - dy);
+        if seen[..k].contains(&u) {
             continue;
         }
-        seen[n] = u;
-        let (c1x, c1y) = atlas.clamp_interior(u.0, u.1);
-        let (sc, hh) = score(atlas, &ns, c1x, c1y, 1);
+        seen[k] = u;
+        let place = |(qx, qy): (i32, i32)| Coord {
+            x: (qx << FRAC_BITS) + n.frac.0,
+            y: (qy << FRAC_BITS) + n.frac.1,
+        };
+        let c1 = atlas.clamp_interior(u.0, u.1);
+        let (sc, hh) = score(atlas, &ns, c1.0, c1.1, 1);
         if sc < best.0 {
-            best = (
-                sc,
-                Coord {
-                    x: (c1x << FRAC_BITS) + frac.0,
-                    y: (c1y << FRAC_BITS) + frac.1,
-                },
-                hh,
-            );
+            best = (sc, place(c1), hh);
         }
         let c2 = atlas.level.similar[atlas.index(u.0, u.1)];
-        let (c2x, c2y) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
-        let (sc, hh) = score(atlas, &ns, c2x, c2y, 2);
+        let c2 = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+        let (sc, hh) = score(atlas, &ns, c2.0, c2.1, 2);
         if sc < best.0 {
-            best = (
-                sc,
-                Coord {
-                    x: (c2x << FRAC_BITS) + frac.0,
-                    y: (c2y << FRAC_BITS) + frac.1,
-                },
-                hh,
-            );
+            best = (sc, place(c2), hh);
         }
     }
     debug_assert!(best.0 < u32::MAX);

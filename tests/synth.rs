@@ -1,0 +1,188 @@
+//! Synthesis engine: determinism, the exemplar-reproduction property,
+//! coordinate invariants, and robustness over odd sizes.
+
+use proptest::prelude::*;
+use std::sync::OnceLock;
+use terrasynth::database::{Database, default};
+use terrasynth::progress::Silent;
+use terrasynth::synth::fixed::{FRAC_BITS, round};
+use terrasynth::synth::{Params, Synthesizer};
+
+fn db() -> &'static Database {
+    static DB: OnceLock<Database> = OnceLock::new();
+    DB.get_or_init(|| default::build_default(&Silent).unwrap())
+}
+
+fn bits(hf: &terrasynth::Heightfield) -> Vec<u32> {
+    hf.data().iter().map(|v| v.to_bits()).collect()
+}
+
+#[test]
+fn identical_bytes_across_runs_and_thread_counts() {
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let s = Synthesizer::new(db(), Params::default()).unwrap();
+                bits(&s.synthesize(300, 200, 42).unwrap())
+            })
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(2), "a second run must repeat the first");
+    let s = Synthesizer::new(db(), Params::default()).unwrap();
+    assert_ne!(
+        one,
+        bits(&s.synthesize(300, 200, 43).unwrap()),
+        "the seed must matter"
+    );
+}
+
+#[test]
+fn without_jitter_the_exemplar_is_reproduced() {
+    // The classic parallel-synthesis property: no jitter, and every level is a
+    // shifted copy of the start exemplar, which correction leaves alone
+    // (the identity candidate matches exactly and wins ties).
+    let params = Params {
+        jitter: 0.0,
+        keep_levels: true,
+        ..Params::default()
+    };
+    let s = Synthesizer::new(db(), params).unwrap();
+    let out = s.run(200, 160, 9).unwrap();
+    let l0 = &out.levels[0];
+    let origin = l0.coords[0];
+    assert_eq!(origin.x % (1 << FRAC_BITS), 0, "integral coordinates");
+    let q = db().quantization();
+    let level = db().level(0);
+    let rect = level.layout.rects[0];
+    for y in 0..160 {
+        for x in 0..200 {
+            let c = l0.coords[y * l0.width + x];
+            let (ex, ey) = (
+                (origin.x >> FRAC_BITS) + x as i32,
+                (origin.y >> FRAC_BITS) + y as i32,
+            );
+            assert_eq!(
+                (c.x, c.y),
+                (ex << FRAC_BITS, ey << FRAC_BITS),
+                "pixel ({x},{y}) left the copy"
+            );
+            assert_eq!(l0.offsets[y * l0.width + x], 0);
+            let e0 = db().heights()[rect.index(ex as u32, ey as u32)];
+            let want = (q.offset_m + q.scale_m * e0 as f64) as f32;
+            assert_eq!(out.heightfield.get(x, y), want, "height at ({x},{y})");
+        }
+    }
+}
+
+#[test]
+fn coordinates_stay_inside_exemplar_interiors_at_every_level() {
+    let params = Params {
+        keep_levels: true,
+        ..Params::default()
+    };
+    let s = Synthesizer::new(db(), params).unwrap();
+    let out = s.run(333, 257, 5).unwrap();
+    let coarsest = db().level_count() - 1;
+    for maps in out.levels.iter().filter(|m| m.level <= coarsest) {
+        let level = db().level(maps.level);
+        for c in &maps.coords {
+            let (x, y) = (round(c.x), round(c.y));
+            assert!(
+                x >= 0 && y >= 0,
+                "negative coordinate at level {}",
+                maps.level
+            );
+            let e = level
+                .layout
+                .exemplar_at(level.columns, x as u32, y as u32)
+                .unwrap_or_else(|| panic!("level {}: ({x},{y}) is in no exemplar", maps.level));
+            assert!(
+                level.layout.rects[e].is_interior(x as u32, y as u32),
+                "level {}: ({x},{y}) on an edge",
+                maps.level
+            );
+        }
+    }
+}
+
+#[test]
+fn the_start_exemplar_dominates_the_result() {
+    let level = db().level(0);
+    for start in 0..3 {
+        let params = Params {
+            keep_levels: true,
+            start_exemplar: start,
+            ..Params::default()
+        };
+        let out = Synthesizer::new(db(), params)
+            .unwrap()
+            .run(256, 256, 3)
+            .unwrap();
+        let mut used = [0usize; 3];
+        for c in &out.levels[0].coords {
+            let e = level
+                .layout
+                .exemplar_at(level.columns, round(c.x) as u32, round(c.y) as u32);
+            used[e.expect("inside an exemplar")] += 1;
+        }
+        assert!(used[start] > 256 * 256 / 2, "start {start}: {used:?}");
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused() {
+    for p in [
+        Params {
+            jitter: -0.1,
+            ..Params::default()
+        },
+        Params {
+            jitter: f64::NAN,
+            ..Params::default()
+        },
+        Params {
+            passes: 99,
+            ..Params::default()
+        },
+        Params {
+            start_exemplar: 3,
+            ..Params::default()
+        },
+    ] {
+        assert!(Synthesizer::new(db(), p).is_err());
+    }
+    let s = Synthesizer::new(db(), Params::default()).unwrap();
+    assert!(s.synthesize(0, 10, 1).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    #[test]
+    fn odd_sizes_never_panic_and_heights_stay_in_range(
+        (w, h) in prop_oneof![
+            Just((1usize, 1usize)),
+            Just((3, 2049)),
+            Just((777, 333)),
+            (1usize..200, 1usize..200),
+        ],
+        seed in any::<u32>(),
+    ) {
+        let s = Synthesizer::new(db(), Params { keep_levels: true, ..Params::default() }).unwrap();
+        let out = s.run(w, h, seed).unwrap();
+        prop_assert_eq!((out.heightfield.width(), out.heightfield.height()), (w, h));
+        // Heights lie within the database's range plus the offsets used.
+        let q = db().quantization();
+        let offs = &out.levels[0].offsets;
+        let (vmin, vmax) = (*offs.iter().min().unwrap() as f64, *offs.iter().max().unwrap() as f64);
+        let lo = q.metres(vmin) - 1e-3;
+        let hi = q.metres(65535.0 + vmax) + 1e-3;
+        for &v in out.heightfield.data() {
+            prop_assert!(v.is_finite() && (v as f64) >= lo && (v as f64) <= hi, "{} outside {}..{}", v, lo, hi);
+        }
+    }
+}
