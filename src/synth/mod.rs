@@ -24,6 +24,15 @@ use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
+/// With jitter, synthesis starts this many levels above the database's
+/// coarsest level L, from hash-chosen exemplar positions (see
+/// `Synthesizer::initial`): level L starts as a mosaic of 2^b × 2^b blocks.
+pub const COARSE_BLOCK_BITS: usize = 2;
+
+/// Hash salt of the coarse start positions (kept apart from the jitter's
+/// `hash4(seed, level, x, y)`, whose level is always < 2^16).
+const COARSE_SALT: u32 = 0xC0A5_0000;
+
 /// Synthesis settings (paper defaults).
 #[derive(Debug, Clone)]
 pub struct Params {
@@ -164,9 +173,16 @@ impl<'db> Synthesizer<'db> {
             ..Default::default()
         };
         let mut kept = Vec::new();
-        let mut state = self.initial(width, height, m);
-        for level in (0..=m).rev() {
-            if level < m {
+        // With jitter, levels above `top` would only be a spread-out copy of
+        // the start exemplar; they are skipped (see `initial`).
+        let top = if self.jitter > 0 {
+            m.min(l + COARSE_BLOCK_BITS)
+        } else {
+            m
+        };
+        let mut state = self.initial(width, height, top, seed);
+        for level in (0..=top).rev() {
+            if level < top {
                 let t = Instant::now();
                 let (w, h) = level_size(width, height, level);
                 let child = State::new(w, h);
@@ -234,15 +250,47 @@ impl<'db> Synthesizer<'db> {
         }
     }
 
-    /// Level M: the start exemplar's centre, spread so that each level
-    /// halves the spacing (at level ≤ L, an exact copy of the centre).
-    fn initial(&self, width: usize, height: usize, m: usize) -> State {
+    /// The coarsest synthesized level, `top`.
+    ///
+    /// Without jitter (the reproduction property): level M holds the start
+    /// exemplar's centre, spread so that each level halves the spacing — at
+    /// level ≤ L an exact copy of the centre, tiled toroidally when the
+    /// output is larger than the exemplar.
+    ///
+    /// With jitter, an output larger than the exemplars would otherwise be
+    /// that tiled copy plus sub-texel jitter: above level L there is no data
+    /// to correct with, so the paper's jitter cannot create variety there and
+    /// the tiles stay visible as a repeating pattern. Instead each pixel of
+    /// level `top = L + COARSE_BLOCK_BITS` starts at a hash-chosen position
+    /// of the start exemplar (the fully jittered coarse level of Lefebvre &
+    /// Hoppe 2005), so level L begins as a mosaic of small exemplar blocks
+    /// that its correction passes assemble into exemplar-like patches.
+    fn initial(&self, width: usize, height: usize, top: usize, seed: u32) -> State {
         let l = self.coarsest();
-        let at = m.min(l);
+        let at = top.min(l);
         let r = self.atlas[at].level.layout.rects[self.params.start_exemplar];
-        let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
-        let (w, h) = level_size(width, height, m);
+        let (w, h) = level_size(width, height, top);
         let st = State::new(w, h);
+        if self.jitter > 0 && top > l {
+            // Level-L texel ranges whose whole 2^b block stays inside the
+            // exemplar interior (b = top − L).
+            let span = (1i32 << (top - l)) - 1;
+            let col = self.atlas[l].columns[r.x0 as usize];
+            let (x0, y0) = (col.min_x, crate::database::layout::MARGIN as i32);
+            let nx = (col.max_x - span - x0 + 1).max(1) as u32;
+            let ny = (col.max_y - span - y0 + 1).max(1) as u32;
+            for y in 0..h {
+                for x in 0..w {
+                    let hash = crate::hash::hash4(seed, COARSE_SALT, x as u32, y as u32);
+                    let tx = x0 + crate::hash::below(hash, nx) as i32;
+                    let ty = y0 + crate::hash::below(crate::hash::pcg(hash), ny) as i32;
+                    st.set(y * w + x, Coord::from_texel(tx, ty), 0);
+                }
+            }
+            return st;
+        }
+        let m = top;
+        let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
         for y in 0..h {
             for x in 0..w {
                 // Offset from the level's centre, in half texels of level m.

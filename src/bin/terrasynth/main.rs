@@ -1,6 +1,7 @@
 //! The `terrasynth` command-line tool: one file per subcommand.
 
 mod args;
+mod bench;
 mod convert;
 mod db;
 mod generate;
@@ -29,6 +30,8 @@ enum Command {
     Info(info::Args),
     /// Convert a heightfield between formats (chosen by extension).
     Convert(convert::Args),
+    /// Time synthesis: median ms per size, level and stage, and memory per pixel.
+    Bench(bench::Args),
     /// Build or inspect an exemplar database.
     #[command(subcommand)]
     Db(db::Command),
@@ -48,6 +51,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Bench(a) => bench::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),
         Command::Synth(a) => synth::run(a),

@@ -1,0 +1,147 @@
+//! `terrasynth bench`: median synthesis times per size, level and stage.
+//!
+//! Timings come from the synthesizer's own stage clocks ([`Timings`]), so
+//! the numbers are the same ones a library user sees; each size is run
+//! `--runs` times after one warm-up and the median of every figure reported
+//! (these machines are shared and noisy: medians, not means).
+
+use crate::CliResult;
+use crate::args::{load_database, parse_size};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::Duration;
+use terrasynth::synth::{Params, Synthesizer, Timings};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Exemplar database (.tsdb); default: the embedded one.
+    #[arg(long)]
+    db: Option<PathBuf>,
+    /// Output sizes to synthesize, comma-separated WxH.
+    #[arg(long, value_delimiter = ',', value_parser = parse_size,
+          default_value = "512x512,1024x1024,2048x2048")]
+    sizes: Vec<(usize, usize)>,
+    /// Timed runs per size (after one warm-up run); the median is reported.
+    #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    runs: u32,
+    /// Random seed of the first run (run k uses seed + k).
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One size's medians, in milliseconds.
+#[derive(Serialize)]
+struct SizeReport {
+    size: String,
+    runs: u32,
+    threads: usize,
+    total_ms: f64,
+    /// Index = level (0 finest).
+    levels: Vec<LevelReport>,
+    stages: BTreeMap<&'static str, f64>,
+    bytes_per_pixel: f64,
+}
+
+#[derive(Serialize)]
+struct LevelReport {
+    level: usize,
+    width: usize,
+    height: usize,
+    upsample_jitter_ms: f64,
+    correct_ms: f64,
+}
+
+#[derive(Serialize)]
+struct Report {
+    sizes: Vec<SizeReport>,
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        (v[n / 2 - 1] + v[n / 2]) / 2.0
+    }
+}
+
+pub fn run(a: Args) -> CliResult {
+    let db = load_database(a.db.as_deref())?;
+    let synth = Synthesizer::new(&db, Params::default())?;
+    let mut sizes = Vec::new();
+    for &(w, h) in &a.sizes {
+        synth.run(w, h, a.seed)?; // warm-up: page in the database, spin up threads
+        let timings: Vec<Timings> = (0..a.runs)
+            .map(|k| synth.run(w, h, a.seed.wrapping_add(k)).map(|s| s.timings))
+            .collect::<Result<_, _>>()?;
+        let med =
+            |f: &dyn Fn(&Timings) -> Duration| median(timings.iter().map(|t| ms(f(t))).collect());
+        let n_levels = timings[0].levels.len();
+        let levels = (0..n_levels)
+            .map(|l| {
+                let (lw, lh) = terrasynth::synth::state::level_size(w, h, l);
+                LevelReport {
+                    level: l,
+                    width: lw,
+                    height: lh,
+                    upsample_jitter_ms: med(&|t| t.levels[l].upsample),
+                    correct_ms: med(&|t| t.levels[l].correct),
+                }
+            })
+            .collect();
+        let stages = BTreeMap::from([
+            (
+                "upsample_jitter",
+                med(&|t| t.levels.iter().map(|l| l.upsample).sum()),
+            ),
+            (
+                "correct",
+                med(&|t| t.levels.iter().map(|l| l.correct).sum()),
+            ),
+            ("reconstruct", med(&|t| t.reconstruct)),
+        ]);
+        let report = SizeReport {
+            size: format!("{w}x{h}"),
+            runs: a.runs,
+            threads: rayon::current_num_threads(),
+            total_ms: med(&|t| t.total),
+            levels,
+            stages,
+            bytes_per_pixel: Synthesizer::bytes_per_pixel(w, h),
+        };
+        if !a.json {
+            print_table(&report);
+        }
+        sizes.push(report);
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&Report { sizes })?);
+    }
+    Ok(())
+}
+
+fn print_table(r: &SizeReport) {
+    println!(
+        "{}: {:.1} ms median of {} runs on {} threads, {:.1} bytes/pixel",
+        r.size, r.total_ms, r.runs, r.threads, r.bytes_per_pixel
+    );
+    for (name, t) in &r.stages {
+        println!("  {name:<16} {t:>8.1} ms");
+    }
+    println!("  level     size        upsample    correct");
+    for l in r.levels.iter().rev() {
+        println!(
+            "  {:>5} {:>5}x{:<5} {:>8.2} ms {:>8.2} ms",
+            l.level, l.width, l.height, l.upsample_jitter_ms, l.correct_ms
+        );
+    }
+}

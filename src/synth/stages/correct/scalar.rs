@@ -1,0 +1,153 @@
+//! The reference correction: one pixel at a time, coordinates throughout,
+//! exactly the arithmetic of `kernels/correct.wgsl`. It handles every pixel
+//! (borders included) and is the oracle the [`super::simd`] path is tested
+//! against.
+
+use super::{CLAMP, CorrectParams, DELTAS, DIAGONALS};
+use crate::database::appearance::unpack_texel;
+use crate::synth::atlas::AtlasLevel;
+use crate::synth::fixed::{Coord, FRAC_BITS, div_floor, round};
+use crate::synth::state::State;
+use rayon::prelude::*;
+
+/// Reflects a coordinate at the level border by 2 (keeps parity); the
+/// level is at least 2 wide and offsets are at most ±2.
+#[inline(always)]
+fn reflect(c: i32, n: i32) -> i32 {
+    if c < 0 {
+        c + 2
+    } else if c >= n {
+        c - 2
+    } else {
+        c
+    }
+}
+
+/// N_S: per diagonal, the 4 modes (×3), mode 1 including V.
+type Neighbourhood = [[i32; 4]; 4];
+
+#[inline(always)]
+fn add_texel(acc: &mut [i32; 4], t: u64, v: i32) {
+    let m = unpack_texel(t);
+    acc[0] += m[0] as i32 + v;
+    acc[1] += m[1] as i32;
+    acc[2] += m[2] as i32;
+    acc[3] += m[3] as i32;
+}
+
+/// Score (×κ) and optimal offset of candidate texel (qx, qy).
+#[inline(always)]
+fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u32) -> (u32, i32) {
+    let mut d = [[0i32; 4]; 4];
+    let mut sum1 = 0;
+    for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
+        let m = unpack_texel(atlas.appearance(qx + dx, qy + dy));
+        for j in 0..4 {
+            d[k][j] = ns[k][j] - 3 * m[j] as i32;
+        }
+        sum1 += d[k][0];
+    }
+    let h = div_floor(sum1 + 6, 12);
+    let mut s = 0u32;
+    for dk in &d {
+        let r1 = (dk[0] - 3 * h).clamp(-CLAMP, CLAMP);
+        s += (r1 * r1) as u32;
+        for &dj in &dk[1..] {
+            let r = dj.clamp(-CLAMP, CLAMP);
+            s += (r * r) as u32;
+        }
+    }
+    (s * kappa, h)
+}
+
+/// What a neighbour contributes: the texel its coordinate points at (as
+/// seen from where the neighbour should be), the fraction of that
+/// coordinate, and its offset V.
+struct Neighbour {
+    tx: i32,
+    ty: i32,
+    frac: (i32, i32),
+    v: i32,
+}
+
+/// Reads the neighbour at (x, y), which may lie outside the level.
+///
+/// Outside pixels read their parity-preserving reflection r (so a subpass
+/// still never reads its own class) and *extrapolate* its coordinate back to
+/// where the missing pixel would be: `round(S(r)) + ((x, y) − r)`, clamped to
+/// stay one texel inside the exemplar. A coherent patch thus continues past
+/// the border instead of folding back on itself, which would make border
+/// pixels mismatch and seed offsets V that diffuse inward level after level.
+#[inline(always)]
+fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> Neighbour {
+    let (w, h) = (st.width as i32, st.height as i32);
+    let (rx, ry) = (reflect(x, w), reflect(y, h));
+    let i = (ry * w + rx) as usize;
+    let s = st.s(i);
+    let (sx, sy) = (round(s.x), round(s.y));
+    let frac = (s.x - (sx << FRAC_BITS), s.y - (sy << FRAC_BITS));
+    let (mut tx, mut ty) = (sx, sy);
+    if (rx, ry) != (x, y) {
+        let col = &atlas.columns[sx as usize];
+        // Interior bounds widened by one: lookups at ±1 stay in the exemplar.
+        tx = (sx + x - rx).clamp(col.min_x - 1, col.max_x + 1);
+        ty = (sy + y - ry).clamp(1, col.max_y + 1);
+    }
+    Neighbour {
+        tx,
+        ty,
+        frac,
+        v: st.v(i),
+    }
+}
+
+/// Corrects one pixel; returns its new coordinate and offset.
+#[inline(always)]
+pub fn correct_pixel(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> (Coord, i32) {
+    let mut ns: Neighbourhood = [[0; 4]; 4];
+    for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
+        for (vx, vy) in [(0, 0), (dx, 0), (0, dy)] {
+            let n = neighbour(atlas, st, x + dx + vx, y + dy + vy);
+            add_texel(&mut ns[k], atlas.appearance(n.tx - vx, n.ty - vy), n.v);
+        }
+    }
+
+    let mut best = (u32::MAX, Coord::default(), 0i32);
+    let mut seen = [(i32::MIN, i32::MIN); 9];
+    for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
+        let n = neighbour(atlas, st, x + dx, y + dy);
+        let u = (n.tx - dx, n.ty - dy);
+        if seen[..k].contains(&u) {
+            continue;
+        }
+        seen[k] = u;
+        let place = |(qx, qy): (i32, i32)| Coord {
+            x: (qx << FRAC_BITS) + n.frac.0,
+            y: (qy << FRAC_BITS) + n.frac.1,
+        };
+        let c1 = atlas.clamp_interior(u.0, u.1);
+        let (sc, hh) = score(atlas, &ns, c1.0, c1.1, 1);
+        if sc < best.0 {
+            best = (sc, place(c1), hh);
+        }
+        let c2 = atlas.level.similar[atlas.index(u.0, u.1)];
+        let c2 = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+        let (sc, hh) = score(atlas, &ns, c2.0, c2.1, 2);
+        if sc < best.0 {
+            best = (sc, place(c2), hh);
+        }
+    }
+    debug_assert!(best.0 < u32::MAX);
+    (best.1, best.2)
+}
+
+/// Runs one subpass in place with the reference path only.
+pub fn correct(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams) {
+    let (w, h) = (st.width, st.height);
+    (p.py as usize..h).into_par_iter().step_by(2).for_each(|y| {
+        for x in (p.px as usize..w).step_by(2) {
+            let (s, v) = correct_pixel(atlas, st, x as i32, y as i32);
+            st.set(y * w + x, s, v);
+        }
+    });
+}
