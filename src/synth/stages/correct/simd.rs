@@ -88,10 +88,13 @@ fn score(app: &[u64], ns: &Neighbourhood, q: i32, s: i32, kappa: u32) -> (u32, i
     let h = div_floor(a[0] + a[4] + b[0] + b[4] + 6, 12);
     let h3 = 3 * h;
     let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
-    let lo = i32x8::splat(-CLAMP);
-    let hi = i32x8::splat(CLAMP);
-    let r01 = i16x8::from_i32x8_saturate((d01 - off).max(lo).min(hi));
-    let r23 = i16x8::from_i32x8_saturate((d23 - off).max(lo).min(hi));
+    // Clamping after the saturating narrowing equals clamping before it
+    // (saturation is monotone and ±CLAMP lies inside i16), and i16 min/max
+    // are single instructions where i32 ones are not (SSE2).
+    let lo = i16x8::splat(-CLAMP as i16);
+    let hi = i16x8::splat(CLAMP as i16);
+    let r01 = i16x8::from_i32x8_saturate(d01 - off).max(lo).min(hi);
+    let r23 = i16x8::from_i32x8_saturate(d23 - off).max(lo).min(hi);
     let sums = (r01.dot(r01) + r23.dot(r23)).to_array();
     let s = (sums[0] as u32)
         .wrapping_add(sums[1] as u32)
@@ -182,14 +185,18 @@ fn at(grid: &[[Tap; GRID_COLS]; 5], c: usize, dx: i32, dy: i32) -> &Tap {
 fn gather(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize, out: &mut Pending) {
     let app = atlas.level.appearance;
     let mut count = 0;
-    let mut seen = [(i32::MIN, i32::MIN); 9];
+    // Distinct u so far, packed `x | y << 16` (atlas sides are < 2^16).
+    let mut seen = [0u32; 9];
+    let mut distinct = 0;
     for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
         let n = at(grid, c, dx, dy);
         let u = (n.sx - dx, n.sy - dy);
-        if seen[..k].contains(&u) {
+        let key = u.0 as u32 | (u.1 as u32) << 16;
+        if seen[..distinct].contains(&key) {
             continue;
         }
-        seen[k] = u;
+        seen[distinct] = key;
+        distinct += 1;
         // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
         let u_idx = n.idx - dx - dy * n.stride;
         let (cx, cy) = atlas.clamp_interior(u.0, u.1);
@@ -235,31 +242,30 @@ fn decide(
     let app = atlas.level.appearance;
     // N_S (eq. 5–6): per diagonal δ, g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a
     // for v ∈ {0, (δx, 0), (0, δy)}.
-    let mut acc = [[0i32; 4]; 4];
-    for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
+    // Two diagonals per vector, three texels each; V joins mode 1.
+    let half = |k: usize| {
+        let (dx, dy) = DIAGONALS[k];
         let a = at(grid, c, dx, dy);
         let b = at(grid, c, 2 * dx, dy);
         let cc = at(grid, c, dx, 2 * dy);
         let texels = [
-            (app[a.idx as usize], a.v),
-            (app[(b.idx - dx) as usize], b.v),
-            (app[(cc.idx - dy * cc.stride) as usize], cc.v),
+            app[a.idx as usize],
+            app[(b.idx - dx) as usize],
+            app[(cc.idx - dy * cc.stride) as usize],
         ];
-        for (t, v) in texels {
-            let m = crate::database::appearance::unpack_texel(t);
-            acc[k][0] += m[0] as i32 + v;
-            acc[k][1] += m[1] as i32;
-            acc[k][2] += m[2] as i32;
-            acc[k][3] += m[3] as i32;
+        (texels, a.v + b.v + cc.v)
+    };
+    let pairs = |k: usize| {
+        let ((t0, v0), (t1, v1)) = (half(k), half(k + 1));
+        let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
+        for j in 0..3 {
+            sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
         }
-    }
+        sum
+    };
     let ns = &Neighbourhood {
-        ns01: i32x8::new([
-            acc[0][0], acc[0][1], acc[0][2], acc[0][3], acc[1][0], acc[1][1], acc[1][2], acc[1][3],
-        ]),
-        ns23: i32x8::new([
-            acc[2][0], acc[2][1], acc[2][2], acc[2][3], acc[3][0], acc[3][1], acc[3][2], acc[3][3],
-        ]),
+        ns01: pairs(0),
+        ns23: pairs(2),
     };
     // Ties keep the earlier candidate (DELTAS order, C₁ before C₂).
     let mut best = (u32::MAX, 0usize, 0i32);
