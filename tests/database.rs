@@ -278,3 +278,40 @@ proptest! {
         prop_assert!(Database::load(&p).is_err());
     }
 }
+
+/// The fuzz seeds of the database loader and the type-mask reader decode
+/// (they are valid), and every prefix of them is refused without a panic.
+#[test]
+fn fuzz_seeds_load_and_their_prefixes_fail_cleanly() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus");
+    let files = |t: &str| {
+        let mut v: Vec<_> = std::fs::read_dir(root.join(t))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        v.sort();
+        assert!(!v.is_empty(), "no {t} seeds");
+        v
+    };
+    for p in files("tsdb") {
+        let bytes = std::fs::read(&p).unwrap();
+        let db = Database::from_bytes(&bytes, &p).unwrap();
+        assert_eq!(db.file_bytes(), &bytes[..]);
+        for cut in (0..bytes.len()).step_by(97) {
+            let err = Database::from_bytes(&bytes[..cut], &p).unwrap_err();
+            assert!(err.to_string().contains(&*p.to_string_lossy()), "{err}");
+        }
+    }
+    for p in files("type_mask") {
+        let bytes = std::fs::read(&p).unwrap();
+        let (json, png) = bytes[1..].split_at(bytes[0] as usize);
+        let mask = TypeMask::decode(png, (!json.is_empty()).then_some(json)).unwrap();
+        assert_eq!((mask.width, mask.height), (48, 48));
+        assert_eq!(mask.names.len(), if json.is_empty() { 0 } else { 5 });
+        // Cuts into the pixel data (a missing 12-byte IEND trailer alone
+        // loses nothing, and the PNG decoder accepts it).
+        for cut in (0..png.len() - 12).step_by(7) {
+            assert!(TypeMask::decode(&png[..cut], None).is_err(), "cut at {cut}");
+        }
+    }
+}

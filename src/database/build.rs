@@ -311,7 +311,8 @@ pub fn build(
         });
     }
     let words = file::encode(&sections);
-    let db = Database::parse(Bytes::Owned(words), Path::new("<built database>"))?;
+    let len = words.len() * 8;
+    let db = Database::parse(Bytes::Owned(words, len), Path::new("<built database>"))?;
     Ok((db, report))
 }
 

@@ -222,14 +222,15 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Vec<Found>, DbError> {
 /// The bytes a database lives in: its own buffer after a build, or a
 /// read-only memory map of the file after a load.
 pub enum Bytes {
-    Owned(Vec<u64>),
+    /// 8-byte-aligned words holding `len` bytes.
+    Owned(Vec<u64>, usize),
     Mapped(memmap2::Mmap),
 }
 
 impl Bytes {
     pub fn as_slice(&self) -> &[u8] {
         match self {
-            Bytes::Owned(w) => bytemuck::cast_slice(w),
+            Bytes::Owned(w, len) => &bytemuck::cast_slice(w)[..*len],
             Bytes::Mapped(m) => m,
         }
     }

@@ -145,6 +145,15 @@ impl Database {
         Database::parse(Bytes::map(path)?, path)
     }
 
+    /// Validates an in-memory `.tsdb` image (for embedding, pipes and the
+    /// fuzzer); `name` stands for its origin in error messages. The bytes are
+    /// copied once into 8-byte-aligned storage, as the arrays require.
+    pub fn from_bytes(bytes: &[u8], name: &Path) -> Result<Database, DbError> {
+        let mut words = vec![0u64; bytes.len().div_ceil(8)];
+        bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
+        Database::parse(Bytes::Owned(words, bytes.len()), name)
+    }
+
     /// Writes the database atomically.
     pub fn save(&self, path: &Path) -> Result<(), DbError> {
         Ok(crate::io::write_atomic(path, self.file_bytes())?)
