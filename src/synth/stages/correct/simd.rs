@@ -39,9 +39,6 @@ struct Tap {
     sy: i32,
     /// Height offset V.
     v: i32,
-    /// Fractional part of the coordinate (fixed point, < 2^FRAC_BITS).
-    fx: i16,
-    fy: i16,
 }
 
 #[inline(always)]
@@ -55,8 +52,6 @@ fn tap(atlas: &AtlasLevel<'_>, st: &State, i: usize) -> Tap {
         sx,
         sy,
         v: st.v(i),
-        fx: (s.x - (sx << FRAC_BITS)) as i16,
-        fy: (s.y - (sy << FRAC_BITS)) as i16,
     }
 }
 
@@ -165,8 +160,9 @@ fn correct_chunk(
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
-            let (s, v) = decide(atlas, grid, 2 * k + 2, &ring[k % RING]);
-            st.set(y * w + x0 + 2 * k, s, v);
+            let i = y * w + x0 + 2 * k;
+            let (s, v) = decide(atlas, st, grid, 2 * k + 2, i, &ring[k % RING]);
+            st.set(i, s, v);
         }
     }
 }
@@ -235,8 +231,10 @@ fn gather(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize, out: &
 #[inline(always)]
 fn decide(
     atlas: &AtlasLevel<'_>,
+    st: &State,
     grid: &[[Tap; GRID_COLS]; 5],
     c: usize,
+    pixel: usize,
     p: &Pending,
 ) -> (Coord, i32) {
     let app = atlas.level.appearance;
@@ -277,11 +275,13 @@ fn decide(
     }
     debug_assert!(best.0 < u32::MAX);
     let q = p.cands[best.1];
+    // The winner keeps the fraction of the neighbour it came from.
     let (dx, dy) = DELTAS[q.from as usize];
-    let n = at(grid, c, dx, dy);
+    let n = st.s((pixel as isize + dy as isize * st.width as isize + dx as isize) as usize);
+    let frac = |v: i32| v - (round(v) << FRAC_BITS);
     let s = Coord {
-        x: (q.x << FRAC_BITS) + n.fx as i32,
-        y: (q.y << FRAC_BITS) + n.fy as i32,
+        x: (q.x << FRAC_BITS) + frac(n.x),
+        y: (q.y << FRAC_BITS) + frac(n.y),
     };
     (s, best.2)
 }
