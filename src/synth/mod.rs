@@ -9,6 +9,7 @@
 //! seed — never on the thread count.
 
 pub mod atlas;
+pub mod control;
 pub mod fixed;
 pub mod stages;
 pub mod state;
