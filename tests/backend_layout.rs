@@ -4,6 +4,7 @@
 
 use std::mem::{offset_of, size_of};
 use terrasynth::backend::kernels::{self, CorrectUniform, ReconstructUniform, UpsampleUniform};
+use terrasynth::render::shade::ShadeParams;
 use terrasynth::synth::atlas::Column;
 
 fn module(k: kernels::Kernel) -> naga::Module {
@@ -94,8 +95,58 @@ fn parameter_structs_match_their_wgsl_declarations() {
             pad1
         })
     );
+    assert_eq!(
+        wgsl_struct(&module(kernels::SHADE), "ShadeParams"),
+        rust_layout!(ShadeParams {
+            lights,
+            width,
+            height,
+            flags,
+            light_count,
+            slope_x_mul,
+            slope_x_pre,
+            slope_x_post,
+            slope_x_clamp,
+            slope_y_mul,
+            slope_y_pre,
+            slope_y_post,
+            slope_y_clamp,
+            shade_floor,
+            shade_gain,
+            shade_max,
+            nodata_colour,
+            tint_lo,
+            tint_shift,
+            tint_len,
+            nodata_hatch,
+            water_level,
+            water_shift,
+            water_shallow,
+            water_deep,
+            range_lo,
+            range_hi,
+            range_colour,
+            coast_colour,
+            contour_base,
+            contour_interval,
+            contour_index_every,
+            contour_colour,
+            contour_half_width,
+            index_half_width,
+            coast_half_width,
+            index_colour,
+            contour_min_spacing,
+            grid_step_x,
+            grid_step_y,
+            grid_colour
+        })
+    );
     // The atlas column table is uploaded as the Rust slice's bytes.
-    for k in kernels::ALL {
+    for k in [
+        kernels::UPSAMPLE_JITTER,
+        kernels::CORRECT,
+        kernels::RECONSTRUCT,
+    ] {
         assert_eq!(
             wgsl_struct(&module(k), "Column"),
             rust_layout!(Column {
@@ -109,6 +160,38 @@ fn parameter_structs_match_their_wgsl_declarations() {
             k.name
         );
     }
+}
+
+#[test]
+fn shade_constants_match() {
+    use terrasynth::render::shade::{self, flags};
+    let src = kernels::SHADE.source;
+    for (name, v) in [
+        ("F_CONTOURS", flags::CONTOURS),
+        ("F_GRID", flags::GRID),
+        ("F_RANGE", flags::RANGE),
+        ("F_SEA", flags::SEA),
+        ("F_TYPES", flags::TYPES),
+        ("F_ASPECT_WEIGHTS", flags::ASPECT_WEIGHTS),
+        ("NO_TYPE", shade::NO_TYPE),
+        ("FULL", shade::FULL),
+    ] {
+        assert!(
+            src.contains(&format!("const {name}: u32 = {v}u;")),
+            "{name} must be {v} in shade.wgsl"
+        );
+    }
+    for (name, v) in [
+        ("SLOPE_ONE", shade::SLOPE_ONE),
+        ("MAX_SLOPE", shade::MAX_SLOPE),
+    ] {
+        assert!(
+            src.contains(&format!("const {name}: i32 = {v};")),
+            "{name} must be {v} in shade.wgsl"
+        );
+    }
+    assert_eq!(shade::NODATA, i32::MIN);
+    assert!(src.contains("const NODATA: i32 = -2147483647 - 1;"));
 }
 
 #[test]

@@ -41,8 +41,15 @@ pub const RECONSTRUCT: Kernel = Kernel {
     source: include_str!("../../kernels/reconstruct.wgsl"),
 };
 
+/// The preview renderer's stage (`render::shade`); its parameter block is
+/// `render::shade::ShadeParams` itself, already `#[repr(C)]` and Pod.
+pub const SHADE: Kernel = Kernel {
+    name: "shade",
+    source: include_str!("../../kernels/shade.wgsl"),
+};
+
 /// Every kernel, for tests that check them all.
-pub const ALL: [Kernel; 3] = [UPSAMPLE_JITTER, CORRECT, RECONSTRUCT];
+pub const ALL: [Kernel; 4] = [UPSAMPLE_JITTER, CORRECT, RECONSTRUCT, SHADE];
 
 /// Workgroup side of every kernel (`@workgroup_size(8, 8)`).
 pub const WORKGROUP: u32 = 8;

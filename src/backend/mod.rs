@@ -18,7 +18,25 @@ use crate::synth::fixed::Coord;
 use crate::synth::stages::correct::CorrectParams;
 use crate::synth::stages::upsample_jitter::UpsampleParams;
 use crate::synth::state::State;
+use std::time::Duration;
 use thiserror::Error;
+
+/// The stages a backend runs, for per-stage timings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    UpsampleJitter,
+    Correct,
+    Reconstruct,
+}
+
+/// The device's own measure of one stage call (GPU timestamp queries).
+#[derive(Debug, Clone, Copy)]
+pub struct StageTime {
+    pub stage: Stage,
+    /// The level the call worked on.
+    pub level: usize,
+    pub time: Duration,
+}
 
 /// The synthesis stages of one backend, bound to one database.
 ///
@@ -53,6 +71,16 @@ pub trait Backend {
     /// Waits until every queued stage has run (so a caller's clock measures
     /// the work, not its submission).
     fn finish(&self) -> Result<(), BackendError>;
+    /// Whether [`Backend::device_times`] reports the stages' own times, so
+    /// that the caller need not wait after each stage to time it.
+    fn has_device_clock(&self) -> bool {
+        false
+    }
+    /// The device's times of the stage calls since the last call (and
+    /// forgets them); `None` without a device clock.
+    fn device_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {
+        Ok(None)
+    }
 }
 
 /// Which backend a user asked for (`--backend`).
@@ -87,4 +115,6 @@ pub enum BackendError {
     },
     #[error("GPU error: {0}")]
     Gpu(String),
+    #[error(transparent)]
+    Shade(#[from] crate::render::shade::ParamsError),
 }

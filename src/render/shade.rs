@@ -1,6 +1,6 @@
 //! The `shade` stage: one RGBA8 preview pixel from quantized heights.
 //!
-//! This is the CPU mirror of a future `kernels/shade.wgsl` compute kernel and
+//! This is the CPU mirror of the `kernels/shade.wgsl` compute kernel and
 //! must produce the same bytes (DESIGN.md §6). Everything per pixel is
 //! therefore **integer arithmetic on 32-bit values only**: no floats, no
 //! 64-bit integers (WGSL has none), no shift by 32 or more. The CPU prepares

@@ -14,7 +14,7 @@ pub mod fixed;
 pub mod stages;
 pub mod state;
 
-use crate::backend::{Backend, BackendError, Choice, cpu::Cpu};
+use crate::backend::{Backend, BackendError, Choice, Stage, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
@@ -95,6 +95,9 @@ pub struct Timings {
     pub levels: Vec<LevelTiming>,
     pub reconstruct: Duration,
     pub total: Duration,
+    /// Stage times are the device's own (GPU timestamp queries), not wall
+    /// clock.
+    pub device_clock: bool,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -271,6 +274,10 @@ impl<'db> Synthesizer<'db> {
         } else {
             m
         };
+        // Without a device clock, the loop waits after each stage so that
+        // wall clock measures it; with one, stages queue back to back.
+        let device_clock = b.has_device_clock();
+        b.device_times()?; // forget times of earlier calls
         let mut state = b.upload(self.initial(width, height, top, seed))?;
         for level in (0..=top).rev() {
             let (w, h) = level_size(width, height, level);
@@ -284,7 +291,9 @@ impl<'db> Synthesizer<'db> {
                     step: self.step(level, l),
                 };
                 b.upsample_jitter(&state, &child, level, &params);
-                b.finish()?;
+                if !device_clock {
+                    b.finish()?;
+                }
                 state = child;
                 timings.levels[level].upsample = t.elapsed();
             }
@@ -295,7 +304,9 @@ impl<'db> Synthesizer<'db> {
                         b.correct(&state, level, &CorrectParams { px, py });
                     }
                 }
-                b.finish()?;
+                if !device_clock {
+                    b.finish()?;
+                }
                 timings.levels[level].correct = t.elapsed();
             }
             if self.params.keep_levels {
@@ -316,6 +327,20 @@ impl<'db> Synthesizer<'db> {
         let heightfield = self.to_metres(&fixed, stride, width, height)?;
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
+        if let Some(times) = b.device_times()? {
+            timings.device_clock = true;
+            for l in &mut timings.levels {
+                *l = LevelTiming::default();
+            }
+            timings.reconstruct = Duration::ZERO;
+            for st in times {
+                match st.stage {
+                    Stage::UpsampleJitter => timings.levels[st.level].upsample += st.time,
+                    Stage::Correct => timings.levels[st.level].correct += st.time,
+                    Stage::Reconstruct => timings.reconstruct += st.time,
+                }
+            }
+        }
         Ok(Synthesis {
             heightfield,
             levels: kept,

@@ -13,14 +13,16 @@
 //! submissions, so one subpass sees the previous one's writes.
 
 use super::kernels::{self, CorrectUniform, Kernel, ReconstructUniform, UpsampleUniform};
-use super::{Backend, BackendError};
+use super::{Backend, BackendError, Stage, StageTime};
+use crate::render::shade::{ShadeBuffers, ShadeParams};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::fixed::Coord;
 use crate::synth::stages::correct::CorrectParams;
 use crate::synth::stages::upsample_jitter::{Step, UpsampleParams};
 use crate::synth::state::State;
-use std::sync::Arc;
 use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 use wgpu::util::DeviceExt;
 
 /// A device with the kernels compiled: create once, share (`Arc`) between
@@ -33,6 +35,22 @@ pub struct Context {
     upsample_jitter: wgpu::ComputePipeline,
     correct: wgpu::ComputePipeline,
     reconstruct: wgpu::ComputePipeline,
+    shade: wgpu::ComputePipeline,
+    /// Timestamp queries, where the adapter has them.
+    profile: Option<Mutex<Profile>>,
+}
+
+/// Most timed dispatches between two reads of the times (a 4096² synthesis
+/// makes ~120); later ones go untimed and the times are reported missing.
+const MAX_TIMED: u32 = 2048;
+
+/// Begin/end timestamps of each dispatch since the last read.
+struct Profile {
+    queries: wgpu::QuerySet,
+    /// What each pair of queries timed, in order.
+    labels: Vec<(Stage, usize)>,
+    /// More dispatches than [`MAX_TIMED`] since the last read.
+    overflow: bool,
 }
 
 impl Context {
@@ -59,9 +77,11 @@ impl Context {
                 .map_err(|e| BackendError::NoAdapter(e.to_string()))?,
         };
         let limits = adapter.limits();
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("terrasynth"),
+                required_features: features,
                 required_limits: limits.clone(),
                 ..Default::default()
             })
@@ -85,10 +105,23 @@ impl Context {
         let upsample_jitter = pipeline(kernels::UPSAMPLE_JITTER);
         let correct = pipeline(kernels::CORRECT);
         let reconstruct = pipeline(kernels::RECONSTRUCT);
+        let shade = pipeline(kernels::SHADE);
         if let Some(e) = scope.pop().await {
             return Err(BackendError::Gpu(e.to_string()));
         }
+        let profile = features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            Mutex::new(Profile {
+                queries: device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("stage timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2 * MAX_TIMED,
+                }),
+                labels: Vec::new(),
+                overflow: false,
+            })
+        });
         Ok(Arc::new(Context {
+            profile,
             info: adapter.get_info(),
             device,
             queue,
@@ -96,7 +129,13 @@ impl Context {
             upsample_jitter,
             correct,
             reconstruct,
+            shade,
         }))
+    }
+
+    /// Whether stage times come from GPU timestamp queries (else wall clock).
+    pub fn has_timestamps(&self) -> bool {
+        self.profile.is_some()
     }
 
     /// The adapter, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
@@ -154,9 +193,11 @@ impl Context {
     }
 
     /// Records and submits one dispatch: `uniform` at binding 0, `buffers`
-    /// at bindings 1.., `groups` workgroups.
+    /// at bindings 1.., `groups` workgroups; timed as `label` (a synthesis
+    /// stage and its level) when given and the device has timestamps.
     fn dispatch(
         &self,
+        label: Option<(Stage, usize)>,
         pipeline: &wgpu::ComputePipeline,
         uniform: &[u8],
         buffers: &[&wgpu::Buffer],
@@ -186,10 +227,27 @@ impl Context {
             entries: &entries,
         });
         let mut enc = self.device.create_command_encoder(&Default::default());
+        let mut profile = self
+            .profile
+            .as_ref()
+            .map(|p| p.lock().expect("profile lock"));
+        let timestamp_writes = profile.as_mut().zip(label).and_then(|(p, label)| {
+            let k = p.labels.len() as u32;
+            if k == MAX_TIMED {
+                p.overflow = true;
+                return None;
+            }
+            p.labels.push(label);
+            Some(wgpu::ComputePassTimestampWrites {
+                query_set: &p.queries,
+                beginning_of_pass_write_index: Some(2 * k),
+                end_of_pass_write_index: Some(2 * k + 1),
+            })
+        });
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: None,
-                timestamp_writes: None,
+                timestamp_writes,
             });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind, &[]);
@@ -225,6 +283,71 @@ impl Context {
             .map_err(|e| BackendError::Gpu(e.to_string()))?
             .to_vec();
         Ok(data)
+    }
+
+    /// Stage `shade` (the preview renderer's): the same packed RGBA pixels
+    /// as `render::shade::shade`, row-major. Checks the parameters first,
+    /// exactly like the CPU stage.
+    pub fn shade(&self, p: &ShadeParams, b: &ShadeBuffers<'_>) -> Result<Vec<u32>, BackendError> {
+        p.validate(b)?;
+        let n = p.width as u64 * p.height as u64;
+        // Type buffers may be empty when the overlay is off: bind a word.
+        let some = |v: &[u32]| -> Vec<u32> { if v.is_empty() { vec![0] } else { v.to_vec() } };
+        let heights = self.storage("shade heights", bytemuck::cast_slice(b.heights))?;
+        let types = self.storage("shade types", bytemuck::cast_slice(&some(b.types)))?;
+        let tint = self.storage("tint", bytemuck::cast_slice(b.tint))?;
+        let colours = self.storage("type colours", bytemuck::cast_slice(&some(b.type_colours)))?;
+        let out = self.storage_empty("preview", n * 4)?;
+        self.dispatch(
+            None,
+            &self.shade,
+            bytemuck::bytes_of(p),
+            &[&heights, &types, &tint, &colours, &out],
+            (groups(p.width as usize), groups(p.height as usize)),
+        );
+        Ok(bytemuck::pod_collect_to_vec(&self.read(&out)?))
+    }
+
+    /// Reads and forgets the timestamps recorded since the last call.
+    fn stage_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {
+        let Some(profile) = &self.profile else {
+            return Ok(None);
+        };
+        let mut p = profile.lock().expect("profile lock");
+        let labels = std::mem::take(&mut p.labels);
+        if std::mem::take(&mut p.overflow) {
+            return Ok(None);
+        }
+        if labels.is_empty() {
+            return Ok(Some(Vec::new()));
+        }
+        let n = 2 * labels.len() as u32;
+        let resolved = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size: n as u64 * 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.resolve_query_set(&p.queries, 0..n, &resolved, 0);
+        self.queue.submit([enc.finish()]);
+        drop(p);
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&self.read(&resolved)?);
+        // Host-side conversion of tick counts (floats are fine here, DESIGN §6 rule 5).
+        let period_ns = self.queue.get_timestamp_period() as f64;
+        Ok(Some(
+            labels
+                .into_iter()
+                .zip(ticks.chunks_exact(2))
+                .map(|((stage, level), t)| StageTime {
+                    stage,
+                    level,
+                    time: Duration::from_nanos(
+                        (t[1].saturating_sub(t[0]) as f64 * period_ns) as u64,
+                    ),
+                })
+                .collect(),
+        ))
     }
 
     fn wait(&self) -> Result<(), BackendError> {
@@ -361,6 +484,7 @@ impl Backend for Gpu {
         // coarsest level's so that the binding is valid.
         let columns = &self.levels[level.min(self.levels.len() - 1)].columns;
         self.ctx.dispatch(
+            Some((Stage::UpsampleJitter, level)),
             &self.ctx.upsample_jitter,
             bytemuck::bytes_of(&u),
             &[&parent.s, &parent.v, &child.s, &child.v, columns],
@@ -379,6 +503,7 @@ impl Backend for Gpu {
         // Pixels of the parity class per axis: ⌈(n − parity) / 2⌉.
         let class = |n: usize, parity: u32| (n - parity as usize).div_ceil(2);
         self.ctx.dispatch(
+            Some((Stage::Correct, level)),
             &self.ctx.correct,
             bytemuck::bytes_of(&u),
             &[&st.s, &st.v, &l.columns, &l.appearance, &l.similar],
@@ -399,6 +524,7 @@ impl Backend for Gpu {
             .ctx
             .storage_empty("heights out", (st.width * st.height * 4) as u64)?;
         self.ctx.dispatch(
+            Some((Stage::Reconstruct, 0)),
             &self.ctx.reconstruct,
             bytemuck::bytes_of(&u),
             &[&st.s, &st.v, &self.levels[0].columns, &self.heights, &out],
@@ -415,5 +541,13 @@ impl Backend for Gpu {
 
     fn finish(&self) -> Result<(), BackendError> {
         self.ctx.wait()
+    }
+
+    fn has_device_clock(&self) -> bool {
+        self.ctx.profile.is_some()
+    }
+
+    fn device_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {
+        self.ctx.stage_times()
     }
 }

@@ -32,7 +32,8 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     /// Where the stages run: cpu, gpu (`--features gpu` builds) or auto.
-    /// GPU stage times are wall clock until the device is idle.
+    /// GPU stage times come from timestamp queries where the adapter has
+    /// them, else wall clock until the device is idle.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     backend: BackendArg,
 }
@@ -42,6 +43,8 @@ pub struct Args {
 struct SizeReport {
     size: String,
     backend: &'static str,
+    /// "gpu timestamps" or "wall clock".
+    clock: &'static str,
     runs: u32,
     threads: usize,
     total_ms: f64,
@@ -118,6 +121,11 @@ pub fn run(a: Args) -> CliResult {
         let report = SizeReport {
             size: format!("{w}x{h}"),
             backend: synth.backend_name(),
+            clock: if timings[0].device_clock {
+                "gpu timestamps"
+            } else {
+                "wall clock"
+            },
             runs: a.runs,
             threads: rayon::current_num_threads(),
             total_ms: med(&|t| t.total),
@@ -141,6 +149,7 @@ fn print_table(r: &SizeReport) {
         "{} on {}: {:.1} ms median of {} runs on {} threads, {:.1} bytes/pixel",
         r.size, r.backend, r.total_ms, r.runs, r.threads, r.bytes_per_pixel
     );
+    println!("  stage times: {}", r.clock);
     for (name, t) in &r.stages {
         println!("  {name:<16} {t:>8.1} ms");
     }
