@@ -1,4 +1,5 @@
-//! `--backend` on the CLI: `cpu`, `gpu` and `auto` write the same bytes;
+//! `--backend` on the CLI: `cpu`, `gpu` and `auto` write the same bytes
+//! (heightfield and preview, which the GPU also shades);
 //! `auto` without a GPU says so in one line and uses the CPU; `gpu` where
 //! there is none fails cleanly (no panic, no output file).
 
@@ -14,8 +15,11 @@ fn terrasynth(args: &[&str]) -> Output {
         .unwrap()
 }
 
+/// Runs `synth` with a preview; returns the heightfield and preview bytes
+/// (when written), concatenated.
 fn synth(dir: &Path, backend: &str) -> (Output, Option<Vec<u8>>) {
     let path = dir.join(format!("{backend}.png"));
+    let preview = dir.join(format!("{backend}-preview.png"));
     let out = terrasynth(&[
         "synth",
         "--size",
@@ -26,8 +30,13 @@ fn synth(dir: &Path, backend: &str) -> (Output, Option<Vec<u8>>) {
         backend,
         "-o",
         path.to_str().unwrap(),
+        "--preview",
+        preview.to_str().unwrap(),
     ]);
-    (out, std::fs::read(&path).ok())
+    let bytes = std::fs::read(&path)
+        .ok()
+        .map(|b| [b, std::fs::read(&preview).unwrap()].concat());
+    (out, bytes)
 }
 
 fn notes(out: &Output) -> Vec<String> {

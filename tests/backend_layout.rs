@@ -8,16 +8,60 @@ use terrasynth::render::shade::ShadeParams;
 use terrasynth::synth::atlas::Column;
 
 fn module(k: kernels::Kernel) -> naga::Module {
+    module_info(k).0
+}
+
+fn module_info(k: kernels::Kernel) -> (naga::Module, naga::valid::ModuleInfo) {
     let src = k.module_source();
     let m = naga::front::wgsl::parse_str(&src)
         .unwrap_or_else(|e| panic!("{}.wgsl: {}", k.name, e.emit_to_string(&src)));
-    naga::valid::Validator::new(
+    let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::empty(),
     )
     .validate(&m)
     .unwrap_or_else(|e| panic!("{}.wgsl does not validate: {e:?}", k.name));
-    m
+    (m, info)
+}
+
+/// DESIGN §6: kernels compute in integers only (GPU float arithmetic is not
+/// reproducible). Every expression's resolved type, every declared type and
+/// every local variable is checked for a floating-point scalar.
+#[test]
+fn kernels_use_no_floating_point() {
+    let is_float = |t: &naga::TypeInner| {
+        matches!(
+            t.scalar_kind(),
+            Some(naga::ScalarKind::Float | naga::ScalarKind::AbstractFloat)
+        )
+    };
+    for k in kernels::ALL {
+        let (m, info) = module_info(k);
+        for (_, t) in m.types.iter() {
+            assert!(!is_float(&t.inner), "{}: float type {:?}", k.name, t.name);
+        }
+        let functions = m.functions.iter().map(|(h, f)| (f, &info[h])).chain(
+            m.entry_points
+                .iter()
+                .enumerate()
+                .map(|(i, e)| (&e.function, info.get_entry_point(i))),
+        );
+        let mut checked = 0;
+        for (f, fi) in functions {
+            for (h, e) in f.expressions.iter() {
+                let ty = fi[h].ty.inner_with(&m.types);
+                assert!(
+                    !is_float(ty),
+                    "{}: {:?} in {:?} has a float type",
+                    k.name,
+                    e,
+                    f.name
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 50, "{}: only {checked} expressions seen", k.name);
+    }
 }
 
 /// (size, [(member, offset)]) of the WGSL struct `name`.

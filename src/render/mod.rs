@@ -194,13 +194,18 @@ pub fn render(hf: &Heightfield, opts: &RenderOptions) -> Result<Preview, RenderE
     let prep = prepare(hf, opts)?;
     let mut pixels = vec![0u32; prep.heights.len()];
     shade::shade(&prep.params, &prep.buffers(), &mut pixels)?;
-    let bytes: Vec<u8> = pixels.iter().flat_map(|p| p.to_le_bytes()).collect();
-    let image = RgbaImage::from_raw(prep.info.width as u32, prep.info.height as u32, bytes)
-        .expect("buffer holds width × height pixels");
-    Ok(Preview {
-        image,
-        info: prep.info,
-    })
+    Ok(Preview::from_pixels(prep.info, &pixels))
+}
+
+impl Preview {
+    /// The preview from the `shade` stage's packed RGBA pixels (of
+    /// `info.width × info.height`), whichever backend shaded them.
+    pub fn from_pixels(info: RenderInfo, pixels: &[u32]) -> Preview {
+        let bytes: Vec<u8> = pixels.iter().flat_map(|p| p.to_le_bytes()).collect();
+        let image = RgbaImage::from_raw(info.width as u32, info.height as u32, bytes)
+            .expect("buffer holds width × height pixels");
+        Preview { image, info }
+    }
 }
 
 /// Encodes an image as PNG (deterministic bytes). Fast compression: on a

@@ -202,6 +202,13 @@ impl<'db> Synthesizer<'db> {
         Ok(())
     }
 
+    /// The GPU the stages run on, if they do (e.g. to shade a preview
+    /// there too).
+    #[cfg(feature = "gpu")]
+    pub fn gpu_context(&self) -> Option<&std::sync::Arc<crate::backend::gpu::Context>> {
+        self.gpu.as_ref().map(|g| g.context())
+    }
+
     /// Where the stages run: `"cpu"` or `"gpu"`.
     pub fn backend_name(&self) -> &'static str {
         #[cfg(feature = "gpu")]

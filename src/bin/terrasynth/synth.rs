@@ -66,7 +66,7 @@ pub fn run(a: Args) -> CliResult {
         result.timings.total.as_secs_f64() * 1e3
     );
     if let Some(p) = &a.preview {
-        let preview = render::render(&result.heightfield, &RenderOptions::default())?;
+        let preview = preview(&synth, &result.heightfield)?;
         render::write_png(p, &preview.image)?;
         eprintln!("wrote {}", p.display());
     }
@@ -103,4 +103,19 @@ pub fn run(a: Args) -> CliResult {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The preview, shaded where the synthesis ran (same bytes either way).
+#[cfg_attr(not(feature = "gpu"), allow(unused_variables))]
+fn preview(
+    synth: &Synthesizer<'_>,
+    hf: &terrasynth::Heightfield,
+) -> Result<render::Preview, Box<dyn std::error::Error + Send + Sync>> {
+    #[cfg(feature = "gpu")]
+    if let Some(ctx) = synth.gpu_context() {
+        let prep = render::prepare(hf, &RenderOptions::default())?;
+        let pixels = ctx.shade(&prep.params, &prep.buffers())?;
+        return Ok(render::Preview::from_pixels(prep.info, &pixels));
+    }
+    Ok(render::render(hf, &RenderOptions::default())?)
 }
