@@ -43,6 +43,12 @@ pub struct StageTime {
 /// Stage calls may be queued (a GPU runs them asynchronously, in order);
 /// [`Backend::finish`] waits for them, and every call that returns host
 /// data waits implicitly.
+///
+/// Database data is bound at construction and addressed by level index, so
+/// per-level inputs of later stages (the user-control rasters of
+/// `synth::control`: targets, allowed types, coherence weights) fit the
+/// same way: uploaded once per level as a backend-side associated type,
+/// passed to [`Backend::correct`] next to the state.
 pub trait Backend {
     /// One level's coordinates S and offsets V, where this backend keeps them.
     type State;
