@@ -391,6 +391,10 @@ impl<'db> Synthesizer<'db> {
     /// of the start exemplar (the fully jittered coarse level of Lefebvre &
     /// Hoppe 2005), so level L begins as a mosaic of small exemplar blocks
     /// that its correction passes assemble into exemplar-like patches.
+    ///
+    /// Computed on the host for every backend and uploaded — it is tiny
+    /// (⌈W/2^(L+b)⌉ × ⌈H/2^(L+b)⌉ pixels: 16 × 16 for 4096² with L = 6; 2 × 2
+    /// without jitter) — so it has no kernel mirror.
     fn initial(&self, width: usize, height: usize, top: usize, seed: u32) -> State {
         let l = self.coarsest();
         let at = top.min(l);

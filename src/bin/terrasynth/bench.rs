@@ -43,6 +43,9 @@ pub struct Args {
 struct SizeReport {
     size: String,
     backend: &'static str,
+    /// The GPU adapter, when the stages ran on one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    adapter: Option<String>,
     /// "gpu timestamps" or "wall clock".
     clock: &'static str,
     runs: u32,
@@ -121,6 +124,7 @@ pub fn run(a: Args) -> CliResult {
         let report = SizeReport {
             size: format!("{w}x{h}"),
             backend: synth.backend_name(),
+            adapter: adapter(&synth),
             clock: if timings[0].device_clock {
                 "gpu timestamps"
             } else {
@@ -144,11 +148,24 @@ pub fn run(a: Args) -> CliResult {
     Ok(())
 }
 
+/// The adapter's name, when the synthesizer runs on a GPU.
+#[cfg_attr(not(feature = "gpu"), allow(unused_variables))]
+fn adapter(synth: &Synthesizer<'_>) -> Option<String> {
+    #[cfg(feature = "gpu")]
+    if let Some(ctx) = synth.gpu_context() {
+        return Some(ctx.adapter_name());
+    }
+    None
+}
+
 fn print_table(r: &SizeReport) {
     println!(
         "{} on {}: {:.1} ms median of {} runs on {} threads, {:.1} bytes/pixel",
         r.size, r.backend, r.total_ms, r.runs, r.threads, r.bytes_per_pixel
     );
+    if let Some(a) = &r.adapter {
+        println!("  adapter: {a}");
+    }
     println!("  stage times: {}", r.clock);
     for (name, t) in &r.stages {
         println!("  {name:<16} {t:>8.1} ms");
