@@ -15,6 +15,7 @@ pub mod session;
 pub mod stages;
 pub mod state;
 
+use crate::backend::{Backend, BackendError, Choice, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
@@ -72,6 +73,8 @@ pub enum SynthError {
     StartExemplar { index: usize, count: usize },
     #[error(transparent)]
     Size(#[from] crate::error::SizeError),
+    #[error(transparent)]
+    Backend(#[from] BackendError),
 }
 
 /// One level's final state, kept when [`Params::keep_levels`] is set.
@@ -226,12 +229,15 @@ fn keep_outside(st: &State, r: &PassResult, [x0, y0, x1, y1]: [usize; 4], p: Cor
         });
 }
 
-/// Synthesizes terrain from one database.
+/// Synthesizes terrain from one database, on the CPU unless
+/// [`Synthesizer::use_backend`] moved it to the GPU.
 pub struct Synthesizer<'db> {
     db: &'db Database,
     params: Params,
     atlas: Vec<AtlasLevel<'db>>,
     jitter: i32,
+    #[cfg(feature = "gpu")]
+    gpu: Option<crate::backend::gpu::Gpu>,
 }
 
 impl<'db> Synthesizer<'db> {
@@ -258,7 +264,73 @@ impl<'db> Synthesizer<'db> {
             params,
             atlas,
             jitter,
+            #[cfg(feature = "gpu")]
+            gpu: None,
         })
+    }
+
+    /// Moves the stages to the backend `choice` names. Returns a one-line
+    /// notice when [`Choice::Auto`] found no GPU and stays on the CPU.
+    pub fn use_backend(&mut self, choice: Choice) -> Result<Option<String>, SynthError> {
+        #[cfg(feature = "gpu")]
+        {
+            let ctx = match choice {
+                Choice::Cpu => {
+                    self.gpu = None;
+                    return Ok(None);
+                }
+                Choice::Gpu => crate::backend::gpu::Context::new()?,
+                Choice::Auto => match crate::backend::gpu::Context::new() {
+                    Ok(ctx) => ctx,
+                    Err(e) => {
+                        self.gpu = None;
+                        return Ok(Some(format!("{e}; using the CPU")));
+                    }
+                },
+            };
+            self.use_gpu(ctx)?;
+            Ok(None)
+        }
+        #[cfg(not(feature = "gpu"))]
+        match choice {
+            Choice::Cpu => Ok(None),
+            Choice::Gpu => Err(BackendError::NotCompiled.into()),
+            Choice::Auto => Ok(Some(format!(
+                "{}; using the CPU",
+                BackendError::NotCompiled
+            ))),
+        }
+    }
+
+    /// Runs the stages on the GPU of `ctx` (uploads the database once).
+    #[cfg(feature = "gpu")]
+    pub fn use_gpu(
+        &mut self,
+        ctx: std::sync::Arc<crate::backend::gpu::Context>,
+    ) -> Result<(), SynthError> {
+        self.gpu = Some(crate::backend::gpu::Gpu::new(
+            ctx,
+            &self.atlas,
+            self.db.heights(),
+        )?);
+        Ok(())
+    }
+
+    /// Where the stages run: `"cpu"` or `"gpu"`.
+    pub fn backend_name(&self) -> &'static str {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return g.name();
+        }
+        self.cpu().name()
+    }
+
+    /// The CPU backend over this synthesizer's database.
+    fn cpu(&self) -> Cpu<'_, 'db> {
+        Cpu {
+            atlas: &self.atlas,
+            heights: self.db.heights(),
+        }
     }
 
     pub fn params(&self) -> &Params {
@@ -280,14 +352,96 @@ impl<'db> Synthesizer<'db> {
         Ok(self.run(width, height, seed)?.heightfield)
     }
 
-    /// Synthesizes and returns timings (and levels, if kept).
+    /// Synthesizes and returns timings (and levels, if kept), on the
+    /// backend chosen by [`Synthesizer::use_backend`].
     pub fn run(&self, width: usize, height: usize, seed: u32) -> Result<Synthesis, SynthError> {
-        Ok(self
-            .run_with(width, height, seed, &Guides::default(), None, false)?
-            .0)
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return self.run_on(g, width, height, seed);
+        }
+        self.run_on(&self.cpu(), width, height, seed)
     }
 
-    /// Synthesis under control inputs (paper §5). `prev` is the previous
+    /// The synthesis loop on any backend: the same stage calls in the same
+    /// order, so every backend yields the same bytes. Stage timings are wall
+    /// clock up to [`Backend::finish`], i.e. including the device's work.
+    pub fn run_on<B: Backend>(
+        &self,
+        b: &B,
+        width: usize,
+        height: usize,
+        seed: u32,
+    ) -> Result<Synthesis, SynthError> {
+        crate::heightfield::check_dims(width, height)?;
+        let t0 = Instant::now();
+        let m = top_level(width, height);
+        let l = self.coarsest();
+        let mut timings = Timings {
+            levels: vec![LevelTiming::default(); m + 1],
+            ..Default::default()
+        };
+        let mut kept = Vec::new();
+        // With jitter, levels above `top` would only be a spread-out copy of
+        // the start exemplar; they are skipped (see `initial`).
+        let top = if self.jitter > 0 {
+            m.min(l + COARSE_BLOCK_BITS)
+        } else {
+            m
+        };
+        let mut state = b.upload(self.initial(width, height, top, seed))?;
+        for level in (0..=top).rev() {
+            let (w, h) = level_size(width, height, level);
+            if level < top {
+                let t = Instant::now();
+                let child = b.alloc(w, h)?;
+                let params = UpsampleParams {
+                    seed,
+                    level: level as u32,
+                    jitter: self.jitter,
+                    step: self.step(level, l),
+                };
+                b.upsample_jitter(&state, &child, level, &params);
+                b.finish()?;
+                state = child;
+                timings.levels[level].upsample = t.elapsed();
+            }
+            if level <= l {
+                let t = Instant::now();
+                for _pass in 0..self.params.passes {
+                    for &(px, py) in &SUBPASSES {
+                        b.correct(&state, level, &CorrectParams { px, py });
+                    }
+                }
+                b.finish()?;
+                timings.levels[level].correct = t.elapsed();
+            }
+            if self.params.keep_levels {
+                let (coords, offsets) = b.download(&state)?;
+                kept.push(LevelMaps {
+                    level,
+                    width: w,
+                    height: h,
+                    coords,
+                    offsets,
+                });
+            }
+        }
+        kept.reverse();
+        let t = Instant::now();
+        let fixed = b.reconstruct(&state)?;
+        let stride = level_size(width, height, 0).0;
+        let heightfield = self.to_metres(&fixed, stride, width, height)?;
+        timings.reconstruct = t.elapsed();
+        timings.total = t0.elapsed();
+        Ok(Synthesis {
+            heightfield,
+            levels: kept,
+            timings,
+        })
+    }
+
+    /// Synthesis under control inputs (paper §5), on the CPU (the GPU
+    /// backend runs unconstrained synthesis only, so far). `prev` is the previous
     /// frame's per-pass results (the coherence candidates, and what pixels
     /// outside a level's window keep); with `record`, this frame's are
     /// returned for the next one.
