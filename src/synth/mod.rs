@@ -123,8 +123,8 @@ pub struct Guides {
     /// one: at each level, the window around the pixels whose inputs
     /// changed and the children of the parent level's changed pixels,
     /// widened by how far 4·passes subpasses carry a change. Outside it
-    /// every pixel's inputs equal the previous frame's (weights can only
-    /// have decreased there, which keeps the previous winner), so its
+    /// every pixel's inputs equal the previous frame's (a weight may only
+    /// have dropped to frozen, which keeps the previous result), so its
     /// previous per-pass results are what it would compute: restricted and
     /// full re-synthesis give the same bytes (tested).
     pub restrict: bool,

@@ -27,7 +27,7 @@ use thiserror::Error;
 /// Weights in quarters (paper §5.3).
 pub const W_FROZEN: u8 = 0;
 pub const W_COHERENT: u8 = 1;
-pub const W_FREE: u8 = 4;
+pub use super::stages::correct::W_FREE;
 
 /// Pixels around a paste left unweighted in its step, so it blends in.
 pub const PASTE_MARGIN: f64 = 8.0;
@@ -153,6 +153,16 @@ impl<'db> Session<'db> {
 
     pub fn controls(&self) -> &Controls {
         &self.controls
+    }
+
+    /// The last frame's per-level, per-pass results (for inspection).
+    pub fn frames(&self) -> Option<&Frames> {
+        self.frames.as_ref()
+    }
+
+    /// The synthesizer (database, parameters, cell size).
+    pub fn synthesizer(&self) -> &Synthesizer<'db> {
+        &self.synth
     }
 
     /// The last frame's heights.
@@ -351,8 +361,9 @@ impl<'db> Session<'db> {
                 dirty: None,
             });
         }
-        // Dirty: inputs that differ from the previous frame's, or raised
-        // weights (a lowered weight keeps the previous winner).
+        // Dirty: inputs that differ from the previous frame's, or changed
+        // weights (a weight that changes switches how the previous result
+        // competes; only freezing is safe, as it keeps the previous result).
         let prev = self.guides.as_ref();
         for (i, g) in levels.iter_mut().enumerate() {
             let (w, h) = level_size(self.width, self.height, i);
@@ -368,7 +379,11 @@ impl<'db> Session<'db> {
                     let wt = |g: &LevelGuide| g.weights.as_ref().map_or(W_FREE, |w| w[k]);
                     let same_t = t(g).unwrap_or(super::control::Target::NONE)
                         == t(p).unwrap_or(super::control::Target::NONE);
-                    if !same_t || a(g) != a(p) || wt(g) > wt(p) || self.fresh_paste(i, k) {
+                    if !same_t
+                        || a(g) != a(p)
+                        || (wt(g) != wt(p) && wt(g) != W_FROZEN)
+                        || self.fresh_paste(i, k)
+                    {
                         let px = [x, y, x + 1, y + 1];
                         b = Some(b.map_or(px, |b| {
                             [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)]

@@ -120,6 +120,9 @@ pub struct Coherence<'a> {
     pub weights: &'a [u8],
 }
 
+/// W = 1 (unweighted) in quarters.
+pub const W_FREE: u8 = 4;
+
 /// Coherence cost `⌊score · w / 4⌋` without leaving 32 bits (w ≤ 4).
 #[inline(always)]
 pub fn weigh(score: u32, w: u8) -> u32 {

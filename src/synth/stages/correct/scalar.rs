@@ -5,7 +5,7 @@
 
 use super::{
     ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, SEED_SALT, SEEDS_PER_ALLOWED_TYPE,
-    weigh,
+    W_FREE, weigh,
 };
 use crate::database::appearance::{MODE1_BIAS, unpack_texel};
 use crate::database::types::SEEDS_PER_TYPE;
@@ -47,8 +47,8 @@ fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u3
     score_with(atlas, ns, qx, qy, kappa, None)
 }
 
-/// Score (×κ) of candidate texel (qx, qy) with offset `fixed`, or with its
-/// optimal offset (returned) when `fixed` is None.
+/// [`score`] with the offset fixed to `fixed` when given (a coherent
+/// previous result keeps its own offset).
 #[inline(always)]
 fn score_with(
     atlas: &AtlasLevel<'_>,
@@ -135,19 +135,27 @@ pub fn correct_pixel(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> (Coo
 }
 
 /// The best candidate so far: cost, coordinate, offset, and its texel
-/// (None for the coherence candidate, which is taken as is).
+/// (None for a frozen previous result, which is taken as is).
 type Best = (u32, Coord, i32, Option<(i32, i32)>);
 
 /// Corrects one pixel under control inputs (paper §5):
-/// 1. the coherence candidate (previous result with its own offset), first
-///    so that a tie keeps the previous result, cost × W/4;
+/// 1. the coherence candidate, first so that a tie keeps it, cost × W/4:
+///    where unweighted (W = 1) the previous coordinate, scored like C₁ with
+///    its optimal offset; where coherent (0 < W < 1) the previous S and V
+///    as they are, scored with that offset; where frozen (W = 0) the
+///    previous S and V at cost 0;
 /// 2. the k-coherence candidates, those of a type outside R^i(p) rejected;
 /// 3. if a type constraint rejected them all, 9 hash-chosen seeds per
 ///    allowed type, scored like C₁;
-/// 4. a winner other than the coherence candidate gets its offset nudged
-///    by φ_d towards the blended target (eq. 8–9). The coherence candidate
-///    is the previous result as is, nudge included, so an unchanged frame
-///    repeats bit for bit instead of drifting.
+/// 4. the winner's offset nudged by φ_d towards the blended target
+///    (eq. 8–9), unless it is a previous result taken as is.
+///
+/// Why two forms of the previous result: inside an edit's influence a kept
+/// coordinate must still follow the new target (so its offset is re-fitted
+/// and nudged), while elsewhere keeping the previous *height* is what stops
+/// an edit's offsets from diffusing outwards level after level. Both forms
+/// make the result a function of the neighbourhood, the candidates and the
+/// target, so an unchanged frame repeats bit for bit.
 #[inline(always)]
 pub fn correct_pixel_guided(
     atlas: &AtlasLevel<'_>,
@@ -177,8 +185,19 @@ pub fn correct_pixel_guided(
             || c.weights[i] == 0
             || allowed >> atlas.level.types[atlas.index(q.0, q.1)] & 1 == 1;
         if ok {
-            let (sc, _) = score_with(atlas, &ns, q.0, q.1, 1, Some(v));
-            best = (weigh(sc, c.weights[i]), s, v, None);
+            let w = c.weights[i];
+            best = if w == 0 {
+                // Frozen: the previous result as is (offset and all).
+                (0, s, v, None)
+            } else if w >= W_FREE {
+                // Unweighted: the coordinate, re-fitted and nudged.
+                let (sc, hh) = score(atlas, &ns, q.0, q.1, 1);
+                (weigh(sc, w), s, hh, Some(q))
+            } else {
+                // Coherent: the previous result as is, at a discount.
+                let (sc, _) = score_with(atlas, &ns, q.0, q.1, 1, Some(v));
+                (weigh(sc, w), s, v, None)
+            };
         }
     }
     // Scores the k-coherence candidates admitted by `filter`; whether any was.

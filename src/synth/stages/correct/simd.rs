@@ -21,7 +21,7 @@
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 
-use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, scalar, weigh};
+use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, W_FREE, scalar, weigh};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::control::blend::nudge;
 use crate::synth::fixed::{Coord, FRAC_BITS, div_floor, round};
@@ -78,8 +78,8 @@ fn score(app: &[u64], ns: &Neighbourhood, q: i32, s: i32, kappa: u32) -> (u32, i
     score_with(app, ns, q, s, kappa, None)
 }
 
-/// [`score`] with the offset fixed to `fixed` when given (the coherence
-/// candidate keeps its own offset).
+/// [`score`] with the offset fixed to `fixed` when given (a coherent
+/// previous result keeps its own offset).
 #[inline(always)]
 fn score_with(
     app: &[u64],
@@ -300,18 +300,41 @@ fn decide(
     // the rest in DELTAS order, C₁ before C₂ (ties keep the earlier).
     if let Some(c) = &g.coherence {
         let (prev, v) = (c.coords[pixel], c.offsets[pixel]);
-        let col = &atlas.columns[round(prev.x) as usize];
-        let idx = col.base + round(prev.y) * col.stride as i32 + round(prev.x);
-        let (sc, _) = score_with(app, ns, idx, col.stride as i32, 1, Some(v));
-        let cost = weigh(sc, c.weights[pixel]);
-        let (best, i, hh) = best_of(app, ns, p, cost);
-        if i == usize::MAX {
+        let w = c.weights[pixel];
+        if w == 0 {
+            // Frozen: cost 0 cannot be beaten (ties keep the first).
             return (prev, v);
         }
-        return finish(atlas, st, pixel, p, (best, i, hh), g);
+        let col = &atlas.columns[round(prev.x) as usize];
+        let idx = col.base + round(prev.y) * col.stride as i32 + round(prev.x);
+        // Unweighted: the coordinate, re-fitted and nudged like any other;
+        // coherent: the previous result as is.
+        let free = w >= W_FREE;
+        let (sc, h_prev) = score_with(app, ns, idx, col.stride as i32, 1, (!free).then_some(v));
+        let (cost, i, hh) = best_of(app, ns, p, weigh(sc, w));
+        if i == usize::MAX {
+            return match free {
+                true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
+                false => (prev, v),
+            };
+        }
+        return finish(atlas, st, pixel, p, (cost, i, hh), g);
     }
     let winner = best_of(app, ns, p, u32::MAX);
     finish(atlas, st, pixel, p, winner, g)
+}
+
+/// The winner's offset `v`, nudged towards the pixel's geometric target
+/// if any (`idx`: the winner's texel).
+#[inline(always)]
+fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>) -> i32 {
+    match g.targets {
+        Some(t) => {
+            let h_c = scalar::texel_height(atlas.level.appearance[idx as usize]) + v;
+            nudge(v, h_c, t[pixel])
+        }
+        None => v,
+    }
 }
 
 /// The best gathered candidate whose cost is below `bar`:
@@ -348,12 +371,7 @@ fn finish(
         x: (q.x << FRAC_BITS) + frac(n.x),
         y: (q.y << FRAC_BITS) + frac(n.y),
     };
-    let mut v = best.2;
-    if let Some(t) = g.targets {
-        let h_c = scalar::texel_height(atlas.level.appearance[q.idx as usize]) + v;
-        v = nudge(v, h_c, t[pixel]);
-    }
-    (s, v)
+    (s, nudged(atlas, q.idx, best.2, pixel, g))
 }
 
 /// One candidate of the pixel being corrected.
