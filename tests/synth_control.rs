@@ -362,3 +362,32 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
         far * 100.0
     );
 }
+
+#[test]
+fn sessions_are_identical_on_one_and_two_threads() {
+    let Some(db) = db() else { return };
+    let cell = db.meta().exemplars[0].cell_size_m;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut s = session(db);
+            s.apply(vec![]).unwrap();
+            let p = PointConstraint::new((100.0, 120.0), 2000.0, 0.7, 0.3, 40.0, cell).unwrap();
+            let f = s
+                .apply(vec![Edit::SetConstraint(ConstraintId(9), Arc::new(p))])
+                .unwrap();
+            (f.heightfield, s.frames().unwrap().clone())
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    assert!(
+        a.0.data()
+            .iter()
+            .zip(b.0.data())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    );
+    assert!(a.1 == b.1);
+}
