@@ -28,6 +28,8 @@ pub struct Column {
 pub struct AtlasLevel<'a> {
     pub level: Level<'a>,
     pub columns: Vec<Column>,
+    /// Seed slots filled per type (type seeding draws from these).
+    pub seed_counts: Vec<u32>,
 }
 
 impl<'a> AtlasLevel<'a> {
@@ -45,7 +47,11 @@ impl<'a> AtlasLevel<'a> {
                 };
             }
         }
-        AtlasLevel { level, columns }
+        AtlasLevel {
+            level,
+            columns,
+            seed_counts: db.meta().levels[i].seed_counts.clone(),
+        }
     }
 
     /// Texel index of (x, y); the caller guarantees it lies in an exemplar.

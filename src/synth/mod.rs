@@ -11,6 +11,7 @@
 pub mod atlas;
 pub mod control;
 pub mod fixed;
+pub mod session;
 pub mod stages;
 pub mod state;
 
@@ -18,10 +19,11 @@ use crate::backend::{Backend, BackendError, Choice, Stage, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
+use control::Target;
 use fixed::{Coord, FRAC_BITS};
-use stages::correct::{CorrectParams, SUBPASSES};
-use stages::reconstruct::HEIGHT_FRAC_BITS;
-use stages::upsample_jitter::{Step, UpsampleParams};
+use stages::correct::{self, Coherence, CorrectParams, Guide, SUBPASSES};
+use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
+use stages::upsample_jitter::{self, Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -113,6 +115,121 @@ pub struct Synthesis {
     /// Levels M..0 when kept (index = level).
     pub levels: Vec<LevelMaps>,
     pub timings: Timings,
+}
+
+/// Control inputs of one synthesis, per level (index = level; levels the
+/// correction never visits are ignored).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Guides {
+    pub levels: Vec<LevelGuide>,
+    /// Re-synthesize only where this frame can differ from the previous
+    /// one: at each level, the window around the pixels whose inputs
+    /// changed and the children of the parent level's changed pixels,
+    /// widened by how far 4·passes subpasses carry a change. Outside it
+    /// every pixel's inputs equal the previous frame's (a weight may only
+    /// have dropped to frozen, which keeps the previous result), so its
+    /// previous per-pass results are what it would compute: restricted and
+    /// full re-synthesis give the same bytes (tested).
+    pub restrict: bool,
+}
+
+/// One level's control rasters (level-sized, row-major).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LevelGuide {
+    /// Geometric targets (levels ≥ 2).
+    pub targets: Option<Vec<Target>>,
+    /// Type target sets R^i (levels ≥ 2).
+    pub allowed: Option<Vec<u32>>,
+    /// Coherence weights W^i in quarters (used when a previous frame exists).
+    pub weights: Option<Vec<u8>>,
+    /// Bounds `[x0, y0, x1, y1)` of the pixels whose own inputs (targets,
+    /// type sets, raised weights, pasted candidates) differ from the
+    /// previous frame's; None if none do. Used when [`Guides::restrict`].
+    pub dirty: Option<[usize; 4]>,
+}
+
+/// Subpass reads reach two pixels (DESIGN §5), so within one level a change
+/// spreads at most this far per subpass.
+const REACH_PER_SUBPASS: usize = 2;
+
+/// Every corrected level's state after every pass (index = level, then
+/// pass): the previous frame a coherent re-synthesis reads. A pass writes
+/// each pixel once, in its parity class's subpass, so the state after the
+/// pass holds every subpass's result (paper §5.3: "the results for all
+/// sub-passes are needed").
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Frames {
+    pub levels: Vec<Vec<PassResult>>,
+}
+
+/// One level's S and V after one pass.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PassResult {
+    pub coords: Vec<Coord>,
+    pub offsets: Vec<i32>,
+}
+
+/// The union of two optional bounds.
+fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
+    }
+}
+
+/// The children of a parent level's bounds.
+fn double(b: [usize; 4]) -> [usize; 4] {
+    b.map(|v| 2 * v)
+}
+
+/// Bounds grown by `by` on every side, clipped to `w × h`.
+fn widen(b: [usize; 4], by: usize, w: usize, h: usize) -> [usize; 4] {
+    [
+        b[0].saturating_sub(by),
+        b[1].saturating_sub(by),
+        (b[2] + by).min(w),
+        (b[3] + by).min(h),
+    ]
+}
+
+/// Bounds of the pixels whose S or V differ from `r`; None if none do.
+fn changed_bounds(st: &State, r: &PassResult) -> Option<[usize; 4]> {
+    let w = st.width;
+    let mut b: Option<[usize; 4]> = None;
+    for y in 0..st.height {
+        for x in 0..w {
+            let i = y * w + x;
+            if st.s(i) != r.coords[i] || st.v(i) != r.offsets[i] {
+                b = union(b, Some([x, y, x + 1, y + 1]));
+            }
+        }
+    }
+    b
+}
+
+/// After a windowed subpass: the subpass's pixels outside the window take
+/// the previous frame's result of this pass (what they would compute).
+fn keep_outside(st: &State, r: &PassResult, [x0, y0, x1, y1]: [usize; 4], p: CorrectParams) {
+    use rayon::prelude::*;
+    let w = st.width;
+    (p.py as usize..st.height)
+        .into_par_iter()
+        .step_by(2)
+        .for_each(|y| {
+            let inside_row = (y0..y1).contains(&y);
+            for x in (p.px as usize..w).step_by(2) {
+                if !(inside_row && (x0..x1).contains(&x)) {
+                    let i = y * w + x;
+                    st.set(i, r.coords[i], r.offsets[i]);
+                }
+            }
+        });
 }
 
 /// Synthesizes terrain from one database, on the CPU unless
@@ -353,6 +470,145 @@ impl<'db> Synthesizer<'db> {
             levels: kept,
             timings,
         })
+    }
+
+    /// Synthesis under control inputs (paper §5), on the CPU (the GPU
+    /// backend runs unconstrained synthesis only, so far). `prev` is the previous
+    /// frame's per-pass results (the coherence candidates, and what pixels
+    /// outside a level's window keep); with `record`, this frame's are
+    /// returned for the next one.
+    pub fn run_with(
+        &self,
+        width: usize,
+        height: usize,
+        seed: u32,
+        guides: &Guides,
+        prev: Option<&Frames>,
+        record: bool,
+    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
+        crate::heightfield::check_dims(width, height)?;
+        let t0 = Instant::now();
+        let m = top_level(width, height);
+        let l = self.coarsest();
+        let mut timings = Timings {
+            levels: vec![LevelTiming::default(); m + 1],
+            ..Default::default()
+        };
+        let mut kept = Vec::new();
+        let mut frames = record.then(|| Frames {
+            levels: vec![Vec::new(); l.min(m) + 1],
+        });
+        // With jitter, levels above `top` would only be a spread-out copy of
+        // the start exemplar; they are skipped (see `initial`).
+        let top = if self.jitter > 0 {
+            m.min(l + COARSE_BLOCK_BITS)
+        } else {
+            m
+        };
+        let mut state = self.initial(width, height, top, seed);
+        // Bounds of the pixels of the level above that differ from the
+        // previous frame (restricted re-synthesis only).
+        let mut changed_parent: Option<[usize; 4]> = None;
+        for level in (0..=top).rev() {
+            if level < top {
+                let t = Instant::now();
+                let (w, h) = level_size(width, height, level);
+                let child = State::new(w, h);
+                let params = UpsampleParams {
+                    seed,
+                    level: level as u32,
+                    jitter: self.jitter,
+                    step: self.step(level, l),
+                };
+                let atlas = (level <= l && level < l).then(|| &self.atlas[level]);
+                upsample_jitter::upsample_jitter(&state, &child, atlas, &params);
+                state = child;
+                timings.levels[level].upsample = t.elapsed();
+            }
+            if level <= l {
+                let t = Instant::now();
+                let lg = guides.levels.get(level);
+                let before = prev.and_then(|f| f.levels.get(level));
+                let window = match (guides.restrict, before) {
+                    (true, Some(b)) if !b.is_empty() => {
+                        let seeds = union(lg.and_then(|g| g.dirty), changed_parent.map(double));
+                        let grow =
+                            REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
+                        Some(seeds.map_or([0; 4], |b| widen(b, grow, state.width, state.height)))
+                    }
+                    _ => None,
+                };
+                for pass in 0..self.params.passes as usize {
+                    let last = before.and_then(|b| b.get(pass));
+                    let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
+                        (Some(r), Some(weights)) => Some(Coherence {
+                            coords: &r.coords,
+                            offsets: &r.offsets,
+                            weights,
+                        }),
+                        _ => None,
+                    };
+                    let guide = Guide {
+                        level: level as u32,
+                        targets: lg.and_then(|g| g.targets.as_deref()),
+                        allowed: lg.and_then(|g| g.allowed.as_deref()),
+                        coherence,
+                        window,
+                    };
+                    for &(px, py) in &SUBPASSES {
+                        let p = CorrectParams { px, py };
+                        correct::correct_guided(&self.atlas[level], &state, &p, &guide);
+                        if let (Some(win), Some(r)) = (window, last) {
+                            keep_outside(&state, r, win, p);
+                        }
+                    }
+                    if let Some(f) = frames.as_mut() {
+                        f.levels[level].push(PassResult {
+                            coords: state.coords(),
+                            offsets: state.offsets(),
+                        });
+                    }
+                }
+                changed_parent = match (window, before.and_then(|b| b.last())) {
+                    (Some(_), Some(r)) => changed_bounds(&state, r),
+                    _ => Some([0, 0, state.width, state.height]),
+                };
+                timings.levels[level].correct = t.elapsed();
+            }
+            if self.params.keep_levels {
+                kept.push(LevelMaps {
+                    level,
+                    width: state.width,
+                    height: state.height,
+                    coords: state.coords(),
+                    offsets: state.offsets(),
+                });
+            }
+        }
+        kept.reverse();
+        let t = Instant::now();
+        let fixed = reconstruct::reconstruct(&self.atlas[0], self.db.heights(), &state);
+        let heightfield = self.to_metres(&fixed, state.width, width, height)?;
+        timings.reconstruct = t.elapsed();
+        timings.total = t0.elapsed();
+        Ok((
+            Synthesis {
+                heightfield,
+                levels: kept,
+                timings,
+            },
+            frames,
+        ))
+    }
+
+    /// The database this synthesizer draws from.
+    pub fn database(&self) -> &'db Database {
+        self.db
+    }
+
+    /// Output cell size, metres (the start exemplar's).
+    pub fn cell_size_m(&self) -> f64 {
+        self.db.meta().exemplars[self.params.start_exemplar].cell_size_m
     }
 
     /// How level `level` is made from the one above.

@@ -1,0 +1,393 @@
+//! User control on real DEMs (issue 5 "Done means"): point accuracy and
+//! slope, painted types, freezing, coherence locality, copy-paste, and
+//! exact restricted re-synthesis. A small database is built from two 256²
+//! crops of ../shared/dem (with their type masks); skipped when absent.
+
+use std::path::Path;
+use std::sync::{Arc, OnceLock};
+use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
+use terrasynth::heightfield::Heightfield;
+use terrasynth::progress::Silent;
+use terrasynth::synth::Params;
+use terrasynth::synth::control::{
+    Constraint, ConstraintId, Paste, PasteSource, PointConstraint, UNCONSTRAINED,
+};
+use terrasynth::synth::session::{Edit, Session};
+
+const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+const N: usize = 256;
+
+fn db() -> Option<&'static Database> {
+    static DB: OnceLock<Option<Database>> = OnceLock::new();
+    DB.get_or_init(|| {
+        let crop = |name: &str, x: usize, y: usize| -> Option<ExemplarInput> {
+            let dir = Path::new(DEM);
+            let hf =
+                terrasynth::io::read(&dir.join(format!("{name}.png")), &Default::default()).ok()?;
+            let mask = TypeMask::read(&dir.join(format!("{name}_types.png"))).ok()?;
+            let mut m = TypeMask::new(N, N, vec![0; N * N]).ok()?;
+            for r in 0..N {
+                m.indices[r * N..(r + 1) * N]
+                    .copy_from_slice(&mask.indices[(y + r) * mask.width + x..][..N]);
+            }
+            m.names = mask.names.clone();
+            Some(ExemplarInput {
+                name: name.into(),
+                heights: hf.crop(x, y, N, N).ok()?,
+                types: Some(m),
+            })
+        };
+        let inputs = vec![
+            crop("pyrenees_andorra", 300, 200)?,
+            crop("catalan_coast_hills", 300, 300)?,
+        ];
+        let opts = BuildOptions {
+            levels: 4,
+            ..Default::default()
+        };
+        Some(database::build(inputs, &opts, &Silent).unwrap().0)
+    })
+    .as_ref()
+    .or_else(|| {
+        eprintln!("{DEM} not found: control tests on real DEMs skipped");
+        None
+    })
+}
+
+/// Relief (max − min) of the start exemplar, metres.
+fn relief(db: &Database) -> f64 {
+    let e = &db.meta().exemplars[0];
+    e.max_m - e.min_m
+}
+
+fn session(db: &Database) -> Session<'_> {
+    Session::new(db, Params::default(), N, N, 7).unwrap()
+}
+
+fn at(hf: &Heightfield, x: f64, y: f64) -> f64 {
+    hf.get(x as usize, y as usize) as f64
+}
+
+/// Mean height in a (2r+1)² window around (x, y).
+fn mean_around(hf: &Heightfield, x: usize, y: usize, r: usize) -> f64 {
+    let mut s = 0.0;
+    for v in y - r..=y + r {
+        for u in x - r..=x + r {
+            s += hf.get(u, v) as f64;
+        }
+    }
+    s / ((2 * r + 1) * (2 * r + 1)) as f64
+}
+
+#[test]
+fn point_constraint_sets_height_and_slope() {
+    let Some(db) = db() else { return };
+    let mut s = session(db);
+    let base = s.apply(vec![]).unwrap().heightfield;
+    let rel = relief(db);
+    let cell = s.synthesizer().cell_size_m();
+    let mut worst: f64 = 0.0;
+    // Raise one site and lower another, each with a slope facing +x / +y.
+    for (k, (x, y, dir, lift)) in [
+        (80.0, 90.0, 0.0, 0.25),
+        (170.0, 160.0, std::f64::consts::FRAC_PI_2, -0.2),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let h = at(&base, x, y) + lift * rel;
+        let p = PointConstraint::new((x, y), h, dir, 20f64.to_radians(), 40.0, cell).unwrap();
+        let out = s
+            .apply(vec![Edit::SetConstraint(
+                ConstraintId(k as u64),
+                Arc::new(p),
+            )])
+            .unwrap();
+        let hf = &out.heightfield;
+        let err = (at(hf, x, y) - h).abs() / rel;
+        worst = worst.max(err);
+        // Slope: the terrain descends along the direction across the site.
+        let (dx, dy) = (dir.cos(), dir.sin());
+        let (xi, yi) = (x as usize, y as usize);
+        let o = 12.0;
+        let up = mean_around(hf, (x - o * dx) as usize, (y - o * dy) as usize, 2);
+        let down = mean_around(hf, (x + o * dx) as usize, (y + o * dy) as usize, 2);
+        println!(
+            "point {k}: target {h:.1} m, got {:.1} m (error {:.2}% of relief {rel:.0} m); uphill {up:.1} m, downhill {down:.1} m (plane: {:.1} m apart)",
+            hf.get(xi, yi),
+            err * 100.0,
+            2.0 * o * cell * 20f64.to_radians().tan()
+        );
+        assert!(up > down, "point {k}: no descent along the slope direction");
+    }
+    assert!(
+        worst <= 0.02,
+        "site height off by {:.2}% of relief",
+        worst * 100.0
+    );
+}
+
+#[test]
+fn painted_types_take_their_coordinates_from_that_type() {
+    let Some(db) = db() else { return };
+    let hills = db
+        .type_names()
+        .iter()
+        .position(|n| n == "hills")
+        .expect("a hills type") as u8;
+    let mut s = session(db);
+    let (c, r) = (128.0, 60.0);
+    let map: Vec<u8> = (0..N * N)
+        .map(|k| {
+            let (x, y) = ((k % N) as f64 + 0.5, (k / N) as f64 + 0.5);
+            if (x - c).hypot(y - c) <= r {
+                hills
+            } else {
+                UNCONSTRAINED
+            }
+        })
+        .collect();
+    let before = s.apply(vec![]).unwrap();
+    drop(before);
+    let share = |s: &Session<'_>| {
+        let f = s.frames().unwrap();
+        let lvl = db.level(2);
+        let atlas = terrasynth::synth::atlas::AtlasLevel::new(db, 2);
+        let last = f.levels[2].last().unwrap();
+        let w = N / 4;
+        let (mut inside, mut ok) = (0, 0);
+        for (k, co) in last.coords.iter().enumerate() {
+            let (x, y) = ((k % w) as f64 * 4.0 + 2.0, (k / w) as f64 * 4.0 + 2.0);
+            if (x - c).hypot(y - c) <= r - 4.0 {
+                inside += 1;
+                let (tx, ty) = ((co.x + 128) >> 8, (co.y + 128) >> 8);
+                ok += (lvl.types[atlas.index(tx, ty)] == hills) as usize;
+            }
+        }
+        ok as f64 / inside as f64
+    };
+    let unpainted = share(&s);
+    s.apply(vec![Edit::PaintTypes(Some(map))]).unwrap();
+    let painted = share(&s);
+    println!(
+        "level-2 coordinates of type hills in the painted disc: {:.1}% (unpainted {:.1}%)",
+        painted * 100.0,
+        unpainted * 100.0
+    );
+    assert!(painted >= 0.95, "only {:.1}% hills", painted * 100.0);
+}
+
+#[test]
+fn frozen_pixels_survive_edits_elsewhere_bit_for_bit() {
+    let Some(db) = db() else { return };
+    let mut s = session(db);
+    let base = s.apply(vec![]).unwrap().heightfield;
+    let frozen = |x: usize, y: usize| (20..110).contains(&x) && (30..120).contains(&y);
+    let mask: Vec<bool> = (0..N * N).map(|k| frozen(k % N, k / N)).collect();
+    s.apply(vec![Edit::Freeze(Some(mask))]).unwrap();
+    let cell = s.synthesizer().cell_size_m();
+    let p = PointConstraint::new((150.0, 120.0), 2500.0, 1.0, 0.3, 60.0, cell).unwrap();
+    let out = s
+        .apply(vec![Edit::SetConstraint(ConstraintId(1), Arc::new(p))])
+        .unwrap();
+    let change = out.change.unwrap();
+    let mut checked = 0;
+    for y in 0..N {
+        for x in (0..N).filter(|&x| frozen(x, y)) {
+            assert_eq!(
+                out.heightfield.get(x, y).to_bits(),
+                base.get(x, y).to_bits(),
+                "({x}, {y})"
+            );
+            checked += 1;
+        }
+    }
+    println!(
+        "{checked} frozen pixels unchanged; {} pixels changed elsewhere",
+        change.pixels
+    );
+    assert!(change.pixels > 100, "the point changed nothing");
+}
+
+/// Fraction of pixels farther than `reach` from (x, y) whose height moved
+/// by more than 1% of relief.
+fn moved_outside(
+    a: &Heightfield,
+    b: &Heightfield,
+    (x, y): (f64, f64),
+    reach: f64,
+    rel: f64,
+) -> f64 {
+    let (mut n, mut moved) = (0, 0);
+    for v in 0..N {
+        for u in 0..N {
+            if (u as f64 + 0.5 - x).hypot(v as f64 + 0.5 - y) > reach {
+                n += 1;
+                moved += ((a.get(u, v) - b.get(u, v)).abs() as f64 > 0.01 * rel) as usize;
+            }
+        }
+    }
+    moved as f64 / n as f64
+}
+
+#[test]
+fn coherence_keeps_a_new_point_local() {
+    let Some(db) = db() else { return };
+    let rel = relief(db);
+    let site = (140.0, 100.0);
+    let run = |coherence: bool| {
+        let mut s = session(db);
+        s.coherence = coherence;
+        let base = s.apply(vec![]).unwrap().heightfield;
+        let cell = s.synthesizer().cell_size_m();
+        let h = at(&base, site.0, site.1) + 0.2 * rel;
+        let p = PointConstraint::new(site, h, 0.5, 0.2, 32.0, cell).unwrap();
+        let after = s
+            .apply(vec![Edit::SetConstraint(ConstraintId(3), Arc::new(p))])
+            .unwrap();
+        moved_outside(&base, &after.heightfield, site, 32.0, rel)
+    };
+    let (with, without) = (run(true), run(false));
+    println!(
+        "pixels outside the reach moved by > 1% of relief: {:.2}% with coherence, {:.2}% without",
+        with * 100.0,
+        without * 100.0
+    );
+    assert!(with < 0.02, "{:.2}% with coherence", with * 100.0);
+    assert!(
+        without > 2.0 * with && without > 0.01,
+        "{:.2}% without",
+        without * 100.0
+    );
+}
+
+#[test]
+fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
+    let Some(db) = db() else { return };
+    let cell = db.meta().exemplars[0].cell_size_m;
+    let hills = db.type_names().iter().position(|n| n == "hills").unwrap() as u8;
+    let paint: Vec<u8> = (0..N * N)
+        .map(|k| {
+            if (k % N) > 180 && (k / N) < 70 {
+                hills
+            } else {
+                UNCONSTRAINED
+            }
+        })
+        .collect();
+    let p1: Arc<dyn Constraint> =
+        Arc::new(PointConstraint::new((60.0, 60.0), 1800.0, 0.0, 0.2, 30.0, cell).unwrap());
+    let p2: Arc<dyn Constraint> =
+        Arc::new(PointConstraint::new((70.0, 190.0), 900.0, 2.0, 0.4, 40.0, cell).unwrap());
+    let p1b: Arc<dyn Constraint> =
+        Arc::new(PointConstraint::new((90.0, 70.0), 1700.0, 0.0, 0.2, 30.0, cell).unwrap());
+    let edits = vec![
+        vec![],
+        vec![Edit::SetConstraint(ConstraintId(1), p1)],
+        vec![
+            Edit::SetConstraint(ConstraintId(2), p2),
+            Edit::PaintTypes(Some(paint)),
+        ],
+        vec![Edit::SetConstraint(ConstraintId(1), p1b)],
+        vec![Edit::RemoveConstraint(ConstraintId(2))],
+        vec![],
+    ];
+    let mut fast = session(db);
+    let mut full = session(db);
+    full.restrict = false;
+    for (k, e) in edits.into_iter().enumerate() {
+        let a = fast.apply(e.clone()).unwrap();
+        let b = full.apply(e).unwrap();
+        let same = a
+            .heightfield
+            .data()
+            .iter()
+            .zip(b.heightfield.data())
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "edit {k}: restricted and full re-synthesis differ");
+        assert!(
+            fast.frames() == full.frames(),
+            "edit {k}: per-pass results differ"
+        );
+        if k == 5 {
+            assert_eq!(
+                a.change.unwrap().pixels,
+                0,
+                "unchanged inputs must repeat bit for bit"
+            );
+        }
+    }
+}
+
+#[test]
+fn pasted_region_keeps_its_source_heights_plus_delta() {
+    let Some(db) = db() else { return };
+    let mut s = session(db);
+    let base = s.apply(vec![]).unwrap().heightfield;
+    let lasso = vec![(30.0, 30.0), (90.0, 34.0), (80.0, 95.0), (36.0, 80.0)];
+    let (ox, oy, delta) = (130i64, 120i64, 150.0);
+    let out = s
+        .apply(vec![Edit::Paste(Paste {
+            source: PasteSource::Terrain,
+            lasso: lasso.clone(),
+            offset: (ox, oy),
+            delta_m: delta,
+        })])
+        .unwrap()
+        .heightfield;
+    let q = db.quantization();
+    let d = (delta / q.scale_m).round() * q.scale_m;
+    let mut n = 0;
+    for y in 0..N {
+        for x in 0..N {
+            if terrasynth::synth::control::inside(&lasso, x as f64 + 0.5, y as f64 + 0.5) {
+                let want = base.get(x, y) as f64 + d;
+                let got = out.get(x + ox as usize, y + oy as usize) as f64;
+                assert!((got - want).abs() < 0.01, "({x}, {y}): {got} vs {want}");
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 2000);
+    // Outside the paste and its blend margin, the terrain stays put.
+    let far = moved_outside(
+        &base,
+        &out,
+        (ox as f64 + 60.0, oy as f64 + 60.0),
+        90.0,
+        relief(db),
+    );
+    println!(
+        "paste: {n} pixels exact; {:.2}% of far pixels moved > 1% of relief",
+        far * 100.0
+    );
+}
+
+#[test]
+fn sessions_are_identical_on_one_and_two_threads() {
+    let Some(db) = db() else { return };
+    let cell = db.meta().exemplars[0].cell_size_m;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut s = session(db);
+            s.apply(vec![]).unwrap();
+            let p = PointConstraint::new((100.0, 120.0), 2000.0, 0.7, 0.3, 40.0, cell).unwrap();
+            let f = s
+                .apply(vec![Edit::SetConstraint(ConstraintId(9), Arc::new(p))])
+                .unwrap();
+            (f.heightfield, s.frames().unwrap().clone())
+        })
+    };
+    let (a, b) = (run(1), run(2));
+    assert!(
+        a.0.data()
+            .iter()
+            .zip(b.0.data())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    );
+    assert!(a.1 == b.1);
+}
