@@ -31,7 +31,8 @@ pub mod segments;
 pub mod smooth;
 
 use super::{Constraint, Sample};
-use field::{DistanceField, FieldCache};
+use field::DistanceField;
+pub use field::FieldCache;
 use glam::DVec2;
 use profile::Track;
 use segments::Hit;
