@@ -7,8 +7,11 @@ use std::sync::OnceLock;
 use terrasynth::database::{Database, default, layout::MARGIN};
 use terrasynth::progress::Silent;
 use terrasynth::synth::atlas::AtlasLevel;
+use terrasynth::synth::control::Target;
 use terrasynth::synth::fixed::Coord;
-use terrasynth::synth::stages::correct::{self, CorrectParams, SUBPASSES, scalar};
+use terrasynth::synth::stages::correct::{
+    self, ALL_TYPES, Coherence, CorrectParams, Guide, SUBPASSES, scalar,
+};
 use terrasynth::synth::state::State;
 use terrasynth::synth::{Params, Synthesizer};
 
@@ -27,12 +30,17 @@ fn state_from(w: usize, h: usize, coords: &[Coord], offsets: &[i32]) -> State {
 
 /// Runs one subpass both ways on copies of a state; asserts equal bytes.
 fn assert_paths_agree(atlas: &AtlasLevel<'_>, st: &State, what: &str) {
+    assert_guided_paths_agree(atlas, st, &Guide::NONE, what)
+}
+
+/// [`assert_paths_agree`] under control inputs.
+fn assert_guided_paths_agree(atlas: &AtlasLevel<'_>, st: &State, g: &Guide<'_>, what: &str) {
     for &(px, py) in &SUBPASSES {
         let p = CorrectParams { px, py };
         let fast = state_from(st.width, st.height, &st.coords(), &st.offsets());
         let slow = state_from(st.width, st.height, &st.coords(), &st.offsets());
-        correct::correct(atlas, &fast, &p);
-        scalar::correct(atlas, &slow, &p);
+        correct::correct_guided(atlas, &fast, &p, g);
+        scalar::correct_guided(atlas, &slow, &p, g);
         let (fc, sc) = (fast.coords(), slow.coords());
         let (fo, so) = (fast.offsets(), slow.offsets());
         if let Some(i) = (0..fc.len()).find(|&i| fc[i] != sc[i] || fo[i] != so[i]) {
@@ -119,5 +127,161 @@ proptest! {
         let atlas = AtlasLevel::new(db(), level);
         let st = random_state(&atlas, w, h, seed);
         assert_paths_agree(&atlas, &st, &format!("random {w}x{h} at level {level}"));
+    }
+}
+
+/// Random control inputs for a w×h level: targets on about half the
+/// pixels, coherence from another random state with weights 0, 1 or 4,
+/// type sets on a few pixels, and a window.
+#[allow(clippy::type_complexity)]
+fn random_guide_inputs(
+    atlas: &AtlasLevel<'_>,
+    w: usize,
+    h: usize,
+    seed: u64,
+) -> (Vec<Target>, State, Vec<u8>, Vec<u32>, [usize; 4]) {
+    let mut rng = seed | 1;
+    let mut next = move || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        rng
+    };
+    let n = w * h;
+    let targets = (0..n)
+        .map(|_| {
+            if next() % 2 == 0 {
+                Target::NONE
+            } else {
+                Target {
+                    height: (next() % 70_000) as i32 - 2_000,
+                    tol: (next() % 5_000) as i32,
+                }
+            }
+        })
+        .collect();
+    let prev = random_state(atlas, w, h, seed ^ 0x9E37_79B9);
+    let weights = (0..n).map(|_| [0u8, 1, 4][(next() % 3) as usize]).collect();
+    let types = atlas.seed_counts.len() as u32;
+    let allowed = (0..n)
+        .map(|_| {
+            if next() % 5 == 0 {
+                (1u32 << (next() % types as u64)) | (next() as u32 & 1) << (next() % types as u64)
+            } else {
+                ALL_TYPES
+            }
+        })
+        .collect();
+    let x0 = (next() % w as u64) as usize;
+    let y0 = (next() % h as u64) as usize;
+    let window = [
+        x0,
+        y0,
+        x0 + 1 + (next() % w as u64) as usize,
+        y0 + 1 + (next() % h as u64) as usize,
+    ];
+    (targets, prev, weights, allowed, window)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Geometric targets, coherence, type sets and windows: the fast path
+    /// still gives the scalar oracle's bytes.
+    #[test]
+    fn fast_and_scalar_correction_agree_under_control(
+        level in 0usize..3,
+        w in 2usize..70,
+        h in 2usize..40,
+        seed in any::<u64>(),
+        which in 0u8..16,
+    ) {
+        let atlas = AtlasLevel::new(db(), level);
+        let st = random_state(&atlas, w, h, seed);
+        let (targets, prev, weights, allowed, window) = random_guide_inputs(&atlas, w, h, seed);
+        let (coords, offsets) = (prev.coords(), prev.offsets());
+        let g = Guide {
+            level: level as u32,
+            targets: (which & 1 != 0).then_some(&targets[..]),
+            coherence: (which & 2 != 0).then_some(Coherence {
+                coords: &coords,
+                offsets: &offsets,
+                weights: &weights,
+            }),
+            allowed: (which & 4 != 0).then_some(&allowed[..]),
+            window: (which & 8 != 0).then_some(window),
+        };
+        assert_guided_paths_agree(&atlas, &st, &g, &format!("guided {which:04b} {w}x{h} at level {level}"));
+    }
+}
+
+/// The controls actually act: a target pulls heights, a window leaves the
+/// outside alone, a frozen coherence candidate is kept as is.
+#[test]
+fn controls_change_the_result_as_intended() {
+    let atlas = AtlasLevel::new(db(), 1);
+    let (w, h) = (40, 30);
+    let st = random_state(&atlas, w, h, 5);
+    let p = CorrectParams { px: 0, py: 0 };
+    let plain = state_from(w, h, &st.coords(), &st.offsets());
+    correct::correct(&atlas, &plain, &p);
+    // A far-away target with zero tolerance moves every corrected offset.
+    let targets = vec![
+        Target {
+            height: 200_000,
+            tol: 0
+        };
+        w * h
+    ];
+    let pulled = state_from(w, h, &st.coords(), &st.offsets());
+    let g = Guide {
+        targets: Some(&targets),
+        ..Guide::NONE
+    };
+    correct::correct_guided(&atlas, &pulled, &p, &g);
+    for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
+        assert!(
+            pulled.offsets()[i] > plain.offsets()[i] + 10_000,
+            "pixel {i}"
+        );
+    }
+    // A window corrects only inside.
+    let windowed = state_from(w, h, &st.coords(), &st.offsets());
+    let g = Guide {
+        window: Some([10, 4, 20, 12]),
+        ..Guide::NONE
+    };
+    correct::correct_guided(&atlas, &windowed, &p, &g);
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let inside = (10..20).contains(&x) && (4..12).contains(&y);
+            let want = if inside {
+                plain.coords()[i]
+            } else {
+                st.coords()[i]
+            };
+            assert_eq!(windowed.coords()[i], want, "({x}, {y})");
+        }
+    }
+    // Frozen (W = 0): the previous result comes back unchanged.
+    let prev = random_state(&atlas, w, h, 99);
+    let (coords, offsets) = (prev.coords(), prev.offsets());
+    let weights = vec![0u8; w * h];
+    let frozen = state_from(w, h, &st.coords(), &st.offsets());
+    let g = Guide {
+        coherence: Some(Coherence {
+            coords: &coords,
+            offsets: &offsets,
+            weights: &weights,
+        }),
+        ..Guide::NONE
+    };
+    correct::correct_guided(&atlas, &frozen, &p, &g);
+    for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
+        assert_eq!(
+            (frozen.coords()[i], frozen.offsets()[i]),
+            (coords[i], offsets[i])
+        );
     }
 }

@@ -9,7 +9,11 @@
 use crate::database::{Database, Level, layout::MARGIN};
 
 /// Per-column addressing of one level.
-#[derive(Clone, Copy, Default)]
+///
+/// `#[repr(C)]` and plain old data: the GPU backend uploads the table as is
+/// (`Column` in `kernels/common.wgsl`; layout checked by a test).
+#[repr(C)]
+#[derive(Clone, Copy, Default, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Column {
     /// `offset − x0` of the column's exemplar (may be negative).
     pub base: i32,
@@ -24,6 +28,8 @@ pub struct Column {
 pub struct AtlasLevel<'a> {
     pub level: Level<'a>,
     pub columns: Vec<Column>,
+    /// Seed slots filled per type (type seeding draws from these).
+    pub seed_counts: Vec<u32>,
 }
 
 impl<'a> AtlasLevel<'a> {
@@ -41,7 +47,11 @@ impl<'a> AtlasLevel<'a> {
                 };
             }
         }
-        AtlasLevel { level, columns }
+        AtlasLevel {
+            level,
+            columns,
+            seed_counts: db.meta().levels[i].seed_counts.clone(),
+        }
     }
 
     /// Texel index of (x, y); the caller guarantees it lies in an exemplar.

@@ -11,14 +11,17 @@
 pub mod atlas;
 pub mod control;
 pub mod fixed;
+pub mod session;
 pub mod stages;
 pub mod state;
 
+use crate::backend::{Backend, BackendError, Choice, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
+use control::Target;
 use fixed::{Coord, FRAC_BITS};
-use stages::correct::{self, CorrectParams, SUBPASSES};
+use stages::correct::{self, Coherence, CorrectParams, Guide, SUBPASSES};
 use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
 use stages::upsample_jitter::{self, Step, UpsampleParams};
 use state::{State, level_size, top_level};
@@ -70,6 +73,8 @@ pub enum SynthError {
     StartExemplar { index: usize, count: usize },
     #[error(transparent)]
     Size(#[from] crate::error::SizeError),
+    #[error(transparent)]
+    Backend(#[from] BackendError),
 }
 
 /// One level's final state, kept when [`Params::keep_levels`] is set.
@@ -109,12 +114,130 @@ pub struct Synthesis {
     pub timings: Timings,
 }
 
-/// Synthesizes terrain from one database.
+/// Control inputs of one synthesis, per level (index = level; levels the
+/// correction never visits are ignored).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Guides {
+    pub levels: Vec<LevelGuide>,
+    /// Re-synthesize only where this frame can differ from the previous
+    /// one: at each level, the window around the pixels whose inputs
+    /// changed and the children of the parent level's changed pixels,
+    /// widened by how far 4·passes subpasses carry a change. Outside it
+    /// every pixel's inputs equal the previous frame's (weights can only
+    /// have decreased there, which keeps the previous winner), so its
+    /// previous per-pass results are what it would compute: restricted and
+    /// full re-synthesis give the same bytes (tested).
+    pub restrict: bool,
+}
+
+/// One level's control rasters (level-sized, row-major).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LevelGuide {
+    /// Geometric targets (levels ≥ 2).
+    pub targets: Option<Vec<Target>>,
+    /// Type target sets R^i (levels ≥ 2).
+    pub allowed: Option<Vec<u32>>,
+    /// Coherence weights W^i in quarters (used when a previous frame exists).
+    pub weights: Option<Vec<u8>>,
+    /// Bounds `[x0, y0, x1, y1)` of the pixels whose own inputs (targets,
+    /// type sets, raised weights, pasted candidates) differ from the
+    /// previous frame's; None if none do. Used when [`Guides::restrict`].
+    pub dirty: Option<[usize; 4]>,
+}
+
+/// Subpass reads reach two pixels (DESIGN §5), so within one level a change
+/// spreads at most this far per subpass.
+const REACH_PER_SUBPASS: usize = 2;
+
+/// Every corrected level's state after every pass (index = level, then
+/// pass): the previous frame a coherent re-synthesis reads. A pass writes
+/// each pixel once, in its parity class's subpass, so the state after the
+/// pass holds every subpass's result (paper §5.3: "the results for all
+/// sub-passes are needed").
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Frames {
+    pub levels: Vec<Vec<PassResult>>,
+}
+
+/// One level's S and V after one pass.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PassResult {
+    pub coords: Vec<Coord>,
+    pub offsets: Vec<i32>,
+}
+
+/// The union of two optional bounds.
+fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
+    }
+}
+
+/// The children of a parent level's bounds.
+fn double(b: [usize; 4]) -> [usize; 4] {
+    b.map(|v| 2 * v)
+}
+
+/// Bounds grown by `by` on every side, clipped to `w × h`.
+fn widen(b: [usize; 4], by: usize, w: usize, h: usize) -> [usize; 4] {
+    [
+        b[0].saturating_sub(by),
+        b[1].saturating_sub(by),
+        (b[2] + by).min(w),
+        (b[3] + by).min(h),
+    ]
+}
+
+/// Bounds of the pixels whose S or V differ from `r`; None if none do.
+fn changed_bounds(st: &State, r: &PassResult) -> Option<[usize; 4]> {
+    let w = st.width;
+    let mut b: Option<[usize; 4]> = None;
+    for y in 0..st.height {
+        for x in 0..w {
+            let i = y * w + x;
+            if st.s(i) != r.coords[i] || st.v(i) != r.offsets[i] {
+                b = union(b, Some([x, y, x + 1, y + 1]));
+            }
+        }
+    }
+    b
+}
+
+/// After a windowed subpass: the subpass's pixels outside the window take
+/// the previous frame's result of this pass (what they would compute).
+fn keep_outside(st: &State, r: &PassResult, [x0, y0, x1, y1]: [usize; 4], p: CorrectParams) {
+    use rayon::prelude::*;
+    let w = st.width;
+    (p.py as usize..st.height)
+        .into_par_iter()
+        .step_by(2)
+        .for_each(|y| {
+            let inside_row = (y0..y1).contains(&y);
+            for x in (p.px as usize..w).step_by(2) {
+                if !(inside_row && (x0..x1).contains(&x)) {
+                    let i = y * w + x;
+                    st.set(i, r.coords[i], r.offsets[i]);
+                }
+            }
+        });
+}
+
+/// Synthesizes terrain from one database, on the CPU unless
+/// [`Synthesizer::use_backend`] moved it to the GPU.
 pub struct Synthesizer<'db> {
     db: &'db Database,
     params: Params,
     atlas: Vec<AtlasLevel<'db>>,
     jitter: i32,
+    #[cfg(feature = "gpu")]
+    gpu: Option<crate::backend::gpu::Gpu>,
 }
 
 impl<'db> Synthesizer<'db> {
@@ -141,7 +264,73 @@ impl<'db> Synthesizer<'db> {
             params,
             atlas,
             jitter,
+            #[cfg(feature = "gpu")]
+            gpu: None,
         })
+    }
+
+    /// Moves the stages to the backend `choice` names. Returns a one-line
+    /// notice when [`Choice::Auto`] found no GPU and stays on the CPU.
+    pub fn use_backend(&mut self, choice: Choice) -> Result<Option<String>, SynthError> {
+        #[cfg(feature = "gpu")]
+        {
+            let ctx = match choice {
+                Choice::Cpu => {
+                    self.gpu = None;
+                    return Ok(None);
+                }
+                Choice::Gpu => crate::backend::gpu::Context::new()?,
+                Choice::Auto => match crate::backend::gpu::Context::new() {
+                    Ok(ctx) => ctx,
+                    Err(e) => {
+                        self.gpu = None;
+                        return Ok(Some(format!("{e}; using the CPU")));
+                    }
+                },
+            };
+            self.use_gpu(ctx)?;
+            Ok(None)
+        }
+        #[cfg(not(feature = "gpu"))]
+        match choice {
+            Choice::Cpu => Ok(None),
+            Choice::Gpu => Err(BackendError::NotCompiled.into()),
+            Choice::Auto => Ok(Some(format!(
+                "{}; using the CPU",
+                BackendError::NotCompiled
+            ))),
+        }
+    }
+
+    /// Runs the stages on the GPU of `ctx` (uploads the database once).
+    #[cfg(feature = "gpu")]
+    pub fn use_gpu(
+        &mut self,
+        ctx: std::sync::Arc<crate::backend::gpu::Context>,
+    ) -> Result<(), SynthError> {
+        self.gpu = Some(crate::backend::gpu::Gpu::new(
+            ctx,
+            &self.atlas,
+            self.db.heights(),
+        )?);
+        Ok(())
+    }
+
+    /// Where the stages run: `"cpu"` or `"gpu"`.
+    pub fn backend_name(&self) -> &'static str {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return g.name();
+        }
+        self.cpu().name()
+    }
+
+    /// The CPU backend over this synthesizer's database.
+    fn cpu(&self) -> Cpu<'_, 'db> {
+        Cpu {
+            atlas: &self.atlas,
+            heights: self.db.heights(),
+        }
     }
 
     pub fn params(&self) -> &Params {
@@ -163,8 +352,26 @@ impl<'db> Synthesizer<'db> {
         Ok(self.run(width, height, seed)?.heightfield)
     }
 
-    /// Synthesizes and returns timings (and levels, if kept).
+    /// Synthesizes and returns timings (and levels, if kept), on the
+    /// backend chosen by [`Synthesizer::use_backend`].
     pub fn run(&self, width: usize, height: usize, seed: u32) -> Result<Synthesis, SynthError> {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return self.run_on(g, width, height, seed);
+        }
+        self.run_on(&self.cpu(), width, height, seed)
+    }
+
+    /// The synthesis loop on any backend: the same stage calls in the same
+    /// order, so every backend yields the same bytes. Stage timings are wall
+    /// clock up to [`Backend::finish`], i.e. including the device's work.
+    pub fn run_on<B: Backend>(
+        &self,
+        b: &B,
+        width: usize,
+        height: usize,
+        seed: u32,
+    ) -> Result<Synthesis, SynthError> {
         crate::heightfield::check_dims(width, height)?;
         let t0 = Instant::now();
         let m = top_level(width, height);
@@ -181,7 +388,95 @@ impl<'db> Synthesizer<'db> {
         } else {
             m
         };
+        let mut state = b.upload(self.initial(width, height, top, seed))?;
+        for level in (0..=top).rev() {
+            let (w, h) = level_size(width, height, level);
+            if level < top {
+                let t = Instant::now();
+                let child = b.alloc(w, h)?;
+                let params = UpsampleParams {
+                    seed,
+                    level: level as u32,
+                    jitter: self.jitter,
+                    step: self.step(level, l),
+                };
+                b.upsample_jitter(&state, &child, level, &params);
+                b.finish()?;
+                state = child;
+                timings.levels[level].upsample = t.elapsed();
+            }
+            if level <= l {
+                let t = Instant::now();
+                for _pass in 0..self.params.passes {
+                    for &(px, py) in &SUBPASSES {
+                        b.correct(&state, level, &CorrectParams { px, py });
+                    }
+                }
+                b.finish()?;
+                timings.levels[level].correct = t.elapsed();
+            }
+            if self.params.keep_levels {
+                let (coords, offsets) = b.download(&state)?;
+                kept.push(LevelMaps {
+                    level,
+                    width: w,
+                    height: h,
+                    coords,
+                    offsets,
+                });
+            }
+        }
+        kept.reverse();
+        let t = Instant::now();
+        let fixed = b.reconstruct(&state)?;
+        let stride = level_size(width, height, 0).0;
+        let heightfield = self.to_metres(&fixed, stride, width, height)?;
+        timings.reconstruct = t.elapsed();
+        timings.total = t0.elapsed();
+        Ok(Synthesis {
+            heightfield,
+            levels: kept,
+            timings,
+        })
+    }
+
+    /// Synthesis under control inputs (paper §5), on the CPU (the GPU
+    /// backend runs unconstrained synthesis only, so far). `prev` is the previous
+    /// frame's per-pass results (the coherence candidates, and what pixels
+    /// outside a level's window keep); with `record`, this frame's are
+    /// returned for the next one.
+    pub fn run_with(
+        &self,
+        width: usize,
+        height: usize,
+        seed: u32,
+        guides: &Guides,
+        prev: Option<&Frames>,
+        record: bool,
+    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
+        crate::heightfield::check_dims(width, height)?;
+        let t0 = Instant::now();
+        let m = top_level(width, height);
+        let l = self.coarsest();
+        let mut timings = Timings {
+            levels: vec![LevelTiming::default(); m + 1],
+            ..Default::default()
+        };
+        let mut kept = Vec::new();
+        let mut frames = record.then(|| Frames {
+            levels: vec![Vec::new(); l.min(m) + 1],
+        });
+        // With jitter, levels above `top` would only be a spread-out copy of
+        // the start exemplar; they are skipped (see `initial`).
+        let top = if self.jitter > 0 {
+            m.min(l + COARSE_BLOCK_BITS)
+        } else {
+            m
+        };
         let mut state = self.initial(width, height, top, seed);
+        // Bounds of the pixels of the level above that differ from the
+        // previous frame (restricted re-synthesis only).
+        let mut changed_parent: Option<[usize; 4]> = None;
         for level in (0..=top).rev() {
             if level < top {
                 let t = Instant::now();
@@ -200,11 +495,52 @@ impl<'db> Synthesizer<'db> {
             }
             if level <= l {
                 let t = Instant::now();
-                for _pass in 0..self.params.passes {
+                let lg = guides.levels.get(level);
+                let before = prev.and_then(|f| f.levels.get(level));
+                let window = match (guides.restrict, before) {
+                    (true, Some(b)) if !b.is_empty() => {
+                        let seeds = union(lg.and_then(|g| g.dirty), changed_parent.map(double));
+                        let grow =
+                            REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
+                        Some(seeds.map_or([0; 4], |b| widen(b, grow, state.width, state.height)))
+                    }
+                    _ => None,
+                };
+                for pass in 0..self.params.passes as usize {
+                    let last = before.and_then(|b| b.get(pass));
+                    let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
+                        (Some(r), Some(weights)) => Some(Coherence {
+                            coords: &r.coords,
+                            offsets: &r.offsets,
+                            weights,
+                        }),
+                        _ => None,
+                    };
+                    let guide = Guide {
+                        level: level as u32,
+                        targets: lg.and_then(|g| g.targets.as_deref()),
+                        allowed: lg.and_then(|g| g.allowed.as_deref()),
+                        coherence,
+                        window,
+                    };
                     for &(px, py) in &SUBPASSES {
-                        correct::correct(&self.atlas[level], &state, &CorrectParams { px, py });
+                        let p = CorrectParams { px, py };
+                        correct::correct_guided(&self.atlas[level], &state, &p, &guide);
+                        if let (Some(win), Some(r)) = (window, last) {
+                            keep_outside(&state, r, win, p);
+                        }
+                    }
+                    if let Some(f) = frames.as_mut() {
+                        f.levels[level].push(PassResult {
+                            coords: state.coords(),
+                            offsets: state.offsets(),
+                        });
                     }
                 }
+                changed_parent = match (window, before.and_then(|b| b.last())) {
+                    (Some(_), Some(r)) => changed_bounds(&state, r),
+                    _ => Some([0, 0, state.width, state.height]),
+                };
                 timings.levels[level].correct = t.elapsed();
             }
             if self.params.keep_levels {
@@ -223,11 +559,24 @@ impl<'db> Synthesizer<'db> {
         let heightfield = self.to_metres(&fixed, state.width, width, height)?;
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
-        Ok(Synthesis {
-            heightfield,
-            levels: kept,
-            timings,
-        })
+        Ok((
+            Synthesis {
+                heightfield,
+                levels: kept,
+                timings,
+            },
+            frames,
+        ))
+    }
+
+    /// The database this synthesizer draws from.
+    pub fn database(&self) -> &'db Database {
+        self.db
+    }
+
+    /// Output cell size, metres (the start exemplar's).
+    pub fn cell_size_m(&self) -> f64 {
+        self.db.meta().exemplars[self.params.start_exemplar].cell_size_m
     }
 
     /// How level `level` is made from the one above.

@@ -76,3 +76,58 @@ pub(crate) fn check(
         })
     }
 }
+
+/// A constraint's stable identity across edits (chosen by the caller, e.g.
+/// its index in a scene file), so an edit can replace or remove it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ConstraintId(pub u64);
+
+/// "No type painted here" in a type map.
+pub const UNCONSTRAINED: u8 = u8::MAX;
+
+/// Where a pasted region comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PasteSource {
+    /// The session's current terrain (its S and V at every level and pass).
+    Terrain,
+    /// An exemplar of the database, by index (its own coordinates, V = 0).
+    Exemplar(usize),
+}
+
+/// A copy-paste (paper §5.3, Fig. 8): the region inside `lasso` (a closed
+/// polygon, in output pixels for the terrain or level-0 exemplar pixels for
+/// an exemplar) moved by `offset` output pixels and raised by `delta_m`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Paste {
+    pub source: PasteSource,
+    pub lasso: Vec<(f64, f64)>,
+    pub offset: (i64, i64),
+    pub delta_m: f64,
+}
+
+/// Everything the user controls, in memory (a scene file converts to this).
+#[derive(Debug, Clone, Default)]
+pub struct Controls {
+    /// Geometric constraints, by id (sorted, so order never depends on edits).
+    pub constraints: std::collections::BTreeMap<ConstraintId, std::sync::Arc<dyn Constraint>>,
+    /// R⁰: a type id of the database per output pixel (row-major) or
+    /// [`UNCONSTRAINED`]; None = nothing painted.
+    pub types: Option<Vec<u8>>,
+    /// The freezing brush: true = locked (W⁰ = 0), per output pixel.
+    pub freeze: Option<Vec<bool>>,
+    /// Pastes applied so far, in order (each stays frozen).
+    pub pastes: Vec<Paste>,
+}
+
+/// Whether (x, y) lies inside the closed polygon (even-odd rule).
+pub fn inside(poly: &[(f64, f64)], x: f64, y: f64) -> bool {
+    let mut odd = false;
+    let n = poly.len();
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + n - 1) % n]);
+        if (a.1 > y) != (b.1 > y) && x < a.0 + (y - a.1) * (b.0 - a.0) / (b.1 - a.1) {
+            odd = !odd;
+        }
+    }
+    odd
+}

@@ -42,6 +42,8 @@ pub mod scalar;
 pub mod simd;
 
 use crate::synth::atlas::AtlasLevel;
+use crate::synth::control::Target;
+use crate::synth::fixed::Coord;
 use crate::synth::state::State;
 use rayon::prelude::*;
 
@@ -75,27 +77,101 @@ pub struct CorrectParams {
 /// Subpass order within a pass (the four parity classes).
 pub const SUBPASSES: [(u32, u32); 4] = [(0, 0), (1, 0), (0, 1), (1, 1)];
 
+/// Control inputs of one subpass at one level (paper §5), all optional;
+/// [`Guide::NONE`] is plain synthesis. Rasters are level-sized, row-major.
+#[derive(Debug, Clone, Copy)]
+pub struct Guide<'a> {
+    /// The level index (salts the type-seeding hash).
+    pub level: u32,
+    /// Geometric constraints: blended target and tolerance per pixel; the
+    /// winner's height is nudged by φ_d (eq. 8–9).
+    pub targets: Option<&'a [Target]>,
+    /// Type constraints: the target set R^i(p) as a bit mask of type ids
+    /// ([`ALL_TYPES`] = unconstrained).
+    pub allowed: Option<&'a [u32]>,
+    /// Coherence: the previous frame's result of this level and pass, one
+    /// more candidate per pixel with its cost × W/4.
+    pub coherence: Option<Coherence<'a>>,
+    /// Only pixels inside `[x0, y0, x1, y1)` are corrected (the rest are
+    /// known to keep their previous result, see `synth::session`).
+    pub window: Option<[usize; 4]>,
+}
+
+impl Guide<'_> {
+    /// No control: the paper's unconstrained synthesis.
+    pub const NONE: Guide<'static> = Guide {
+        level: 0,
+        targets: None,
+        allowed: None,
+        coherence: None,
+        window: None,
+    };
+}
+
+/// Target set of an unconstrained pixel.
+pub const ALL_TYPES: u32 = u32::MAX;
+
+/// The previous frame's result of one level and pass, and the weights.
+#[derive(Debug, Clone, Copy)]
+pub struct Coherence<'a> {
+    pub coords: &'a [Coord],
+    pub offsets: &'a [i32],
+    /// W^i in quarters: 0 frozen, 1 coherent (0.25), 4 unweighted (1).
+    pub weights: &'a [u8],
+}
+
+/// Coherence cost `⌊score · w / 4⌋` without leaving 32 bits (w ≤ 4).
+#[inline(always)]
+pub fn weigh(score: u32, w: u8) -> u32 {
+    let w = w as u32;
+    (score >> 2) * w + (((score & 3) * w) >> 2)
+}
+
+/// Type seeding (paper §5.2): candidates per allowed type when every
+/// regular candidate is rejected.
+pub const SEEDS_PER_ALLOWED_TYPE: u32 = 9;
+
+/// Hash salt of type seeding.
+pub const SEED_SALT: u32 = 0x7E5E_0000;
+
 /// Runs one subpass in place over the level: [`simd`] inside, [`scalar`]
 /// on the two-texel frame where neighbours reflect.
 pub fn correct(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams) {
+    correct_guided(atlas, st, p, &Guide::NONE)
+}
+
+/// [`correct`] with control inputs. Pixels with a type constraint go
+/// through the scalar path (seeding is rare and lives there); geometric and
+/// coherence controls run in both paths with the same integer arithmetic.
+pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: &Guide<'_>) {
     let (w, h) = (st.width, st.height);
+    let [wx0, wy0, wx1, wy1] = g.window.unwrap_or([0, 0, w, h]);
     let px = p.px as usize;
-    (p.py as usize..h).into_par_iter().step_by(2).for_each(|y| {
-        let scalar_at = |x: usize| {
-            let (s, v) = scalar::correct_pixel(atlas, st, x as i32, y as i32);
-            st.set(y * w + x, s, v);
-        };
-        if y < 2 || y + 2 >= h || w < 5 {
-            (px..w).step_by(2).for_each(scalar_at);
-            return;
-        }
-        // Interior span: first class pixel ≥ 2, last one < w − 2.
-        let x0 = px + 2;
-        let x1 = w - 2;
-        (px..x0).step_by(2).for_each(scalar_at);
-        simd::correct_span(atlas, st, y, x0, x1);
-        (x0 + (x1 - x0).div_ceil(2) * 2..w)
-            .step_by(2)
-            .for_each(scalar_at);
-    });
+    // First row/column of the class at or after a bound.
+    let class_from = |start: usize, parity: usize| start + ((parity + 2 - start % 2) % 2);
+    let (y_first, x_first) = (class_from(wy0, p.py as usize), class_from(wx0, px));
+    (y_first..wy1.min(h))
+        .into_par_iter()
+        .step_by(2)
+        .for_each(|y| {
+            let scalar_at = |x: usize| {
+                let (s, v) = scalar::correct_pixel_guided(atlas, st, x as i32, y as i32, g);
+                st.set(y * w + x, s, v);
+            };
+            let x_end = wx1.min(w);
+            if y < 2 || y + 2 >= h || w < 5 {
+                (x_first..x_end).step_by(2).for_each(scalar_at);
+                return;
+            }
+            // Interior span: first class pixel ≥ 2, last one < w − 2.
+            let x0 = class_from(x_first.max(2), px);
+            let x1 = x_end.min(w - 2);
+            (x_first..x0.min(x_end)).step_by(2).for_each(scalar_at);
+            if x0 < x1 {
+                simd::correct_span(atlas, st, y, x0, x1, g);
+            }
+            (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
+                .step_by(2)
+                .for_each(scalar_at);
+        });
 }

@@ -3,4 +3,6 @@
 
 pub mod correct;
 pub mod reconstruct;
+pub mod reduce_types;
+pub mod reduce_weights;
 pub mod upsample_jitter;

@@ -3,9 +3,15 @@
 //! (borders included) and is the oracle the [`super::simd`] path is tested
 //! against.
 
-use super::{CLAMP, CorrectParams, DELTAS, DIAGONALS};
-use crate::database::appearance::unpack_texel;
+use super::{
+    ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, SEED_SALT, SEEDS_PER_ALLOWED_TYPE,
+    weigh,
+};
+use crate::database::appearance::{MODE1_BIAS, unpack_texel};
+use crate::database::types::SEEDS_PER_TYPE;
+use crate::hash::{below, hash4};
 use crate::synth::atlas::AtlasLevel;
+use crate::synth::control::blend::nudge;
 use crate::synth::fixed::{Coord, FRAC_BITS, div_floor, round};
 use crate::synth::state::State;
 use rayon::prelude::*;
@@ -38,6 +44,20 @@ fn add_texel(acc: &mut [i32; 4], t: u64, v: i32) {
 /// Score (×κ) and optimal offset of candidate texel (qx, qy).
 #[inline(always)]
 fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u32) -> (u32, i32) {
+    score_with(atlas, ns, qx, qy, kappa, None)
+}
+
+/// Score (×κ) of candidate texel (qx, qy) with offset `fixed`, or with its
+/// optimal offset (returned) when `fixed` is None.
+#[inline(always)]
+fn score_with(
+    atlas: &AtlasLevel<'_>,
+    ns: &Neighbourhood,
+    qx: i32,
+    qy: i32,
+    kappa: u32,
+    fixed: Option<i32>,
+) -> (u32, i32) {
     let mut d = [[0i32; 4]; 4];
     let mut sum1 = 0;
     for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
@@ -47,7 +67,7 @@ fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u3
         }
         sum1 += d[k][0];
     }
-    let h = div_floor(sum1 + 6, 12);
+    let h = fixed.unwrap_or_else(|| div_floor(sum1 + 6, 12));
     let mut s = 0u32;
     for dk in &d {
         let r1 = (dk[0] - 3 * h).clamp(-CLAMP, CLAMP);
@@ -58,6 +78,13 @@ fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u3
         }
     }
     (s * kappa, h)
+}
+
+/// Height (units, before V) the correction attributes to texel (qx, qy):
+/// its appearance mode 1, the Gaussian-weighted mean height around it.
+#[inline(always)]
+pub fn texel_height(texel: u64) -> i32 {
+    unpack_texel(texel)[0] as i32 - MODE1_BIAS
 }
 
 /// What a neighbour contributes: the texel its coordinate points at (as
@@ -104,6 +131,31 @@ fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> Neighbour {
 /// Corrects one pixel; returns its new coordinate and offset.
 #[inline(always)]
 pub fn correct_pixel(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> (Coord, i32) {
+    correct_pixel_guided(atlas, st, x, y, &Guide::NONE)
+}
+
+/// The best candidate so far: cost, coordinate, offset, and its texel
+/// (None for the coherence candidate, which is taken as is).
+type Best = (u32, Coord, i32, Option<(i32, i32)>);
+
+/// Corrects one pixel under control inputs (paper §5):
+/// 1. the coherence candidate (previous result with its own offset), first
+///    so that a tie keeps the previous result, cost × W/4;
+/// 2. the k-coherence candidates, those of a type outside R^i(p) rejected;
+/// 3. if a type constraint rejected them all, 9 hash-chosen seeds per
+///    allowed type, scored like C₁;
+/// 4. a winner other than the coherence candidate gets its offset nudged
+///    by φ_d towards the blended target (eq. 8–9). The coherence candidate
+///    is the previous result as is, nudge included, so an unchanged frame
+///    repeats bit for bit instead of drifting.
+#[inline(always)]
+pub fn correct_pixel_guided(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    x: i32,
+    y: i32,
+    g: &Guide<'_>,
+) -> (Coord, i32) {
     let mut ns: Neighbourhood = [[0; 4]; 4];
     for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
         for (vx, vy) in [(0, 0), (dx, 0), (0, dy)] {
@@ -111,43 +163,114 @@ pub fn correct_pixel(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> (Coo
             add_texel(&mut ns[k], atlas.appearance(n.tx - vx, n.ty - vy), n.v);
         }
     }
+    let i = y as usize * st.width + x as usize;
 
-    let mut best = (u32::MAX, Coord::default(), 0i32);
-    let mut seen = [(i32::MIN, i32::MIN); 9];
-    for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
-        let n = neighbour(atlas, st, x + dx, y + dy);
-        let u = (n.tx - dx, n.ty - dy);
-        if seen[..k].contains(&u) {
-            continue;
+    // (cost, coordinate, offset, texel of the winner; None = coherence).
+    let mut best: Best = (u32::MAX, Coord::default(), 0i32, None);
+    let allowed = g.allowed.map_or(ALL_TYPES, |a| a[i]);
+    if let Some(c) = &g.coherence {
+        let (s, v) = (c.coords[i], c.offsets[i]);
+        let q = (round(s.x), round(s.y));
+        // A previous result of a type no longer allowed is no candidate,
+        // unless frozen (freezing dominates).
+        let ok = allowed == ALL_TYPES
+            || c.weights[i] == 0
+            || allowed >> atlas.level.types[atlas.index(q.0, q.1)] & 1 == 1;
+        if ok {
+            let (sc, _) = score_with(atlas, &ns, q.0, q.1, 1, Some(v));
+            best = (weigh(sc, c.weights[i]), s, v, None);
         }
-        seen[k] = u;
-        let place = |(qx, qy): (i32, i32)| Coord {
-            x: (qx << FRAC_BITS) + n.frac.0,
-            y: (qy << FRAC_BITS) + n.frac.1,
+    }
+    // Scores the k-coherence candidates admitted by `filter`; whether any was.
+    let candidates = |filter: u32, best: &mut Best| -> bool {
+        let mut any = false;
+        let admits = |q: (i32, i32)| {
+            filter == ALL_TYPES || filter >> atlas.level.types[atlas.index(q.0, q.1)] & 1 == 1
         };
-        let c1 = atlas.clamp_interior(u.0, u.1);
-        let (sc, hh) = score(atlas, &ns, c1.0, c1.1, 1);
-        if sc < best.0 {
-            best = (sc, place(c1), hh);
+        let mut seen = [(i32::MIN, i32::MIN); 9];
+        for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
+            let n = neighbour(atlas, st, x + dx, y + dy);
+            let u = (n.tx - dx, n.ty - dy);
+            if seen[..k].contains(&u) {
+                continue;
+            }
+            seen[k] = u;
+            let place = |(qx, qy): (i32, i32)| Coord {
+                x: (qx << FRAC_BITS) + n.frac.0,
+                y: (qy << FRAC_BITS) + n.frac.1,
+            };
+            let c1 = atlas.clamp_interior(u.0, u.1);
+            if admits(c1) {
+                any = true;
+                let (sc, hh) = score(atlas, &ns, c1.0, c1.1, 1);
+                if sc < best.0 {
+                    *best = (sc, place(c1), hh, Some(c1));
+                }
+            }
+            let c2 = atlas.level.similar[atlas.index(u.0, u.1)];
+            let c2 = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+            if admits(c2) {
+                any = true;
+                let (sc, hh) = score(atlas, &ns, c2.0, c2.1, 2);
+                if sc < best.0 {
+                    *best = (sc, place(c2), hh, Some(c2));
+                }
+            }
         }
-        let c2 = atlas.level.similar[atlas.index(u.0, u.1)];
-        let c2 = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
-        let (sc, hh) = score(atlas, &ns, c2.0, c2.1, 2);
-        if sc < best.0 {
-            best = (sc, place(c2), hh);
+        any
+    };
+    if !candidates(allowed, &mut best) {
+        let mut seeded = false;
+        for t in 0..atlas.seed_counts.len() as u32 {
+            let count = atlas.seed_counts[t as usize];
+            if allowed >> t & 1 == 0 || count == 0 {
+                continue;
+            }
+            seeded = true;
+            let list = &atlas.level.seeds[t as usize * SEEDS_PER_TYPE..];
+            for k in 0..SEEDS_PER_ALLOWED_TYPE {
+                let salt = t * SEEDS_PER_ALLOWED_TYPE + k;
+                let hash = hash4(SEED_SALT | g.level, salt, x as u32, y as u32);
+                let c = list[below(hash, count) as usize];
+                let q = ((c & 0xFFFF) as i32, (c >> 16) as i32);
+                let (sc, hh) = score(atlas, &ns, q.0, q.1, 1);
+                if sc < best.0 {
+                    best = (sc, Coord::from_texel(q.0, q.1), hh, Some(q));
+                }
+            }
+        }
+        if !seeded {
+            // No exemplar texel of any allowed type at this level: the
+            // constraint cannot be met, so the pixel synthesizes freely.
+            candidates(ALL_TYPES, &mut best);
         }
     }
     debug_assert!(best.0 < u32::MAX);
-    (best.1, best.2)
+    let (_, s, mut v, texel) = best;
+    if let (Some(q), Some(t)) = (texel, g.targets) {
+        let h_c = texel_height(atlas.appearance(q.0, q.1)) + v;
+        v = nudge(v, h_c, t[i]);
+    }
+    (s, v)
 }
 
 /// Runs one subpass in place with the reference path only.
 pub fn correct(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams) {
+    correct_guided(atlas, st, p, &Guide::NONE)
+}
+
+/// [`correct`] with control inputs (the oracle of `super::correct_guided`).
+pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: &Guide<'_>) {
     let (w, h) = (st.width, st.height);
-    (p.py as usize..h).into_par_iter().step_by(2).for_each(|y| {
-        for x in (p.px as usize..w).step_by(2) {
-            let (s, v) = correct_pixel(atlas, st, x as i32, y as i32);
-            st.set(y * w + x, s, v);
-        }
-    });
+    let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, w, h]);
+    (p.py as usize..y1.min(h))
+        .into_par_iter()
+        .step_by(2)
+        .filter(|&y| y >= y0)
+        .for_each(|y| {
+            for x in (p.px as usize..x1.min(w)).step_by(2).filter(|&x| x >= x0) {
+                let (s, v) = correct_pixel_guided(atlas, st, x as i32, y as i32, g);
+                st.set(y * w + x, s, v);
+            }
+        });
 }

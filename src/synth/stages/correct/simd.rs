@@ -21,8 +21,9 @@
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 
-use super::{CLAMP, DELTAS, DIAGONALS};
+use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, scalar, weigh};
 use crate::synth::atlas::AtlasLevel;
+use crate::synth::control::blend::nudge;
 use crate::synth::fixed::{Coord, FRAC_BITS, div_floor, round};
 use crate::synth::state::State;
 use wide::{i16x8, i32x8};
@@ -74,13 +75,27 @@ struct Neighbourhood {
 /// `score`).
 #[inline(always)]
 fn score(app: &[u64], ns: &Neighbourhood, q: i32, s: i32, kappa: u32) -> (u32, i32) {
+    score_with(app, ns, q, s, kappa, None)
+}
+
+/// [`score`] with the offset fixed to `fixed` when given (the coherence
+/// candidate keeps its own offset).
+#[inline(always)]
+fn score_with(
+    app: &[u64],
+    ns: &Neighbourhood,
+    q: i32,
+    s: i32,
+    kappa: u32,
+    fixed: Option<i32>,
+) -> (u32, i32) {
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
     let m01 = i32x8::from_i16x8(pair(app, q - s - 1, q - s + 1));
     let m23 = i32x8::from_i16x8(pair(app, q + s - 1, q + s + 1));
     let d01 = ns.ns01 - (m01 + m01 + m01);
     let d23 = ns.ns23 - (m23 + m23 + m23);
     let (a, b) = (d01.to_array(), d23.to_array());
-    let h = div_floor(a[0] + a[4] + b[0] + b[4] + 6, 12);
+    let h = fixed.unwrap_or_else(|| div_floor(a[0] + a[4] + b[0] + b[4] + 6, 12));
     let h3 = 3 * h;
     let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
     // Clamping after the saturating narrowing equals clamping before it
@@ -118,12 +133,19 @@ struct Pending {
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of row `y`, all at least two
 /// texels inside the level, writing each result as it is found.
-pub fn correct_span(atlas: &AtlasLevel<'_>, st: &State, y: usize, x0: usize, x1: usize) {
+pub fn correct_span(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    g: &Guide<'_>,
+) {
     let mut grid = [[Tap::default(); GRID_COLS]; 5];
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
-        correct_chunk(atlas, st, y, a, b, &mut grid);
+        correct_chunk(atlas, st, y, a, b, &mut grid, g);
         a = b;
     }
 }
@@ -138,6 +160,7 @@ fn correct_chunk(
     x0: usize,
     x1: usize,
     grid: &mut [[Tap; GRID_COLS]; 5],
+    g: &Guide<'_>,
 ) {
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
@@ -161,7 +184,14 @@ fn correct_chunk(
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
             let i = y * w + x0 + 2 * k;
-            let (s, v) = decide(atlas, st, grid, 2 * k + 2, i, &ring[k % RING]);
+            // Type-constrained pixels take the scalar path (rejection and
+            // seeding live there; they are few and at coarse levels).
+            let (s, v) = match g.allowed {
+                Some(a) if a[i] != ALL_TYPES => {
+                    scalar::correct_pixel_guided(atlas, st, (x0 + 2 * k) as i32, y as i32, g)
+                }
+                _ => decide(atlas, st, grid, 2 * k + 2, i, &ring[k % RING], g),
+            };
             st.set(i, s, v);
         }
     }
@@ -236,6 +266,7 @@ fn decide(
     c: usize,
     pixel: usize,
     p: &Pending,
+    g: &Guide<'_>,
 ) -> (Coord, i32) {
     let app = atlas.level.appearance;
     // N_S (eq. 5–6): per diagonal δ, g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a
@@ -265,17 +296,51 @@ fn decide(
         ns01: pairs(0),
         ns23: pairs(2),
     };
-    // Ties keep the earlier candidate (DELTAS order, C₁ before C₂).
-    let mut best = (u32::MAX, 0usize, 0i32);
+    // The coherence candidate first (a tie keeps the previous result), then
+    // the rest in DELTAS order, C₁ before C₂ (ties keep the earlier).
+    if let Some(c) = &g.coherence {
+        let (prev, v) = (c.coords[pixel], c.offsets[pixel]);
+        let col = &atlas.columns[round(prev.x) as usize];
+        let idx = col.base + round(prev.y) * col.stride as i32 + round(prev.x);
+        let (sc, _) = score_with(app, ns, idx, col.stride as i32, 1, Some(v));
+        let cost = weigh(sc, c.weights[pixel]);
+        let (best, i, hh) = best_of(app, ns, p, cost);
+        if i == usize::MAX {
+            return (prev, v);
+        }
+        return finish(atlas, st, pixel, p, (best, i, hh), g);
+    }
+    let winner = best_of(app, ns, p, u32::MAX);
+    finish(atlas, st, pixel, p, winner, g)
+}
+
+/// The best gathered candidate whose cost is below `bar`:
+/// (cost, index, optimal offset), index `usize::MAX` if none is.
+#[inline(always)]
+fn best_of(app: &[u64], ns: &Neighbourhood, p: &Pending, bar: u32) -> (u32, usize, i32) {
+    let mut best = (bar, usize::MAX, 0i32);
     for (i, c) in p.cands[..p.count].iter().enumerate() {
         let (sc, hh) = score(app, ns, c.idx, c.stride, c.kappa);
         if sc < best.0 {
             best = (sc, i, hh);
         }
     }
-    debug_assert!(best.0 < u32::MAX);
+    best
+}
+
+/// The winner's coordinate (with the fraction of the neighbour it came
+/// from) and its offset, nudged towards a geometric target if any.
+#[inline(always)]
+fn finish(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    pixel: usize,
+    p: &Pending,
+    best: (u32, usize, i32),
+    g: &Guide<'_>,
+) -> (Coord, i32) {
+    debug_assert!(best.1 < p.count);
     let q = p.cands[best.1];
-    // The winner keeps the fraction of the neighbour it came from.
     let (dx, dy) = DELTAS[q.from as usize];
     let n = st.s((pixel as isize + dy as isize * st.width as isize + dx as isize) as usize);
     let frac = |v: i32| v - (round(v) << FRAC_BITS);
@@ -283,7 +348,12 @@ fn decide(
         x: (q.x << FRAC_BITS) + frac(n.x),
         y: (q.y << FRAC_BITS) + frac(n.y),
     };
-    (s, best.2)
+    let mut v = best.2;
+    if let Some(t) = g.targets {
+        let h_c = scalar::texel_height(atlas.level.appearance[q.idx as usize]) + v;
+        v = nudge(v, h_c, t[pixel]);
+    }
+    (s, v)
 }
 
 /// One candidate of the pixel being corrected.

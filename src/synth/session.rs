@@ -1,0 +1,531 @@
+//! Editing sessions (paper §5.3, DESIGN §2): a sequence of edits, each
+//! re-synthesized coherently with the previous frame.
+//!
+//! Per frame, W⁰ (quarters) is 4 (unweighted) inside the influence of the
+//! constraints, type paint and pastes edited in this step, 1 (coherent,
+//! 0.25) elsewhere and 0 where frozen (freezing brush, pasted regions);
+//! W^i follows by `reduce_weights`. The previous frame's per-pass results
+//! are the coherence candidates, and with [`Session::restrict`] only the
+//! region that can change is re-synthesized (exactly, see
+//! [`crate::synth::Guides::restrict`]).
+
+use super::control::{
+    Blend, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED, inside,
+};
+use super::fixed::Coord;
+use super::stages::correct::ALL_TYPES;
+use super::stages::reduce_types::reduce_types;
+use super::stages::reduce_weights::reduce_weights;
+use super::state::{level_size, top_level};
+use super::{Frames, Guides, LevelGuide, Params, SynthError, Synthesizer};
+use crate::database::Database;
+use crate::heightfield::Heightfield;
+use std::sync::Arc;
+use std::time::Duration;
+use thiserror::Error;
+
+/// Weights in quarters (paper §5.3).
+pub const W_FROZEN: u8 = 0;
+pub const W_COHERENT: u8 = 1;
+pub const W_FREE: u8 = 4;
+
+/// Pixels around a paste left unweighted in its step, so it blends in.
+pub const PASTE_MARGIN: f64 = 8.0;
+
+/// One change to the controls.
+#[derive(Debug, Clone)]
+pub enum Edit {
+    /// Adds a constraint, or replaces the one with this id.
+    SetConstraint(ConstraintId, Arc<dyn super::control::Constraint>),
+    RemoveConstraint(ConstraintId),
+    /// Replaces R⁰ (see [`Controls::types`]); None clears it.
+    PaintTypes(Option<Vec<u8>>),
+    /// Replaces the freeze mask; None clears it.
+    Freeze(Option<Vec<bool>>),
+    Paste(Paste),
+}
+
+/// Invalid edits and sessions.
+#[non_exhaustive]
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SessionError {
+    #[error(transparent)]
+    Synth(#[from] SynthError),
+    #[error("removing constraint {0}: no constraint has this id")]
+    NoConstraint(u64),
+    #[error("{what} has {got} pixels: expected {width}×{height} = {}", width * height)]
+    MaskSize {
+        what: &'static str,
+        got: usize,
+        width: usize,
+        height: usize,
+    },
+    #[error("type map pixel ({x}, {y}) has type {id}: expected 0..={max} or 255 (unconstrained)")]
+    TypeId {
+        x: usize,
+        y: usize,
+        id: u8,
+        max: usize,
+    },
+    #[error("paste source exemplar {index} does not exist: the database has {count}")]
+    PasteExemplar { index: usize, count: usize },
+    #[error("paste lasso has {0} points: expected at least 3")]
+    PasteLasso(usize),
+    #[error("paste height offset {0} m is invalid: expected a finite value")]
+    PasteDelta(f64),
+}
+
+/// Where a frame differs from the one before.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Change {
+    /// Per output pixel: the height changed (any bit).
+    pub mask: Vec<bool>,
+    /// How many pixels changed.
+    pub pixels: usize,
+    /// Bounds `[x0, y0, x1, y1)` of the changed pixels.
+    pub bounds: Option<[usize; 4]>,
+}
+
+/// One synthesized frame.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    pub heightfield: Heightfield,
+    /// None for the first frame.
+    pub change: Option<Change>,
+    pub time: Duration,
+}
+
+/// An editing session on one output.
+pub struct Session<'db> {
+    synth: Synthesizer<'db>,
+    width: usize,
+    height: usize,
+    seed: u32,
+    controls: Controls,
+    blend: Blend,
+    /// The last frame's per-pass results and rasters.
+    frames: Option<Frames>,
+    guides: Option<Guides>,
+    /// Per level (index = level), pasted pixels: frozen, with stored S, V.
+    pasted: Vec<Vec<bool>>,
+    /// Per level, pixels pasted in the current step.
+    fresh: Vec<Vec<bool>>,
+    last: Option<Heightfield>,
+    /// Use coherence (paper §5.3); off = every frame from scratch.
+    pub coherence: bool,
+    /// Re-synthesize only where the frame can change (same bytes).
+    pub restrict: bool,
+}
+
+impl<'db> Session<'db> {
+    pub fn new(
+        db: &'db Database,
+        params: Params,
+        width: usize,
+        height: usize,
+        seed: u32,
+    ) -> Result<Session<'db>, SessionError> {
+        crate::heightfield::check_dims(width, height).map_err(SynthError::from)?;
+        let synth = Synthesizer::new(db, params)?;
+        let last = (db.level_count() - 1).min(top_level(width, height));
+        let pasted = (0..=last)
+            .map(|i| {
+                let (w, h) = level_size(width, height, i);
+                vec![false; w * h]
+            })
+            .collect();
+        Ok(Session {
+            fresh: Vec::new(),
+            blend: Blend::new(width, height, last, db.quantization()),
+            synth,
+            width,
+            height,
+            seed,
+            controls: Controls::default(),
+            frames: None,
+            guides: None,
+            pasted,
+            last: None,
+            coherence: true,
+            restrict: true,
+        })
+    }
+
+    pub fn controls(&self) -> &Controls {
+        &self.controls
+    }
+
+    /// The last frame's heights.
+    pub fn heightfield(&self) -> Option<&Heightfield> {
+        self.last.as_ref()
+    }
+
+    /// Applies edits (all or none) and re-synthesizes.
+    pub fn apply(&mut self, edits: Vec<Edit>) -> Result<Frame, SessionError> {
+        let t = std::time::Instant::now();
+        for e in &edits {
+            self.check(e)?;
+        }
+        // A paste writes into the previous frame: make one first.
+        if self.frames.is_none() && edits.iter().any(|e| matches!(e, Edit::Paste(_))) {
+            let (pastes, rest): (Vec<_>, Vec<_>) =
+                edits.into_iter().partition(|e| matches!(e, Edit::Paste(_)));
+            self.apply(rest)?;
+            let mut frame = self.apply(pastes)?;
+            frame.change = None;
+            frame.time = t.elapsed();
+            return Ok(frame);
+        }
+        self.fresh = self.pasted.iter().map(|p| vec![false; p.len()]).collect();
+        let (w0, h0) = level_size(self.width, self.height, 0);
+        let mut weights = vec![W_COHERENT; w0 * h0];
+        let mark = |c: &dyn super::control::Constraint, weights: &mut Vec<u8>| {
+            free_within(c, weights, w0, h0)
+        };
+        for e in edits {
+            match e {
+                Edit::SetConstraint(id, c) => {
+                    if let Some(old) = self.controls.constraints.insert(id, c.clone()) {
+                        self.blend.subtract(&*old);
+                        mark(&*old, &mut weights);
+                    }
+                    self.blend.add(&*c);
+                    mark(&*c, &mut weights);
+                }
+                Edit::RemoveConstraint(id) => {
+                    let old = self.controls.constraints.remove(&id).expect("checked");
+                    self.blend.subtract(&*old);
+                    mark(&*old, &mut weights);
+                }
+                Edit::PaintTypes(map) => {
+                    let before = self.controls.types.take();
+                    for y in 0..self.height {
+                        for x in 0..self.width {
+                            let i = y * self.width + x;
+                            let get =
+                                |m: &Option<Vec<u8>>| m.as_ref().map_or(UNCONSTRAINED, |m| m[i]);
+                            if get(&before) != get(&map) {
+                                weights[y * w0 + x] = W_FREE;
+                            }
+                        }
+                    }
+                    self.controls.types = map;
+                }
+                Edit::Freeze(mask) => self.controls.freeze = mask,
+                Edit::Paste(p) => {
+                    self.paste(&p, &mut weights);
+                    self.controls.pastes.push(p);
+                }
+            }
+        }
+        if let Some(f) = &self.controls.freeze {
+            for y in 0..self.height {
+                for x in 0..self.width {
+                    if f[y * self.width + x] {
+                        weights[y * w0 + x] = W_FROZEN;
+                    }
+                }
+            }
+        }
+        for (i, p) in self.pasted[0].iter().enumerate() {
+            if *p {
+                weights[i] = W_FROZEN;
+            }
+        }
+        let guides = self.guides(weights);
+        let prev = if self.coherence {
+            self.frames.as_ref()
+        } else {
+            None
+        };
+        let (out, frames) =
+            self.synth
+                .run_with(self.width, self.height, self.seed, &guides, prev, true)?;
+        let hf = out.heightfield;
+        let change = self.last.as_ref().map(|old| change(old, &hf));
+        self.frames = frames;
+        self.guides = Some(guides);
+        self.last = Some(hf.clone());
+        Ok(Frame {
+            heightfield: hf,
+            change,
+            time: t.elapsed(),
+        })
+    }
+
+    /// Validates an edit before anything changes.
+    fn check(&self, e: &Edit) -> Result<(), SessionError> {
+        let n = self.width * self.height;
+        let size = |what, got| {
+            if got == n {
+                Ok(())
+            } else {
+                Err(SessionError::MaskSize {
+                    what,
+                    got,
+                    width: self.width,
+                    height: self.height,
+                })
+            }
+        };
+        match e {
+            Edit::SetConstraint(..) => Ok(()),
+            Edit::RemoveConstraint(id) => match self.controls.constraints.contains_key(id) {
+                true => Ok(()),
+                false => Err(SessionError::NoConstraint(id.0)),
+            },
+            Edit::PaintTypes(None) | Edit::Freeze(None) => Ok(()),
+            Edit::PaintTypes(Some(m)) => {
+                size("type map", m.len())?;
+                let max = self.synth.database().type_names().len() - 1;
+                match m
+                    .iter()
+                    .position(|&t| t != UNCONSTRAINED && t as usize > max)
+                {
+                    None => Ok(()),
+                    Some(i) => Err(SessionError::TypeId {
+                        x: i % self.width,
+                        y: i / self.width,
+                        id: m[i],
+                        max,
+                    }),
+                }
+            }
+            Edit::Freeze(Some(m)) => size("freeze mask", m.len()),
+            Edit::Paste(p) => {
+                let count = self.synth.database().meta().exemplars.len();
+                if let PasteSource::Exemplar(index) = p.source
+                    && index >= count
+                {
+                    return Err(SessionError::PasteExemplar { index, count });
+                }
+                if p.lasso.len() < 3 {
+                    return Err(SessionError::PasteLasso(p.lasso.len()));
+                }
+                if !p.delta_m.is_finite() {
+                    return Err(SessionError::PasteDelta(p.delta_m));
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Per-level rasters of this frame, with the pixels whose inputs differ
+    /// from the previous frame's marked dirty.
+    fn guides(&self, w0: Vec<u8>) -> Guides {
+        let db = self.synth.database();
+        let last = self.pasted.len() - 1;
+        let cell = self.synth.cell_size_m();
+        let full = ((1u64 << db.type_names().len()) - 1) as u32;
+        let (lw, lh) = level_size(self.width, self.height, 0);
+        let mut allowed = self.controls.types.as_ref().map(|m| {
+            let mut r = vec![ALL_TYPES; lw * lh];
+            for y in 0..self.height {
+                for x in 0..self.width {
+                    let t = m[y * self.width + x];
+                    if t != UNCONSTRAINED {
+                        r[y * lw + x] = 1 << t;
+                    }
+                }
+            }
+            r
+        });
+        let mut weights = w0;
+        let mut levels = Vec::with_capacity(last + 1);
+        for i in 0..=last {
+            let (w, h) = level_size(self.width, self.height, i);
+            if i > 0 {
+                let (cw, ch) = level_size(self.width, self.height, i - 1);
+                allowed = allowed.map(|a| reduce_types(&a, cw, ch, w, h, full));
+                weights = reduce_weights(&weights, cw, ch, w, h);
+                for (k, p) in self.pasted[i].iter().enumerate() {
+                    if *p {
+                        weights[k] = W_FROZEN;
+                    }
+                }
+            }
+            levels.push(LevelGuide {
+                targets: self.blend.targets(i, cell).map(|t| t.cells),
+                allowed: allowed.clone().filter(|_| i >= FIRST_LEVEL),
+                weights: Some(weights.clone()),
+                dirty: None,
+            });
+        }
+        // Dirty: inputs that differ from the previous frame's, or raised
+        // weights (a lowered weight keeps the previous winner).
+        let prev = self.guides.as_ref();
+        for (i, g) in levels.iter_mut().enumerate() {
+            let (w, h) = level_size(self.width, self.height, i);
+            let p = prev.and_then(|p| p.levels.get(i));
+            let none = LevelGuide::default();
+            let p = p.unwrap_or(&none);
+            let mut b: Option<[usize; 4]> = None;
+            for y in 0..h {
+                for x in 0..w {
+                    let k = y * w + x;
+                    let t = |g: &LevelGuide| g.targets.as_ref().map(|t| t[k]);
+                    let a = |g: &LevelGuide| g.allowed.as_ref().map_or(ALL_TYPES, |a| a[k]);
+                    let wt = |g: &LevelGuide| g.weights.as_ref().map_or(W_FREE, |w| w[k]);
+                    let same_t = t(g).unwrap_or(super::control::Target::NONE)
+                        == t(p).unwrap_or(super::control::Target::NONE);
+                    if !same_t || a(g) != a(p) || wt(g) > wt(p) || self.fresh_paste(i, k) {
+                        let px = [x, y, x + 1, y + 1];
+                        b = Some(b.map_or(px, |b| {
+                            [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)]
+                        }));
+                    }
+                }
+            }
+            g.dirty = b;
+        }
+        Guides {
+            levels,
+            restrict: self.restrict && self.coherence,
+        }
+    }
+
+    /// Whether level pixel k received pasted values in this step (its
+    /// previous results were overwritten).
+    fn fresh_paste(&self, level: usize, k: usize) -> bool {
+        self.fresh.get(level).is_some_and(|f| f[k])
+    }
+}
+
+impl Session<'_> {
+    /// Writes a paste's stored S and V (+δ) into the previous frame at the
+    /// target, for every level and pass, freezes it there and leaves a
+    /// margin around it unweighted in this step.
+    fn paste(&mut self, p: &Paste, weights0: &mut [u8]) {
+        let db = self.synth.database();
+        let frames = self.frames.as_mut().expect("a frame exists before a paste");
+        let delta = (p.delta_m / db.quantization().scale_m).round() as i32;
+        // Source mask at level 0, then dilated upwards (any child inside).
+        let (mut sw, mut sh) = match p.source {
+            PasteSource::Terrain => level_size(self.width, self.height, 0),
+            PasteSource::Exemplar(e) => {
+                let r = db.level(0).layout.rects[e];
+                (r.width as usize, r.height as usize)
+            }
+        };
+        let mut mask: Vec<bool> = (0..sw * sh)
+            .map(|k| inside(&p.lasso, (k % sw) as f64 + 0.5, (k / sw) as f64 + 0.5))
+            .collect();
+        for (level, passes) in frames.levels.iter_mut().enumerate() {
+            if level > 0 {
+                let (cw, ch) = (sw, sh);
+                (sw, sh) = match p.source {
+                    PasteSource::Terrain => level_size(self.width, self.height, level),
+                    PasteSource::Exemplar(e) => {
+                        let r = db.level(level).layout.rects[e];
+                        (r.width as usize, r.height as usize)
+                    }
+                };
+                mask = (0..sw * sh)
+                    .map(|k| {
+                        let (x, y) = (k % sw, k / sw);
+                        [(0, 0), (1, 0), (0, 1), (1, 1)].iter().any(|&(dx, dy)| {
+                            let (cx, cy) = (2 * x + dx, 2 * y + dy);
+                            cx < cw && cy < ch && mask[cy * cw + cx]
+                        })
+                    })
+                    .collect();
+            }
+            let (tw, th) = level_size(self.width, self.height, level);
+            let shift = |o: i64| o.div_euclid(1 << level);
+            let (ox, oy) = (shift(p.offset.0), shift(p.offset.1));
+            // Read every source value first: source and target may overlap.
+            let mut writes = Vec::new();
+            for k in (0..sw * sh).filter(|&k| mask[k]) {
+                let (x, y) = ((k % sw) as i64, (k / sw) as i64);
+                let (tx, ty) = (x + ox, y + oy);
+                if tx < 0 || ty < 0 || tx >= tw as i64 || ty >= th as i64 {
+                    continue;
+                }
+                let t = ty as usize * tw + tx as usize;
+                let values: Vec<(Coord, i32)> = match p.source {
+                    PasteSource::Terrain => passes
+                        .iter()
+                        .map(|r| (r.coords[k], r.offsets[k] + delta))
+                        .collect(),
+                    PasteSource::Exemplar(e) => {
+                        let r = db.level(level).layout.rects[e];
+                        let m = crate::database::layout::MARGIN as i64;
+                        if x < m || y < m || x >= r.width as i64 - m || y >= r.height as i64 - m {
+                            continue;
+                        }
+                        let c = Coord::from_texel(r.x0 as i32 + x as i32, y as i32);
+                        vec![(c, delta); passes.len()]
+                    }
+                };
+                writes.push((t, values));
+            }
+            for (t, values) in writes {
+                for (r, (c, v)) in passes.iter_mut().zip(values) {
+                    r.coords[t] = c;
+                    r.offsets[t] = v;
+                }
+                self.pasted[level][t] = true;
+                self.fresh[level][t] = true;
+            }
+        }
+        // Unweighted margin at level 0 (the frozen paste itself is set later).
+        let (w0, h0) = level_size(self.width, self.height, 0);
+        let m = PASTE_MARGIN as i64;
+        let pasted = &self.pasted[0];
+        let fresh = &self.fresh[0];
+        for y in 0..h0 as i64 {
+            for x in 0..w0 as i64 {
+                let near = (-m..=m).any(|dy| {
+                    (-m..=m).any(|dx| {
+                        let (u, v) = (x + dx, y + dy);
+                        u >= 0
+                            && v >= 0
+                            && u < w0 as i64
+                            && v < h0 as i64
+                            && fresh[(v * w0 as i64 + u) as usize]
+                    })
+                });
+                if near && !pasted[(y * w0 as i64 + x) as usize] {
+                    weights0[(y * w0 as i64 + x) as usize] = W_FREE;
+                }
+            }
+        }
+    }
+}
+
+/// Marks level-0 pixels within a constraint's reach unweighted.
+fn free_within(c: &dyn super::control::Constraint, weights: &mut [u8], w: usize, h: usize) {
+    let [x0, y0, x1, y1] = c.bounds();
+    let clip = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n);
+    for y in clip(y0, h)..clip(y1 + 1.0, h) {
+        for x in clip(x0, w)..clip(x1 + 1.0, w) {
+            let s = c.sample(x as f64 + 0.5, y as f64 + 0.5);
+            if s.is_some_and(|s| s.distance <= s.reach) {
+                weights[y * w + x] = W_FREE;
+            }
+        }
+    }
+}
+
+/// Where `new` differs from `old` (same size), bit for bit.
+fn change(old: &Heightfield, new: &Heightfield) -> Change {
+    let w = new.width();
+    let mask: Vec<bool> = old
+        .data()
+        .iter()
+        .zip(new.data())
+        .map(|(a, b)| a.to_bits() != b.to_bits())
+        .collect();
+    let mut bounds: Option<[usize; 4]> = None;
+    for (k, _) in mask.iter().enumerate().filter(|(_, c)| **c) {
+        let (x, y) = (k % w, k / w);
+        bounds = Some(bounds.map_or([x, y, x + 1, y + 1], |b| {
+            [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)]
+        }));
+    }
+    Change {
+        pixels: mask.iter().filter(|c| **c).count(),
+        mask,
+        bounds,
+    }
+}

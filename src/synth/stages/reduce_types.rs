@@ -1,0 +1,59 @@
+//! Stage `reduce_types` (paper §5.2): the target-set pyramid R^i. Each
+//! pixel's set is the union of its 2×2 children's sets at level i − 1,
+//! leaving out children whose set is full (unconstrained) — otherwise a
+//! narrow painted band would be washed out by its unconstrained
+//! surroundings at coarse levels. Four full children give a full set.
+//!
+//! Sets are u32 bit masks of type ids; [`ALL_TYPES`] and `full` (every
+//! type of the database) both count as full.
+
+use crate::synth::stages::correct::ALL_TYPES;
+use rayon::prelude::*;
+
+/// R^{i} (`w × h`) from R^{i−1} (`cw × ch`); children past the child
+/// level's edge (odd sizes) are absent.
+pub fn reduce_types(
+    child: &[u32],
+    cw: usize,
+    ch: usize,
+    w: usize,
+    h: usize,
+    full: u32,
+) -> Vec<u32> {
+    let mut out = vec![ALL_TYPES; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            let mut union = 0u32;
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let (cx, cy) = (2 * x + dx, 2 * y + dy);
+                if cx < cw && cy < ch {
+                    let r = child[cy * cw + cx];
+                    if r != ALL_TYPES && r & full != full {
+                        union |= r;
+                    }
+                }
+            }
+            if union != 0 {
+                *o = union;
+            }
+        }
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn union_ignores_full_sets() {
+        let full = 0b111;
+        #[rustfmt::skip]
+        let r0 = [
+            ALL_TYPES, 0b001, full, full, 0b100,
+            ALL_TYPES, 0b010, full, full, ALL_TYPES,
+        ];
+        let r1 = reduce_types(&r0, 5, 2, 3, 1, full);
+        assert_eq!(r1, vec![0b011, ALL_TYPES, 0b100]);
+    }
+}
