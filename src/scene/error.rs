@@ -44,6 +44,10 @@ pub enum SceneErrorKind {
     #[error(transparent)]
     Curve(#[from] crate::synth::control::curve::CurveError),
     #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    #[error(transparent)]
+    Session(#[from] crate::synth::session::SessionError),
+    #[error(transparent)]
     Control(#[from] crate::synth::control::ControlError),
 }
 

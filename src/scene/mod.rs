@@ -65,10 +65,13 @@
 //! [`Scene::freeze_raster`] read the referenced images and check them
 //! against the scene and the database.
 
+mod controls;
 mod error;
+pub mod overlay;
 mod parse;
 mod raster;
 
+pub use controls::{SceneEdits, polygon_centroid};
 pub use error::{SceneError, SceneErrorKind};
 pub use raster::stroke_mask;
 
