@@ -12,10 +12,15 @@
 //!   length (a twiced Gaussian, σ = [`sigma`] of the largest reach), which
 //!   removes steps without moving smooth parts of the boundary noticeably.
 //! - The effective reach at a node is `d + s`, with `s` the signed distance
-//!   to the smoothed loops (positive inside, even-odd rule). Inside ⇔
-//!   `d ≤ reach_eff`, and away from the jumps `reach_eff ≈ reach(t)`; being
-//!   the sum of two 1-Lipschitz functions it changes by at most 2 per pixel
-//!   everywhere, so the extent has no discontinuity left.
+//!   to the smoothed loops (positive inside, even-odd rule) clamped to
+//!   ±[`BAND`]. Inside ⇔ `d ≤ reach_eff`, and within the band (where the
+//!   boundary is) `reach_eff ≈ reach(t)` away from the jumps; being the sum
+//!   of two 1-Lipschitz functions it changes by at most 2 per pixel
+//!   everywhere, so the extent has no discontinuity left. Deeper inside,
+//!   `d + BAND` is a lower bound of the true extent: the overlap blend only
+//!   asks whether `d ≤ min(reach, 4·2^i)`, which the bound answers exactly,
+//!   and the clamp keeps the search local (envelope rebuild of a 1024-px
+//!   meander, reach 60 px: 578 → 304 ms on 2 cores, `benches/curve.rs`).
 
 use super::segments::Segments;
 use glam::DVec2;
@@ -158,16 +163,13 @@ fn gaussian(r: &[DVec2], sigma: f64) -> Vec<DVec2> {
         .collect()
 }
 
+/// How far from the smoothed boundary the effective reach is exact, pixels.
+pub const BAND: f64 = 16.0;
+
 /// Effective reach per node: `d + s`, `s` the signed distance to `loops`
-/// (lattice coordinates; positive inside by the even-odd rule), searched out
-/// to `limit`; rows in parallel.
-pub fn effective_reach(
-    loops: &[Vec<DVec2>],
-    d: &[f64],
-    w: usize,
-    h: usize,
-    limit: f64,
-) -> Vec<f32> {
+/// (lattice coordinates; positive inside by the even-odd rule) clamped to
+/// ±[`BAND`]; rows in parallel.
+pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> Vec<f32> {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for lp in loops {
         for k in 0..lp.len() {
@@ -197,8 +199,8 @@ pub fn effective_reach(
             }
             let inside = xs.partition_point(|&c| c <= x) % 2 == 1;
             let s = segs
-                .closest(DVec2::new(x, y), limit)
-                .map_or(limit, |h| h.dist);
+                .closest(DVec2::new(x, y), BAND)
+                .map_or(BAND, |h| h.dist);
             *slot = (di + if inside { s } else { -s }) as f32;
         }
     });
@@ -225,7 +227,7 @@ mod tests {
             assert!((p.distance(DVec2::splat(20.0)) - 12.0).abs() < 0.15, "{p}");
         }
         let d: Vec<f64> = vec![0.0; w * h];
-        let r = effective_reach(&loops, &d, w, h, 40.0);
+        let r = effective_reach(&loops, &d, w, h);
         assert!(r[20 * w + 20] > 11.5 && r[20 * w + 20] < 12.5);
         assert!(r[0] < 0.0);
     }

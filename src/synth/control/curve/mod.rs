@@ -374,13 +374,13 @@ impl Curve {
             envelope: Vec::new(),
             raw_envelope: Vec::new(),
         };
-        curve.build_envelope(sigma, margin);
+        curve.build_envelope(sigma);
         Ok(curve)
     }
 
     /// Raw envelope `d − reach(t)` per node, its isocurve, the smoothed
     /// isocurve, and the effective reach.
-    fn build_envelope(&mut self, sigma: f64, margin: f64) {
+    fn build_envelope(&mut self, sigma: f64) {
         use rayon::prelude::*;
         let f = &self.field;
         let (w, h) = (f.width, f.height);
@@ -407,7 +407,7 @@ impl Curve {
             .iter()
             .map(|l| envelope::smooth_loop(l, sigma))
             .collect();
-        self.reach_eff = envelope::effective_reach(&smoothed, &d, w, h, margin + 2.0 * sigma);
+        self.reach_eff = envelope::effective_reach(&smoothed, &d, w, h);
         let shift = |ls: &[Vec<DVec2>]| -> Vec<Vec<DVec2>> {
             ls.iter()
                 .map(|l| l.iter().map(|p| *p + origin).collect())

@@ -280,3 +280,39 @@ fn bad_curves_are_errors() {
     let e = build(&[straight(vec![bad])], &[], 1.0, &cache).unwrap_err();
     assert!(e.to_string().contains("reach"), "{e}");
 }
+
+#[test]
+fn builds_are_identical_on_any_thread_count() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let c = arc();
+            let mut bits = Vec::new();
+            for j in 0..100 {
+                for i in 0..100 {
+                    if let Some(s) = c.sample(i as f64, j as f64) {
+                        bits.extend([
+                            s.target_m.to_bits(),
+                            s.distance.to_bits(),
+                            s.reach.to_bits(),
+                        ]);
+                    }
+                }
+            }
+            let env: Vec<u64> = c
+                .envelope()
+                .iter()
+                .flatten()
+                .flat_map(|p| [p.x.to_bits(), p.y.to_bits()])
+                .collect();
+            (bits, env)
+        })
+    };
+    let one = run(1);
+    assert!(one.0.len() > 3000);
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(3));
+}
