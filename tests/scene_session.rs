@@ -322,3 +322,44 @@ fn cli_synth_scene_and_edit_write_frames_previews_and_a_report() {
     assert!(err.contains("curves[0].points"), "{err}");
     assert!(!dir.path().join("bad").exists());
 }
+
+#[test]
+fn overlays_draw_curves_widgets_points_types_and_frozen_regions() {
+    let Some((db, lo, hi)) = db() else { return };
+    let mut v = curve_scene(*lo, *hi, lo + 0.6 * (hi - lo));
+    v["freeze"] = json!({"strokes": [{"points": [[200, 40]], "radius_px": 12}]});
+    v["types"] = json!({"strokes": [{"type": db.type_names()[0].clone(), "points": [[40, 230]], "radius_px": 10}]});
+    let sc = scene(v);
+    let mut edits = SceneEdits::new();
+    let first = edits.edits(&sc, db).unwrap();
+    let mut session = Session::new(db, SceneEdits::params(&sc), SIZE, SIZE, sc.seed).unwrap();
+    let hf = session.apply(first).unwrap().heightfield;
+    let names = db.type_names();
+    let plain = terrasynth::scene::overlay::preview(&hf, &sc, &edits, names, false).unwrap();
+    let drawn = terrasynth::scene::overlay::preview(&hf, &sc, &edits, names, true).unwrap();
+    assert_eq!(plain.dimensions(), drawn.dimensions());
+    let k = plain.width() as f64 / SIZE as f64;
+    let px =
+        |img: &image::RgbaImage, x: f64, y: f64| *img.get_pixel((x * k) as u32, (y * k) as u32);
+    let c = &edits.curves()[0].1;
+    // The curve is drawn dark along its length.
+    for f in [0.1, 0.3, 0.7, 0.9] {
+        let q = c.point_at(f * c.length());
+        let p = px(&drawn, q.x, q.y);
+        assert!(p[0] < 60 && p[1] < 60 && p[2] < 60, "curve at {f}: {p:?}");
+    }
+    // The middle widget is a yellow diamond.
+    let q = c.point_at(0.5 * c.length());
+    let p = px(&drawn, q.x, q.y);
+    assert!(p[0] > 200 && p[1] > 170 && p[2] < 80, "widget: {p:?}");
+    // The point: its site is cyan.
+    let p = px(&drawn, 60.0, 200.0);
+    assert!(p[0] < 80 && p[2] > 200, "point: {p:?}");
+    // Frozen region is washed lighter; the painted type tinted.
+    let (a, b) = (px(&plain, 200.0, 40.0), px(&drawn, 200.0, 40.0));
+    assert!(
+        b[0] as i32 + b[1] as i32 + b[2] as i32 > a[0] as i32 + a[1] as i32 + a[2] as i32,
+        "{a:?} {b:?}"
+    );
+    assert_ne!(px(&plain, 40.0, 230.0), px(&drawn, 40.0, 230.0));
+}
