@@ -316,3 +316,53 @@ fn builds_are_identical_on_any_thread_count() {
     assert_eq!(one, run(2));
     assert_eq!(one, run(3));
 }
+
+mod prop {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Any sketch builds, and every sample is inside the bounds, within
+        /// its reach, finite, and exact in distance to the smoothed curve.
+        #[test]
+        fn random_curves_build_and_sample_consistently(
+            pts in proptest::collection::vec((0.0f64..64.0, 0.0f64..64.0), 2..8),
+            reach in (1.0f64..20.0, 1.0f64..20.0),
+            slope in (-60.0f64..60.0, -60.0f64..60.0),
+            smoothing in 0u32..4,
+        ) {
+            let points: Vec<DVec2> = pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
+            prop_assume!(points.windows(2).any(|w| w[0].distance(w[1]) > 0.5));
+            let spec = CurveSpec {
+                points,
+                widgets: vec![
+                    widget(0.0, 100.0, [slope.0, slope.1], [reach.0, reach.1]),
+                    widget(1.0, 300.0, [slope.1, slope.0], [reach.1, reach.0]),
+                ],
+                smoothing,
+            };
+            let (curves, _) = build(&[spec], &[], 10.0, &FieldCache::new()).unwrap();
+            let c = &curves[0];
+            let [x0, y0, x1, y1] = c.bounds();
+            let pts = c.points();
+            for j in -30..100 {
+                for i in -30..100 {
+                    let (x, y) = (i as f64, j as f64);
+                    let Some(s) = c.sample(x, y) else { continue };
+                    prop_assert!(x >= x0 && x < x1 && y >= y0 && y < y1);
+                    prop_assert!(s.distance <= s.reach && s.target_m.is_finite());
+                    let brute = pts
+                        .windows(2)
+                        .map(|w| {
+                            let d = w[1] - w[0];
+                            let u = ((DVec2::new(x, y) - w[0]).dot(d) / d.length_squared().max(1e-300)).clamp(0.0, 1.0);
+                            DVec2::new(x, y).distance(w[0] + d * u)
+                        })
+                        .fold(f64::INFINITY, f64::min);
+                    prop_assert!((s.distance - brute).abs() < 1e-9, "{} vs {brute}", s.distance);
+                }
+            }
+        }
+    }
+}
