@@ -156,7 +156,8 @@ impl SceneEdits {
                         | curve::CurveError::ZeroLength { curve }
                         | curve::CurveError::NoWidget { curve }
                         | curve::CurveError::Value { curve, .. }
-                        | curve::CurveError::TooLarge { curve, .. } => format!("curves[{curve}]"),
+                        | curve::CurveError::TooLarge { curve, .. }
+                        | curve::CurveError::TooLong { curve, .. } => format!("curves[{curve}]"),
                         _ => "junctions".to_string(),
                     };
                     err(&path, e.into())

@@ -110,10 +110,24 @@ pub enum CurveError {
     )]
     TooLarge { curve: usize, reach: f64 },
     #[error(
+        "curve {curve} is {length:.0} px long after smoothing ({points} points): at most {max} px and {max} smoothed points",
+        max = MAX_LENGTH_PX
+    )]
+    TooLong {
+        curve: usize,
+        length: f64,
+        points: usize,
+    },
+    #[error(
         "junction height at ({x}, {y}) matches no junction: the curves cross nowhere within {JUNCTION_SNAP} px of it"
     )]
     NoJunction { x: f64, y: f64 },
 }
+
+/// Longest curve, output pixels of arc length (and most points after
+/// smoothing): its resampled form holds one point per pixel, so this bounds
+/// the memory a hostile scene can ask for (64 MiB).
+pub const MAX_LENGTH_PX: f64 = (1 << 22) as f64;
 
 /// Largest reach, output pixels.
 pub const MAX_REACH_PX: f64 = 4096.0;
@@ -230,7 +244,17 @@ fn shape(curve: usize, spec: &CurveSpec) -> Result<(Vec<DVec2>, Vec<f64>), Curve
             }
         }
     }
-    let smoothed = smooth::chaikin(&spec.points, spec.smoothing.min(8));
+    let iterations = spec.smoothing.min(8);
+    let length: f64 = spec.points.windows(2).map(|w| w[0].distance(w[1])).sum();
+    let smoothed_points = (spec.points.len() as f64) * f64::from(1u32 << iterations);
+    if length > MAX_LENGTH_PX || smoothed_points > MAX_LENGTH_PX {
+        return Err(CurveError::TooLong {
+            curve,
+            length,
+            points: spec.points.len() << iterations,
+        });
+    }
+    let smoothed = smooth::chaikin(&spec.points, iterations);
     let pts = smooth::resample(&smoothed).ok_or(CurveError::ZeroLength { curve })?;
     let cum = smooth::arc_lengths(&pts);
     Ok((pts, cum))

@@ -276,6 +276,18 @@ fn bad_curves_are_errors() {
         build(&[straight(vec![])], &[], 1.0, &cache),
         Err(CurveError::NoWidget { .. })
     ));
+    // A zig-zag 2^22 px long would resample to 4 M points: refused up front.
+    let zig = CurveSpec {
+        points: (0..70_000)
+            .map(|k| DVec2::new((k % 2) as f64 * 60.0, 0.0))
+            .collect(),
+        widgets: vec![w],
+        smoothing: 0,
+    };
+    assert!(matches!(
+        build(&[zig], &[], 1.0, &cache),
+        Err(CurveError::TooLong { curve: 0, .. })
+    ));
     let bad = widget(0.5, 0.0, [0.0; 2], [0.0, 5.0]);
     let e = build(&[straight(vec![bad])], &[], 1.0, &cache).unwrap_err();
     assert!(e.to_string().contains("reach"), "{e}");
