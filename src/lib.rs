@@ -20,6 +20,7 @@ pub mod procedural;
 pub mod progress;
 pub mod render;
 pub mod resample;
+pub mod scene;
 pub mod synth;
 
 pub use error::{Error, Result, SizeError};

@@ -4,6 +4,7 @@ mod args;
 mod bench;
 mod convert;
 mod db;
+mod edit;
 mod generate;
 mod info;
 mod progress;
@@ -37,6 +38,9 @@ enum Command {
     Db(db::Command),
     /// Synthesize a terrain from real exemplars (the embedded ones by default).
     Synth(synth::Args),
+    /// Apply scene files in order as edits of one session, writing every
+    /// frame, its preview and a report of where the terrain changed.
+    Edit(edit::Args),
     /// Draw a shaded relief map (PNG) of a heightfield.
     Render(render::Args),
     /// Generate a procedural terrain in a default exemplar style (see --list).
@@ -55,6 +59,7 @@ fn main() -> ExitCode {
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),
         Command::Synth(a) => synth::run(a),
+        Command::Edit(a) => edit::run(a),
         Command::Generate(a) => generate::run(a),
     };
     match result {

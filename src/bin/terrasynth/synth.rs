@@ -41,9 +41,20 @@ pub struct Args {
     /// builds) or auto (the GPU if there is one). Same output bytes on each.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     backend: BackendArg,
+    /// A scene file (see data/scenes/): its database, size, seed and
+    /// controls replace --db, --size, --seed, --jitter, --passes and
+    /// --start-exemplar; the preview shows the controls.
+    #[arg(long, conflicts_with_all = ["db", "coords"])]
+    scene: Option<PathBuf>,
+    /// With --scene: a preview without the controls drawn on it.
+    #[arg(long, requires = "scene")]
+    no_overlay: bool,
 }
 
 pub fn run(a: Args) -> CliResult {
+    if let Some(scene) = &a.scene {
+        return crate::edit::synth_scene(scene, &a.output, a.preview.as_deref(), !a.no_overlay);
+    }
     let db = load_database(a.db.as_deref())?;
     let params = Params {
         jitter: a.jitter,

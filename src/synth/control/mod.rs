@@ -12,6 +12,7 @@
 //! ((x + 0.5)·2^i, (y + 0.5)·2^i).
 
 pub mod blend;
+pub mod curve;
 pub mod point;
 
 pub use blend::{Blend, Target, Targets};

@@ -1,0 +1,237 @@
+//! The curve's distance field: for every integer lattice node around the
+//! curve, its closest segment (paper §5.1: "closest-point queries are
+//! accelerated using a distance field that is recomputed only when the
+//! horizontal shape of the curve changes").
+//!
+//! Nodes sit at integer output coordinates, i.e. on output pixel corners.
+//! That is exactly where constraints are evaluated: a level-i pixel centre
+//! maps to ((x + ½)·2^i, (y + ½)·2^i), an integer for every i ≥ 1, and
+//! geometric constraints only run on levels ≥ 2. Storing the closest
+//! *segment* (not the distance) keeps the distance exact: a query projects
+//! onto the stored segment(s), so at a node it equals the brute-force
+//! closest-point distance, and between nodes it takes the best of the four
+//! surrounding nodes' segments.
+//!
+//! [`FieldCache`] keys fields on the resampled shape, so changing a widget's
+//! height, slope or reach reuses the field; only a reach that outgrows the
+//! computed margin (or a new shape) recomputes it.
+
+use super::segments::Segments;
+use glam::DVec2;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// No segment within the field's margin.
+pub const NONE: u32 = u32::MAX;
+
+/// Most lattice nodes one field may hold (256 MiB of segment indices).
+pub const MAX_NODES: usize = 1 << 26;
+
+/// The resampled curve and its closest-segment lattice.
+#[derive(Debug)]
+pub struct DistanceField {
+    pub segments: Segments,
+    /// Lattice origin: node (0, 0) is at output position (x0, y0).
+    pub x0: i64,
+    pub y0: i64,
+    pub width: usize,
+    pub height: usize,
+    /// How far from the curve nodes were searched, output pixels.
+    pub margin: f64,
+    /// Closest segment per node, row-major; [`NONE`] beyond the margin.
+    pub seg: Vec<u32>,
+}
+
+impl DistanceField {
+    /// Computes the field around `points` (resampled) out to `margin` pixels,
+    /// rows in parallel. `None` when the lattice would exceed [`MAX_NODES`].
+    pub fn compute(points: &[DVec2], margin: f64) -> Option<DistanceField> {
+        let segments = Segments::polyline(points, false);
+        let (mut lo, mut hi) = (points[0], points[0]);
+        for p in points {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let x0 = (lo.x - margin).floor() as i64 - 1;
+        let y0 = (lo.y - margin).floor() as i64 - 1;
+        let x1 = (hi.x + margin).ceil() as i64 + 1;
+        let y1 = (hi.y + margin).ceil() as i64 + 1;
+        let (width, height) = ((x1 - x0 + 1) as usize, (y1 - y0 + 1) as usize);
+        if width.checked_mul(height)? > MAX_NODES {
+            return None;
+        }
+        let mut seg = vec![NONE; width * height];
+        seg.par_chunks_mut(width).enumerate().for_each(|(j, row)| {
+            let y = (y0 + j as i64) as f64;
+            for (i, slot) in row.iter_mut().enumerate() {
+                let p = DVec2::new((x0 + i as i64) as f64, y);
+                if let Some(h) = segments.closest(p, margin) {
+                    *slot = h.seg;
+                }
+            }
+        });
+        Some(DistanceField {
+            segments,
+            x0,
+            y0,
+            width,
+            height,
+            margin,
+            seg,
+        })
+    }
+
+    /// The stored closest segment of node `(i, j)` (lattice indices).
+    #[inline]
+    pub fn node(&self, i: i64, j: i64) -> u32 {
+        if i < 0 || j < 0 || i >= self.width as i64 || j >= self.height as i64 {
+            return NONE;
+        }
+        self.seg[j as usize * self.width + i as usize]
+    }
+
+    /// Closest point to output position `p`, from the segments stored at
+    /// the (up to four) lattice nodes around it; `None` beyond the margin.
+    pub fn closest(&self, p: DVec2) -> Option<super::segments::Hit> {
+        let (fx, fy) = (p.x - self.x0 as f64, p.y - self.y0 as f64);
+        let (i0, j0) = (fx.floor() as i64, fy.floor() as i64);
+        let (i1, j1) = (fx.ceil() as i64, fy.ceil() as i64);
+        let mut best: Option<super::segments::Hit> = None;
+        for (i, j) in [(i0, j0), (i1, j0), (i0, j1), (i1, j1)] {
+            let s = self.node(i, j);
+            if s == NONE {
+                continue;
+            }
+            let h = self.segments.project(s, p);
+            if best.is_none_or(|b| h.dist < b.dist || (h.dist == b.dist && h.seg < b.seg)) {
+                best = Some(h);
+            }
+        }
+        best
+    }
+}
+
+/// Distance fields by shape, shared by the curves of a scene and across the
+/// frames of an editing session.
+#[derive(Debug, Default)]
+pub struct FieldCache {
+    fields: Mutex<HashMap<u64, Arc<DistanceField>>>,
+    computed: AtomicUsize,
+}
+
+impl FieldCache {
+    pub fn new() -> FieldCache {
+        FieldCache::default()
+    }
+
+    /// How many fields were computed (cache misses) so far.
+    pub fn computed(&self) -> usize {
+        self.computed.load(Ordering::Relaxed)
+    }
+
+    /// The field of `points` with at least `margin`, reused when the same
+    /// shape was seen with a margin at least as large.
+    pub fn get(&self, points: &[DVec2], margin: f64) -> Option<Arc<DistanceField>> {
+        let key = shape_key(points);
+        if let Some(f) = self.fields.lock().expect("not poisoned").get(&key)
+            && f.margin >= margin
+            && same_shape(&f.segments, points)
+        {
+            return Some(f.clone());
+        }
+        let f = Arc::new(DistanceField::compute(points, margin)?);
+        self.computed.fetch_add(1, Ordering::Relaxed);
+        self.fields
+            .lock()
+            .expect("not poisoned")
+            .insert(key, f.clone());
+        Some(f)
+    }
+}
+
+fn shape_key(points: &[DVec2]) -> u64 {
+    // DefaultHasher::new() has fixed keys: stable within and across runs.
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for p in points {
+        p.x.to_bits().hash(&mut h);
+        p.y.to_bits().hash(&mut h);
+    }
+    h.finish()
+}
+
+fn same_shape(s: &Segments, points: &[DVec2]) -> bool {
+    s.len() + 1 == points.len()
+        && s.a.iter().zip(points).all(|(a, p)| a == p)
+        && s.b.last() == points.last()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wiggle() -> Vec<DVec2> {
+        let raw: Vec<DVec2> = (0..40)
+            .map(|k| {
+                let t = k as f64 / 39.0;
+                DVec2::new(5.0 + 50.0 * t, 20.0 + 12.0 * (t * 9.0).sin())
+            })
+            .collect();
+        super::super::smooth::resample(&raw).unwrap()
+    }
+
+    #[test]
+    fn field_distances_equal_brute_force_at_every_node() {
+        let pts = wiggle();
+        let f = DistanceField::compute(&pts, 12.0).unwrap();
+        let mut inside = 0;
+        for j in 0..f.height as i64 {
+            for i in 0..f.width as i64 {
+                let p = DVec2::new((f.x0 + i) as f64, (f.y0 + j) as f64);
+                let brute = (0..f.segments.len() as u32)
+                    .map(|k| f.segments.project(k, p).dist)
+                    .fold(f64::INFINITY, f64::min);
+                match f.closest(p) {
+                    Some(h) => {
+                        assert_eq!(h.dist, brute, "node ({i}, {j})");
+                        inside += 1;
+                    }
+                    None => assert!(brute > 12.0, "node ({i}, {j}) at {brute} was missed"),
+                }
+            }
+        }
+        assert!(inside > 1000, "{inside}");
+        // Between nodes the four-node lookup stays within a pixel of exact.
+        for k in 0..500 {
+            let p = DVec2::new(
+                3.0 + (k as f64 * 0.618).fract() * 55.0,
+                10.0 + (k as f64 * 0.377).fract() * 20.0,
+            );
+            let brute = (0..f.segments.len() as u32)
+                .map(|s| f.segments.project(s, p).dist)
+                .fold(f64::INFINITY, f64::min);
+            if brute < 10.0 {
+                let d = f.closest(p).unwrap().dist;
+                assert!(d >= brute && d - brute < 0.1, "{p}: {d} vs {brute}");
+            }
+        }
+    }
+
+    #[test]
+    fn cache_recomputes_only_for_new_shapes_or_wider_margins() {
+        let c = FieldCache::new();
+        let pts = wiggle();
+        let a = c.get(&pts, 10.0).unwrap();
+        let b = c.get(&pts, 8.0).unwrap();
+        assert!(Arc::ptr_eq(&a, &b));
+        assert_eq!(c.computed(), 1);
+        c.get(&pts, 20.0).unwrap();
+        assert_eq!(c.computed(), 2);
+        let mut moved = pts.clone();
+        moved[3].x += 0.5;
+        c.get(&moved, 10.0).unwrap();
+        assert_eq!(c.computed(), 3);
+    }
+}

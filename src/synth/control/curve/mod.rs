@@ -1,0 +1,596 @@
+//! Curve constraints (paper §3, §5.1): a sketched polyline, smoothed, whose
+//! height, left/right slope and left/right reach are given by widgets along
+//! it and interpolated with Hermite curves; junction widgets (height only)
+//! placed automatically where curves cross each other or themselves; end
+//! caps by angular interpolation of the left and right properties; closest
+//! points from a distance field cached on the curve's shape; and an area of
+//! effect whose boundary is smoothed as an isocurve (Fig. 5).
+//!
+//! Conventions (the paper leaves them open):
+//! - Positions are output (finest-level) pixels, y down; pixel (i, j) has
+//!   its centre at (i + ½, j + ½).
+//! - *Left* is the left of someone walking along the curve from its first
+//!   point to its last, as seen on the map (y down): for a curve heading
+//!   east, left is north (smaller y).
+//! - A widget sits at a fraction `at` of the smoothed curve's arc length, so
+//!   it stays on the same part of the curve when the sketch is smoothed.
+//! - Slope is an angle in degrees from the horizontal, positive when the
+//!   terrain rises away from the curve: the target height at distance d is
+//!   `height + tan(slope)·d·cell`. A canyon floor has positive slopes, a
+//!   ridge negative ones, a cliff top one flat side and one steep negative.
+//! - A junction's default height is the mean of the heights its curves'
+//!   own widgets give there (so adding a crossing does not move either
+//!   curve on average); a scene may set it. Near a widget (within half a
+//!   pixel of arc length) the widget wins over a junction.
+
+pub mod envelope;
+pub mod field;
+pub mod junction;
+pub mod profile;
+pub mod segments;
+pub mod smooth;
+
+use super::{Constraint, Sample};
+use field::DistanceField;
+pub use field::FieldCache;
+use glam::DVec2;
+use profile::Track;
+use segments::Hit;
+use std::sync::Arc;
+use thiserror::Error;
+
+/// Side indices of two-sided properties.
+pub const LEFT: usize = 0;
+pub const RIGHT: usize = 1;
+
+/// A curve-located widget.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Widget {
+    /// Position as a fraction of the curve's arc length, 0..=1.
+    pub at: f64,
+    /// Height of the curve here, metres.
+    pub height_m: f64,
+    /// Slope away from the curve on each side ([`LEFT`], [`RIGHT`]), degrees.
+    pub slope_deg: [f64; 2],
+    /// Area of effect on each side, output pixels.
+    pub reach_px: [f64; 2],
+}
+
+/// A curve as the user describes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveSpec {
+    /// The sketched polyline, output pixels (≥ 2 points, not all equal).
+    pub points: Vec<DVec2>,
+    /// At least one widget.
+    pub widgets: Vec<Widget>,
+    /// Chaikin iterations applied to the polyline (paper: "smoothed").
+    pub smoothing: u32,
+}
+
+/// A junction's height set by the user: applies to the junction within
+/// [`JUNCTION_SNAP`] pixels of `at`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JunctionHeight {
+    pub at: DVec2,
+    pub height_m: f64,
+}
+
+/// How far a [`JunctionHeight`] may be from the junction it sets, pixels.
+pub const JUNCTION_SNAP: f64 = 4.0;
+
+/// A junction widget placed where curves cross.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Junction {
+    pub at: DVec2,
+    pub height_m: f64,
+    /// `(curve index, arc length)` of every curve through it.
+    pub members: Vec<(usize, f64)>,
+}
+
+/// Curves that cannot be built.
+#[non_exhaustive]
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CurveError {
+    #[error("curve {curve} has {count} point(s): expected at least 2")]
+    TooFewPoints { curve: usize, count: usize },
+    #[error("curve {curve} has zero length: its points must not all coincide")]
+    ZeroLength { curve: usize },
+    #[error("curve {curve} has no widget: expected at least 1 (height, slopes, reaches)")]
+    NoWidget { curve: usize },
+    #[error("curve {curve}: {what} {value} is invalid: expected {range}")]
+    Value {
+        curve: usize,
+        what: &'static str,
+        value: f64,
+        range: &'static str,
+    },
+    #[error(
+        "curve {curve} with reach {reach} px needs a distance field of more than {max} nodes: shorten it or reduce the reach",
+        max = field::MAX_NODES
+    )]
+    TooLarge { curve: usize, reach: f64 },
+    #[error(
+        "curve {curve} is {length:.0} px long after smoothing ({points} points): at most {max} px and {max} smoothed points",
+        max = MAX_LENGTH_PX
+    )]
+    TooLong {
+        curve: usize,
+        length: f64,
+        points: usize,
+    },
+    #[error(
+        "junction height at ({x}, {y}) matches no junction: the curves cross nowhere within {JUNCTION_SNAP} px of it"
+    )]
+    NoJunction { x: f64, y: f64 },
+}
+
+/// Longest curve, output pixels of arc length (and most points after
+/// smoothing): its resampled form holds one point per pixel, so this bounds
+/// the memory a hostile scene can ask for (64 MiB).
+pub const MAX_LENGTH_PX: f64 = (1 << 22) as f64;
+
+/// Largest reach, output pixels.
+pub const MAX_REACH_PX: f64 = 4096.0;
+/// Largest |slope|, degrees (steeper than this is a wall, not a slope).
+pub const MAX_SLOPE_DEG: f64 = 85.0;
+
+/// The properties the constraint asks for at one closest point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Props {
+    /// Arc length of the closest point, pixels.
+    pub s: f64,
+    /// 0 = fully left-side properties, 1 = fully right (fractional in caps).
+    pub right: f64,
+    pub height_m: f64,
+    pub slope_deg: f64,
+    pub reach_px: f64,
+}
+
+/// One built curve constraint.
+pub struct Curve {
+    field: Arc<DistanceField>,
+    /// Resampled points and arc length at each.
+    points: Vec<DVec2>,
+    cum: Vec<f64>,
+    height: Track,
+    slope: [Track; 2],
+    reach: [Track; 2],
+    cell_m: f64,
+    /// Effective reach per field node (see [`envelope`]).
+    reach_eff: Vec<f32>,
+    /// The smoothed envelope boundary, output pixels.
+    envelope: Vec<Vec<DVec2>>,
+    /// The raw envelope boundary before smoothing, output pixels.
+    raw_envelope: Vec<Vec<DVec2>>,
+}
+
+impl std::fmt::Debug for Curve {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Curve")
+            .field("points", &self.points.len())
+            .field("length_px", &self.length())
+            .field("field", &(self.field.width, self.field.height))
+            .field("envelope_loops", &self.envelope.len())
+            .finish()
+    }
+}
+
+/// Smooths and resamples one spec's polyline, with its arc lengths.
+fn shape(curve: usize, spec: &CurveSpec) -> Result<(Vec<DVec2>, Vec<f64>), CurveError> {
+    if spec.points.len() < 2 {
+        return Err(CurveError::TooFewPoints {
+            curve,
+            count: spec.points.len(),
+        });
+    }
+    for p in &spec.points {
+        for v in [p.x, p.y] {
+            if !v.is_finite() || v.abs() > 1e6 {
+                return Err(CurveError::Value {
+                    curve,
+                    what: "point coordinate",
+                    value: v,
+                    range: "a finite value within ±1e6 px",
+                });
+            }
+        }
+    }
+    if spec.widgets.is_empty() {
+        return Err(CurveError::NoWidget { curve });
+    }
+    for w in &spec.widgets {
+        let checks = [
+            (
+                "widget position",
+                w.at,
+                (0.0..=1.0).contains(&w.at),
+                "0..=1 of the arc length",
+            ),
+            (
+                "height",
+                w.height_m,
+                w.height_m.is_finite() && w.height_m.abs() <= 1e5,
+                "-100000..=100000 m",
+            ),
+        ];
+        for (what, value, ok, range) in checks {
+            if !ok {
+                return Err(CurveError::Value {
+                    curve,
+                    what,
+                    value,
+                    range,
+                });
+            }
+        }
+        for side in [LEFT, RIGHT] {
+            let s = w.slope_deg[side];
+            if s.is_nan() || s.abs() > MAX_SLOPE_DEG {
+                return Err(CurveError::Value {
+                    curve,
+                    what: "slope",
+                    value: s,
+                    range: "-85..=85 degrees",
+                });
+            }
+            let r = w.reach_px[side];
+            if !(r > 0.0 && r <= MAX_REACH_PX) {
+                return Err(CurveError::Value {
+                    curve,
+                    what: "reach",
+                    value: r,
+                    range: "0 < reach <= 4096 px",
+                });
+            }
+        }
+    }
+    let iterations = spec.smoothing.min(8);
+    let length: f64 = spec.points.windows(2).map(|w| w[0].distance(w[1])).sum();
+    let smoothed_points = (spec.points.len() as f64) * f64::from(1u32 << iterations);
+    if length > MAX_LENGTH_PX || smoothed_points > MAX_LENGTH_PX {
+        return Err(CurveError::TooLong {
+            curve,
+            length,
+            points: spec.points.len() << iterations,
+        });
+    }
+    let smoothed = smooth::chaikin(&spec.points, iterations);
+    let pts = smooth::resample(&smoothed).ok_or(CurveError::ZeroLength { curve })?;
+    let cum = smooth::arc_lengths(&pts);
+    Ok((pts, cum))
+}
+
+/// Builds every curve of a scene together, so that junctions between them
+/// are found; `junction_heights` override junction heights. Distance fields
+/// come from `cache`.
+pub fn build(
+    specs: &[CurveSpec],
+    junction_heights: &[JunctionHeight],
+    cell_m: f64,
+    cache: &FieldCache,
+) -> Result<(Vec<Curve>, Vec<Junction>), CurveError> {
+    let shapes: Vec<(Vec<DVec2>, Vec<f64>)> = specs
+        .iter()
+        .enumerate()
+        .map(|(k, s)| shape(k, s))
+        .collect::<Result<_, _>>()?;
+    // Widget-only tracks, for junction defaults.
+    let tracks: Vec<_> = specs
+        .iter()
+        .zip(&shapes)
+        .map(|(spec, (_, cum))| widget_tracks(spec, *cum.last().expect("non-empty")))
+        .collect();
+    let refs: Vec<(&[DVec2], &[f64])> = shapes.iter().map(|(p, c)| (&p[..], &c[..])).collect();
+    let mut junctions: Vec<Junction> = junction::find(&refs)
+        .into_iter()
+        .map(|c| {
+            let mean = c
+                .members
+                .iter()
+                .map(|&(k, s)| tracks[k].0.at(s))
+                .sum::<f64>()
+                / c.members.len() as f64;
+            Junction {
+                at: c.at,
+                height_m: mean,
+                members: c.members,
+            }
+        })
+        .collect();
+    for jh in junction_heights {
+        let best = junctions
+            .iter_mut()
+            .map(|j| (j.at.distance(jh.at), j))
+            .filter(|(d, _)| *d <= JUNCTION_SNAP)
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        match best {
+            Some((_, j)) => j.height_m = jh.height_m,
+            None => {
+                return Err(CurveError::NoJunction {
+                    x: jh.at.x,
+                    y: jh.at.y,
+                });
+            }
+        }
+    }
+    let curves = shapes
+        .into_iter()
+        .zip(tracks)
+        .enumerate()
+        .map(|(k, ((points, cum), (_, slope, reach)))| {
+            let total = *cum.last().expect("non-empty");
+            let mut keys: Vec<(f64, f64)> = specs[k]
+                .widgets
+                .iter()
+                .map(|w| (w.at * total, w.height_m))
+                .collect();
+            for j in &junctions {
+                keys.extend(
+                    j.members
+                        .iter()
+                        .filter(|m| m.0 == k)
+                        .map(|m| (m.1, j.height_m)),
+                );
+            }
+            Curve::new(
+                k,
+                points,
+                cum,
+                Track::new(&keys),
+                slope,
+                reach,
+                cell_m,
+                cache,
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    Ok((curves, junctions))
+}
+
+/// Height, slope and reach tracks from a spec's widgets alone.
+fn widget_tracks(spec: &CurveSpec, total: f64) -> (Track, [Track; 2], [Track; 2]) {
+    let keys = |f: &dyn Fn(&Widget) -> f64| -> Track {
+        Track::new(
+            &spec
+                .widgets
+                .iter()
+                .map(|w| (w.at * total, f(w)))
+                .collect::<Vec<_>>(),
+        )
+    };
+    (
+        keys(&|w| w.height_m),
+        [keys(&|w| w.slope_deg[LEFT]), keys(&|w| w.slope_deg[RIGHT])],
+        [keys(&|w| w.reach_px[LEFT]), keys(&|w| w.reach_px[RIGHT])],
+    )
+}
+
+impl Curve {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        index: usize,
+        points: Vec<DVec2>,
+        cum: Vec<f64>,
+        height: Track,
+        slope: [Track; 2],
+        reach: [Track; 2],
+        cell_m: f64,
+        cache: &FieldCache,
+    ) -> Result<Curve, CurveError> {
+        let max_reach = reach[LEFT].max().max(reach[RIGHT].max());
+        let sigma = envelope::sigma(max_reach);
+        // Smoothing may push the boundary outward by up to ~σ where it fills
+        // a notch; the field must cover that.
+        let margin = max_reach + sigma + 2.0;
+        let field = cache.get(&points, margin).ok_or(CurveError::TooLarge {
+            curve: index,
+            reach: max_reach,
+        })?;
+        let mut curve = Curve {
+            field,
+            points,
+            cum,
+            height,
+            slope,
+            reach,
+            cell_m,
+            reach_eff: Vec::new(),
+            envelope: Vec::new(),
+            raw_envelope: Vec::new(),
+        };
+        curve.build_envelope(sigma);
+        Ok(curve)
+    }
+
+    /// Raw envelope `d − reach(t)` per node, its isocurve, the smoothed
+    /// isocurve, and the effective reach.
+    fn build_envelope(&mut self, sigma: f64) {
+        use rayon::prelude::*;
+        let f = &self.field;
+        let (w, h) = (f.width, f.height);
+        let mut d = vec![f64::INFINITY; w * h];
+        let mut excess = vec![f64::INFINITY; w * h];
+        d.par_chunks_mut(w)
+            .zip(excess.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(j, (drow, erow))| {
+                for i in 0..w {
+                    let s = f.node(i as i64, j as i64);
+                    if s == field::NONE {
+                        continue;
+                    }
+                    let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
+                    let hit = f.segments.project(s, p);
+                    drow[i] = hit.dist;
+                    erow[i] = hit.dist - self.props(hit, p).reach_px;
+                }
+            });
+        let origin = DVec2::new(f.x0 as f64, f.y0 as f64);
+        let raw = envelope::isocurves(&excess, w, h);
+        let smoothed: Vec<Vec<DVec2>> = raw
+            .iter()
+            .map(|l| envelope::smooth_loop(l, sigma))
+            .collect();
+        self.reach_eff = envelope::effective_reach(&smoothed, &d, w, h);
+        let shift = |ls: &[Vec<DVec2>]| -> Vec<Vec<DVec2>> {
+            ls.iter()
+                .map(|l| l.iter().map(|p| *p + origin).collect())
+                .collect()
+        };
+        self.envelope = shift(&smoothed);
+        self.raw_envelope = shift(&raw);
+    }
+
+    /// Arc length of the smoothed curve, pixels.
+    pub fn length(&self) -> f64 {
+        *self.cum.last().expect("non-empty")
+    }
+
+    /// The smoothed, resampled curve, output pixels.
+    pub fn points(&self) -> &[DVec2] {
+        &self.points
+    }
+
+    /// The point at arc length `s`.
+    pub fn point_at(&self, s: f64) -> DVec2 {
+        let k = self
+            .cum
+            .partition_point(|&c| c <= s)
+            .clamp(1, self.cum.len() - 1)
+            - 1;
+        let len = self.cum[k + 1] - self.cum[k];
+        let u = if len > 0.0 {
+            ((s - self.cum[k]) / len).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        self.points[k].lerp(self.points[k + 1], u)
+    }
+
+    /// Height at arc length `s`, metres (widgets and junctions).
+    pub fn height_at(&self, s: f64) -> f64 {
+        self.height.at(s)
+    }
+
+    /// The smoothed area-of-effect boundary (closed loops), output pixels.
+    pub fn envelope(&self) -> &[Vec<DVec2>] {
+        &self.envelope
+    }
+
+    /// The boundary before isocurve smoothing, for comparison.
+    pub fn raw_envelope(&self) -> &[Vec<DVec2>] {
+        &self.raw_envelope
+    }
+
+    /// The shared distance field this curve uses.
+    pub fn field(&self) -> &Arc<DistanceField> {
+        &self.field
+    }
+
+    /// Effective reach at lattice node `(i, j)` of [`Curve::field`].
+    pub fn reach_at_node(&self, i: usize, j: usize) -> f32 {
+        self.reach_eff[j * self.field.width + i]
+    }
+
+    /// The raw (unsmoothed) reach the closest point asks for at node `(i, j)`.
+    pub fn raw_reach_at_node(&self, i: usize, j: usize) -> Option<f64> {
+        let f = &self.field;
+        let s = f.node(i as i64, j as i64);
+        (s != field::NONE).then(|| {
+            let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
+            self.props(f.segments.project(s, p), p).reach_px
+        })
+    }
+
+    /// The properties for position `p` whose closest curve point is `hit`:
+    /// the side's own slope and reach, or in an end cap the left and right
+    /// values blended by the angle around the end point (a cubic Hermite
+    /// step from the left normal, 0°, to the right normal, 180°).
+    pub fn props(&self, hit: Hit, p: DVec2) -> Props {
+        let k = hit.seg as usize;
+        let n = self.points.len() - 1;
+        let s = self.cum[k] + hit.u * (self.cum[k + 1] - self.cum[k]);
+        let dir = |k: usize| (self.points[k + 1] - self.points[k]).normalize_or_zero();
+        let c = self.points[k].lerp(self.points[k + 1], hit.u);
+        let v = p - c;
+        let right = if (k == 0 && hit.u == 0.0) || (k == n - 1 && hit.u == 1.0) {
+            let fwd = if k == 0 && hit.u == 0.0 {
+                dir(0)
+            } else {
+                dir(n - 1)
+            };
+            let left_normal = DVec2::new(fwd.y, -fwd.x);
+            let len = v.length();
+            if len == 0.0 {
+                0.0
+            } else {
+                let a = (left_normal.dot(v) / len).clamp(-1.0, 1.0).acos() / std::f64::consts::PI;
+                a * a * (3.0 - 2.0 * a)
+            }
+        } else {
+            let fwd = if hit.u == 0.0 {
+                dir(k - 1) + dir(k)
+            } else if hit.u == 1.0 {
+                dir(k) + dir(k + 1)
+            } else {
+                dir(k)
+            };
+            if fwd.perp_dot(v) > 0.0 { 1.0 } else { 0.0 }
+        };
+        let mix = |t: &[Track; 2]| t[LEFT].at(s) * (1.0 - right) + t[RIGHT].at(s) * right;
+        Props {
+            s,
+            right,
+            height_m: self.height.at(s),
+            slope_deg: mix(&self.slope),
+            reach_px: mix(&self.reach),
+        }
+    }
+
+    /// Effective reach at output position `p`, bilinear between nodes.
+    fn reach_eff_at(&self, p: DVec2) -> f64 {
+        let f = &self.field;
+        let (fx, fy) = (p.x - f.x0 as f64, p.y - f.y0 as f64);
+        let (i0, j0) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - i0, fy - j0);
+        let at = |i: f64, j: f64| -> f64 {
+            if i < 0.0 || j < 0.0 || i >= f.width as f64 || j >= f.height as f64 {
+                return -1.0;
+            }
+            self.reach_eff[j as usize * f.width + i as usize] as f64
+        };
+        let top = at(i0, j0) * (1.0 - tx) + at(i0 + 1.0, j0) * tx;
+        let bottom = at(i0, j0 + 1.0) * (1.0 - tx) + at(i0 + 1.0, j0 + 1.0) * tx;
+        top * (1.0 - ty) + bottom * ty
+    }
+}
+
+impl Constraint for Curve {
+    fn bounds(&self) -> [f64; 4] {
+        let f = &self.field;
+        [
+            f.x0 as f64,
+            f.y0 as f64,
+            (f.x0 + f.width as i64) as f64,
+            (f.y0 + f.height as i64) as f64,
+        ]
+    }
+
+    fn sample(&self, x: f64, y: f64) -> Option<Sample> {
+        let p = DVec2::new(x, y);
+        let hit = self.field.closest(p)?;
+        let reach = self.reach_eff_at(p);
+        if hit.dist > reach {
+            return None;
+        }
+        let pr = self.props(hit, p);
+        Some(Sample {
+            target_m: pr.height_m + pr.slope_deg.to_radians().tan() * hit.dist * self.cell_m,
+            distance: hit.dist,
+            reach,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;
