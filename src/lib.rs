@@ -8,12 +8,14 @@
 //! Data flows one way: [`io`] → database → synthesis → render / [`io`].
 //! See `DESIGN.md` in the repository for the architecture.
 
+pub mod blend;
 pub mod database;
 pub mod error;
 pub mod fill;
 pub mod hash;
 pub mod heightfield;
 pub mod io;
+pub mod patch;
 pub mod poisson;
 pub mod procedural;
 pub mod progress;
