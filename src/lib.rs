@@ -8,6 +8,7 @@
 //! Data flows one way: [`io`] → database → synthesis → render / [`io`].
 //! See `DESIGN.md` in the repository for the architecture.
 
+pub mod backend;
 pub mod blend;
 pub mod database;
 pub mod error;

@@ -9,7 +9,11 @@
 use crate::database::{Database, Level, layout::MARGIN};
 
 /// Per-column addressing of one level.
-#[derive(Clone, Copy, Default)]
+///
+/// `#[repr(C)]` and plain old data: the GPU backend uploads the table as is
+/// (`Column` in `kernels/common.wgsl`; layout checked by a test).
+#[repr(C)]
+#[derive(Clone, Copy, Default, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Column {
     /// `offset − x0` of the column's exemplar (may be negative).
     pub base: i32,

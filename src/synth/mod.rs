@@ -9,17 +9,19 @@
 //! seed — never on the thread count.
 
 pub mod atlas;
+pub mod control;
 pub mod fixed;
 pub mod stages;
 pub mod state;
 
+use crate::backend::{Backend, BackendError, Choice, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
 use fixed::{Coord, FRAC_BITS};
-use stages::correct::{self, CorrectParams, SUBPASSES};
-use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
-use stages::upsample_jitter::{self, Step, UpsampleParams};
+use stages::correct::{CorrectParams, SUBPASSES};
+use stages::reconstruct::HEIGHT_FRAC_BITS;
+use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -69,6 +71,8 @@ pub enum SynthError {
     StartExemplar { index: usize, count: usize },
     #[error(transparent)]
     Size(#[from] crate::error::SizeError),
+    #[error(transparent)]
+    Backend(#[from] BackendError),
 }
 
 /// One level's final state, kept when [`Params::keep_levels`] is set.
@@ -108,12 +112,15 @@ pub struct Synthesis {
     pub timings: Timings,
 }
 
-/// Synthesizes terrain from one database.
+/// Synthesizes terrain from one database, on the CPU unless
+/// [`Synthesizer::use_backend`] moved it to the GPU.
 pub struct Synthesizer<'db> {
     db: &'db Database,
     params: Params,
     atlas: Vec<AtlasLevel<'db>>,
     jitter: i32,
+    #[cfg(feature = "gpu")]
+    gpu: Option<crate::backend::gpu::Gpu>,
 }
 
 impl<'db> Synthesizer<'db> {
@@ -140,7 +147,73 @@ impl<'db> Synthesizer<'db> {
             params,
             atlas,
             jitter,
+            #[cfg(feature = "gpu")]
+            gpu: None,
         })
+    }
+
+    /// Moves the stages to the backend `choice` names. Returns a one-line
+    /// notice when [`Choice::Auto`] found no GPU and stays on the CPU.
+    pub fn use_backend(&mut self, choice: Choice) -> Result<Option<String>, SynthError> {
+        #[cfg(feature = "gpu")]
+        {
+            let ctx = match choice {
+                Choice::Cpu => {
+                    self.gpu = None;
+                    return Ok(None);
+                }
+                Choice::Gpu => crate::backend::gpu::Context::new()?,
+                Choice::Auto => match crate::backend::gpu::Context::new() {
+                    Ok(ctx) => ctx,
+                    Err(e) => {
+                        self.gpu = None;
+                        return Ok(Some(format!("{e}; using the CPU")));
+                    }
+                },
+            };
+            self.use_gpu(ctx)?;
+            Ok(None)
+        }
+        #[cfg(not(feature = "gpu"))]
+        match choice {
+            Choice::Cpu => Ok(None),
+            Choice::Gpu => Err(BackendError::NotCompiled.into()),
+            Choice::Auto => Ok(Some(format!(
+                "{}; using the CPU",
+                BackendError::NotCompiled
+            ))),
+        }
+    }
+
+    /// Runs the stages on the GPU of `ctx` (uploads the database once).
+    #[cfg(feature = "gpu")]
+    pub fn use_gpu(
+        &mut self,
+        ctx: std::sync::Arc<crate::backend::gpu::Context>,
+    ) -> Result<(), SynthError> {
+        self.gpu = Some(crate::backend::gpu::Gpu::new(
+            ctx,
+            &self.atlas,
+            self.db.heights(),
+        )?);
+        Ok(())
+    }
+
+    /// Where the stages run: `"cpu"` or `"gpu"`.
+    pub fn backend_name(&self) -> &'static str {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return g.name();
+        }
+        self.cpu().name()
+    }
+
+    /// The CPU backend over this synthesizer's database.
+    fn cpu(&self) -> Cpu<'_, 'db> {
+        Cpu {
+            atlas: &self.atlas,
+            heights: self.db.heights(),
+        }
     }
 
     pub fn params(&self) -> &Params {
@@ -162,8 +235,26 @@ impl<'db> Synthesizer<'db> {
         Ok(self.run(width, height, seed)?.heightfield)
     }
 
-    /// Synthesizes and returns timings (and levels, if kept).
+    /// Synthesizes and returns timings (and levels, if kept), on the
+    /// backend chosen by [`Synthesizer::use_backend`].
     pub fn run(&self, width: usize, height: usize, seed: u32) -> Result<Synthesis, SynthError> {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return self.run_on(g, width, height, seed);
+        }
+        self.run_on(&self.cpu(), width, height, seed)
+    }
+
+    /// The synthesis loop on any backend: the same stage calls in the same
+    /// order, so every backend yields the same bytes. Stage timings are wall
+    /// clock up to [`Backend::finish`], i.e. including the device's work.
+    pub fn run_on<B: Backend>(
+        &self,
+        b: &B,
+        width: usize,
+        height: usize,
+        seed: u32,
+    ) -> Result<Synthesis, SynthError> {
         crate::heightfield::check_dims(width, height)?;
         let t0 = Instant::now();
         let m = top_level(width, height);
@@ -180,20 +271,20 @@ impl<'db> Synthesizer<'db> {
         } else {
             m
         };
-        let mut state = self.initial(width, height, top, seed);
+        let mut state = b.upload(self.initial(width, height, top, seed))?;
         for level in (0..=top).rev() {
+            let (w, h) = level_size(width, height, level);
             if level < top {
                 let t = Instant::now();
-                let (w, h) = level_size(width, height, level);
-                let child = State::new(w, h);
+                let child = b.alloc(w, h)?;
                 let params = UpsampleParams {
                     seed,
                     level: level as u32,
                     jitter: self.jitter,
                     step: self.step(level, l),
                 };
-                let atlas = (level <= l && level < l).then(|| &self.atlas[level]);
-                upsample_jitter::upsample_jitter(&state, &child, atlas, &params);
+                b.upsample_jitter(&state, &child, level, &params);
+                b.finish()?;
                 state = child;
                 timings.levels[level].upsample = t.elapsed();
             }
@@ -201,25 +292,28 @@ impl<'db> Synthesizer<'db> {
                 let t = Instant::now();
                 for _pass in 0..self.params.passes {
                     for &(px, py) in &SUBPASSES {
-                        correct::correct(&self.atlas[level], &state, &CorrectParams { px, py });
+                        b.correct(&state, level, &CorrectParams { px, py });
                     }
                 }
+                b.finish()?;
                 timings.levels[level].correct = t.elapsed();
             }
             if self.params.keep_levels {
+                let (coords, offsets) = b.download(&state)?;
                 kept.push(LevelMaps {
                     level,
-                    width: state.width,
-                    height: state.height,
-                    coords: state.coords(),
-                    offsets: state.offsets(),
+                    width: w,
+                    height: h,
+                    coords,
+                    offsets,
                 });
             }
         }
         kept.reverse();
         let t = Instant::now();
-        let fixed = reconstruct::reconstruct(&self.atlas[0], self.db.heights(), &state);
-        let heightfield = self.to_metres(&fixed, state.width, width, height)?;
+        let fixed = b.reconstruct(&state)?;
+        let stride = level_size(width, height, 0).0;
+        let heightfield = self.to_metres(&fixed, stride, width, height)?;
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
         Ok(Synthesis {

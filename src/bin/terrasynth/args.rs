@@ -71,3 +71,31 @@ pub fn load_database(
         }
     }
 }
+
+/// `--backend`: where the synthesis stages run.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum BackendArg {
+    /// The rayon + SIMD stages (the reference).
+    Cpu,
+    /// The WGSL stages on a Vulkan GPU (needs a build with `--features gpu`).
+    Gpu,
+    /// The GPU when one is found, else the CPU (with a one-line notice).
+    Auto,
+}
+
+/// Moves `synth` to the requested backend, printing Auto's fallback notice.
+pub fn select_backend(
+    synth: &mut terrasynth::synth::Synthesizer<'_>,
+    arg: BackendArg,
+) -> Result<(), terrasynth::synth::SynthError> {
+    use terrasynth::backend::Choice;
+    let choice = match arg {
+        BackendArg::Cpu => Choice::Cpu,
+        BackendArg::Gpu => Choice::Gpu,
+        BackendArg::Auto => Choice::Auto,
+    };
+    if let Some(notice) = synth.use_backend(choice)? {
+        eprintln!("note: {notice}");
+    }
+    Ok(())
+}

@@ -6,7 +6,7 @@
 //! (these machines are shared and noisy: medians, not means).
 
 use crate::CliResult;
-use crate::args::{load_database, parse_size};
+use crate::args::{BackendArg, load_database, parse_size, select_backend};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -31,12 +31,17 @@ pub struct Args {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+    /// Where the stages run: cpu, gpu (`--features gpu` builds) or auto.
+    /// GPU stage times are wall clock until the device is idle.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 /// One size's medians, in milliseconds.
 #[derive(Serialize)]
 struct SizeReport {
     size: String,
+    backend: &'static str,
     runs: u32,
     threads: usize,
     total_ms: f64,
@@ -76,7 +81,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 pub fn run(a: Args) -> CliResult {
     let db = load_database(a.db.as_deref())?;
-    let synth = Synthesizer::new(&db, Params::default())?;
+    let mut synth = Synthesizer::new(&db, Params::default())?;
+    select_backend(&mut synth, a.backend)?;
     let mut sizes = Vec::new();
     for &(w, h) in &a.sizes {
         synth.run(w, h, a.seed)?; // warm-up: page in the database, spin up threads
@@ -111,6 +117,7 @@ pub fn run(a: Args) -> CliResult {
         ]);
         let report = SizeReport {
             size: format!("{w}x{h}"),
+            backend: synth.backend_name(),
             runs: a.runs,
             threads: rayon::current_num_threads(),
             total_ms: med(&|t| t.total),
@@ -131,8 +138,8 @@ pub fn run(a: Args) -> CliResult {
 
 fn print_table(r: &SizeReport) {
     println!(
-        "{}: {:.1} ms median of {} runs on {} threads, {:.1} bytes/pixel",
-        r.size, r.total_ms, r.runs, r.threads, r.bytes_per_pixel
+        "{} on {}: {:.1} ms median of {} runs on {} threads, {:.1} bytes/pixel",
+        r.size, r.backend, r.total_ms, r.runs, r.threads, r.bytes_per_pixel
     );
     for (name, t) in &r.stages {
         println!("  {name:<16} {t:>8.1} ms");

@@ -1,7 +1,7 @@
 //! `terrasynth synth`: synthesize a terrain from an exemplar database.
 
 use crate::CliResult;
-use crate::args::{load_database, parse_size};
+use crate::args::{BackendArg, load_database, parse_size, select_backend};
 use std::path::PathBuf;
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::render::{self, RenderOptions};
@@ -37,6 +37,10 @@ pub struct Args {
     /// Exemplar (index) whose centre the synthesis starts from.
     #[arg(long, default_value_t = 0)]
     start_exemplar: usize,
+    /// Where the stages run: cpu, gpu (WGSL on Vulkan; `--features gpu`
+    /// builds) or auto (the GPU if there is one). Same output bytes on each.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -47,7 +51,8 @@ pub fn run(a: Args) -> CliResult {
         start_exemplar: a.start_exemplar,
         keep_levels: a.coords.is_some(),
     };
-    let synth = Synthesizer::new(&db, params)?;
+    let mut synth = Synthesizer::new(&db, params)?;
+    select_backend(&mut synth, a.backend)?;
     let (w, h) = a.size;
     let result = synth.run(w, h, a.seed)?;
     io::write(&result.heightfield, &a.output, &WriteOptions::default())?;

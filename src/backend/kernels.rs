@@ -1,0 +1,92 @@
+//! The WGSL kernels (`kernels/`) and the parameter blocks they share with
+//! Rust.
+//!
+//! Always compiled, with or without the `gpu` feature, so that a plain
+//! `cargo test` checks every `#[repr(C)]` struct here against the WGSL
+//! declaration of the same name (sizes and member offsets, parsed by naga):
+//! a field added on one side only fails that test instead of silently
+//! shifting the GPU's view of its parameters.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Hash and fixed-point rules shared by every kernel.
+pub const COMMON: &str = include_str!("../../kernels/common.wgsl");
+
+/// One GPU stage: its name (= the CPU mirror's module and the `.wgsl` file)
+/// and its source without [`COMMON`].
+#[derive(Debug, Clone, Copy)]
+pub struct Kernel {
+    pub name: &'static str,
+    pub source: &'static str,
+}
+
+impl Kernel {
+    /// The complete WGSL module: WGSL has no includes, so [`COMMON`] is
+    /// prepended.
+    pub fn module_source(&self) -> String {
+        format!("{COMMON}\n{}", self.source)
+    }
+}
+
+pub const UPSAMPLE_JITTER: Kernel = Kernel {
+    name: "upsample_jitter",
+    source: include_str!("../../kernels/upsample_jitter.wgsl"),
+};
+pub const CORRECT: Kernel = Kernel {
+    name: "correct",
+    source: include_str!("../../kernels/correct.wgsl"),
+};
+pub const RECONSTRUCT: Kernel = Kernel {
+    name: "reconstruct",
+    source: include_str!("../../kernels/reconstruct.wgsl"),
+};
+
+/// Every kernel, for tests that check them all.
+pub const ALL: [Kernel; 3] = [UPSAMPLE_JITTER, CORRECT, RECONSTRUCT];
+
+/// Workgroup side of every kernel (`@workgroup_size(8, 8)`).
+pub const WORKGROUP: u32 = 8;
+
+/// `upsample_jitter::Step` as the kernel's `step` field.
+pub const STEP_PYRAMID: u32 = 0;
+pub const STEP_VIRTUAL: u32 = 1;
+pub const STEP_WRAP: u32 = 2;
+
+/// `UpsampleParams` of `kernels/upsample_jitter.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct UpsampleUniform {
+    pub child_width: u32,
+    pub child_height: u32,
+    pub parent_width: u32,
+    pub seed: u32,
+    pub level: u32,
+    pub jitter: i32,
+    pub step: u32,
+    pub shift: u32,
+    pub min_x: i32,
+    pub max_x: i32,
+    pub min_y: i32,
+    pub max_y: i32,
+}
+
+/// `CorrectParams` of `kernels/correct.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct CorrectUniform {
+    pub width: u32,
+    pub height: u32,
+    pub px: u32,
+    pub py: u32,
+}
+
+/// `ReconstructParams` of `kernels/reconstruct.wgsl` (padded to 16 bytes,
+/// the uniform block granularity).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct ReconstructUniform {
+    pub width: u32,
+    pub height: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+}

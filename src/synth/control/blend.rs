@@ -1,0 +1,395 @@
+//! Overlapping geometric constraints (paper §5.1, last paragraph) and the
+//! non-linear height nudge φ_d (eq. 8–9).
+//!
+//! # Running sums
+//! Every synthesis pixel of levels ≥ [`FIRST_LEVEL`] keeps Σb·a, Σb·h_t and
+//! Σb over the constraints that reach it, b = 1 / (1 + d) the inverse
+//! distance to each constraint's site (the 1 keeps b finite at the site and
+//! gives a pixel-sized core). A constraint changes by subtracting it,
+//! altering it and adding it back, without re-evaluating the others.
+//!
+//! **What "a" is.** The paper blends "h_t and a" and then recomputes t and c
+//! from eq. 8, so a is the quantity t is made of: the distance d to the
+//! site. The blended tolerance is therefore `t = s · Σb·d / Σb`. Near one
+//! constraint's site its own tiny d dominates the weighted mean (b ~ 1/d),
+//! so overlapping constraints do not loosen each other's sites.
+//!
+//! **Units of t = s·d.** d is converted to metres with the output cell size,
+//! so s = 0.5 reads "pixels may deviate from the target by up to the height
+//! of a 1:2 slope back to the site" — dimensionless, as the paper's default
+//! suggests, and independent of the database's height quantization.
+//!
+//! **Exactness.** Each sample's b, b·h_t and b·d are quantized to integers
+//! on the CPU and the sums are i64, so subtract → modify → add gives the
+//! same sums as evaluation from scratch, bit for bit (tested below).
+//!
+//! # Reach per level
+//! At level i a sample counts if d ≤ min(reach, 4·2^i) (eq. 9's text:
+//! "min(radius, 4 × 2^d)", with d the level), so constraints act ever more
+//! locally as synthesis gets finer.
+
+use super::{Constraint, FIRST_LEVEL};
+use crate::database::Quantization;
+
+/// The paper's tolerance slope s (eq. 8).
+pub const S: f64 = 0.5;
+/// Fixed-point scale of the blend weight b = 1/(1 + d).
+const B_ONE: f64 = (1u64 << 20) as f64;
+/// Scale of quantized heights (1/16 unit) and distances (1/256 pixel: a
+/// tolerance step below one unit at 30 m cells and 5 cm units) in the sums.
+const H_FRAC: f64 = 16.0;
+const D_FRAC: f64 = 256.0;
+/// Largest tolerance handed to the kernel (keeps φ's products in 32 bits).
+pub const MAX_TOL: i32 = 32_767;
+/// Largest |h_t − h_c| the kernel works with (keeps 3|x| in an i32).
+pub const MAX_ERROR: i32 = 1 << 24;
+
+/// A pixel's blended constraint, in database height units.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Target {
+    /// Target height h_t (units; may leave 0..65535).
+    pub height: i32,
+    /// Tolerance t = s·d (units), or −1 where no constraint reaches.
+    pub tol: i32,
+}
+
+impl Target {
+    /// No constraint here.
+    pub const NONE: Target = Target { height: 0, tol: -1 };
+}
+
+/// The integer raster the `correct` stage reads at one level.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Targets {
+    pub width: usize,
+    pub height: usize,
+    pub cells: Vec<Target>,
+}
+
+/// Running sums of one pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Sums {
+    b: i64,
+    bh: i64,
+    bd: i64,
+}
+
+/// Running sums of one level.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct LevelSums {
+    width: usize,
+    height: usize,
+    sums: Vec<Sums>,
+}
+
+/// The overlap blend of all geometric constraints of one output size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Blend {
+    q: Quantization,
+    /// Index = level; levels below [`FIRST_LEVEL`] are empty.
+    levels: Vec<LevelSums>,
+}
+
+impl Blend {
+    /// Empty sums for levels `FIRST_LEVEL..=last` of an output of this size.
+    pub fn new(width: usize, height: usize, last: usize, q: Quantization) -> Blend {
+        let levels = (0..=last)
+            .map(|i| {
+                let (w, h) = crate::synth::state::level_size(width, height, i);
+                let n = if i >= FIRST_LEVEL { w * h } else { 0 };
+                LevelSums {
+                    width: w,
+                    height: h,
+                    sums: vec![Sums::default(); n],
+                }
+            })
+            .collect();
+        Blend { q, levels }
+    }
+
+    /// Adds a constraint's contribution.
+    pub fn add(&mut self, c: &dyn Constraint) {
+        self.apply(c, 1);
+    }
+
+    /// Removes a contribution added before (exactly).
+    pub fn subtract(&mut self, c: &dyn Constraint) {
+        self.apply(c, -1);
+    }
+
+    /// Whether no constraint contributes anywhere.
+    pub fn is_empty(&self) -> bool {
+        self.levels
+            .iter()
+            .all(|l| l.sums.iter().all(|s| *s == Sums::default()))
+    }
+
+    fn apply(&mut self, c: &dyn Constraint, sign: i64) {
+        let q = self.q;
+        let [x0, y0, x1, y1] = c.bounds();
+        for (i, level) in self.levels.iter_mut().enumerate().skip(FIRST_LEVEL) {
+            let scale = (1u64 << i) as f64;
+            let cap = 4.0 * scale;
+            // Level pixels whose centre lies in the bounds.
+            let range = |a: f64, b: f64, n: usize| {
+                let lo = ((a / scale - 0.5).ceil().max(0.0) as usize).min(n);
+                let hi = (((b / scale - 0.5).floor() + 1.0).max(0.0) as usize).min(n);
+                lo..hi.max(lo)
+            };
+            let (w, h) = (level.width, level.height);
+            for y in range(y0, y1, h) {
+                for x in range(x0, x1, w) {
+                    let (ox, oy) = ((x as f64 + 0.5) * scale, (y as f64 + 0.5) * scale);
+                    let Some(s) = c.sample(ox, oy) else { continue };
+                    // NaN distances (a broken constraint) never count.
+                    let inside = s.distance <= s.reach.min(cap);
+                    if !inside {
+                        continue;
+                    }
+                    let (b, bh, bd) = contribution(&q, s.target_m, s.distance);
+                    let cell = &mut level.sums[y * w + x];
+                    cell.b += sign * b;
+                    cell.bh += sign * bh;
+                    cell.bd += sign * bd;
+                }
+            }
+        }
+    }
+
+    /// The quantized raster of `level` (None below [`FIRST_LEVEL`], past the
+    /// last level, or where nothing reaches): per pixel the blended h_t and
+    /// t = s·d in height units. `cell_size_m` converts pixel distances.
+    pub fn targets(&self, level: usize, cell_size_m: f64) -> Option<Targets> {
+        let l = self.levels.get(level)?;
+        if level < FIRST_LEVEL || l.sums.iter().all(|s| s.b == 0) {
+            return None;
+        }
+        let metres_to_units = cell_size_m / self.q.scale_m;
+        let cells = l
+            .sums
+            .iter()
+            .map(|s| {
+                if s.b <= 0 {
+                    return Target::NONE;
+                }
+                // Nearest integer, ties up, by floor division (exact i64).
+                let one = H_FRAC as i64 * s.b;
+                let height = (2 * s.bh + one).div_euclid(2 * one);
+                let d = s.bd as f64 / s.b as f64 / D_FRAC;
+                let tol = (S * d * metres_to_units).round().min(MAX_TOL as f64) as i32;
+                Target {
+                    height: height.clamp(i32::MIN as i64 / 2, i32::MAX as i64 / 2) as i32,
+                    tol,
+                }
+            })
+            .collect();
+        Some(Targets {
+            width: l.width,
+            height: l.height,
+            cells,
+        })
+    }
+}
+
+/// One sample's integer (b, b·h_t, b·d): b = 1/(1 + d) in 2^-20, heights in
+/// 1/16 unit, distances in 1/256 pixel.
+fn contribution(q: &Quantization, target_m: f64, d: f64) -> (i64, i64, i64) {
+    let b = (B_ONE / (1.0 + d)).round() as i64;
+    let h = (q.units(target_m) * H_FRAC).round().clamp(-1e12, 1e12) as i64;
+    let dq = (d * D_FRAC).round() as i64;
+    (b, b * h, b * dq)
+}
+
+/// φ_d(x) of eq. 9 with λ = ½, in integer height units (the kernel side;
+/// identical in the scalar and SIMD corrections and in WGSL: 32-bit
+/// arithmetic only).
+///
+/// With t the tolerance: `x/2 − sign(x)·t/3` outside ±t (slope λ, offset
+/// c = 2λt/3), `x·(x/t)²/6` inside (= −b·x³ with b = −λ/(3t²)). Inside, the
+/// ratio r = |x|/t is formed in 15 fractional bits (|x| ≤ t ≤ 2^15, so
+/// |x|·2^15 < 2^31) and squared back to 15 bits; the product |x|·r² < 2^30.
+/// Both branches round to nearest (ties away from zero, by symmetry).
+#[inline(always)]
+pub fn phi(x: i32, tol: i32) -> i32 {
+    let x = x.clamp(-MAX_ERROR, MAX_ERROR);
+    let a = x.unsigned_abs();
+    let t = tol as u32;
+    let mag = if a > t {
+        (3 * a - 2 * t + 3) / 6
+    } else if a == 0 {
+        0
+    } else {
+        let r = (a << 15) / t;
+        let r2 = (r * r) >> 15;
+        (a * r2 + 3 * (1 << 15)) / (6 << 15)
+    };
+    if x < 0 { -(mag as i32) } else { mag as i32 }
+}
+
+/// V after nudging a chosen candidate of height `h_c` (units, V included)
+/// towards `target`: `v + φ(h_t − h_c)`; unchanged where no constraint.
+#[inline(always)]
+pub fn nudge(v: i32, h_c: i32, target: Target) -> i32 {
+    if target.tol < 0 {
+        return v;
+    }
+    v + phi(target.height.saturating_sub(h_c), target.tol)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::control::PointConstraint;
+    use proptest::prelude::*;
+
+    fn q() -> Quantization {
+        Quantization {
+            offset_m: -100.0,
+            scale_m: 0.05,
+        }
+    }
+
+    /// Eq. 8–9 in floating point, as printed.
+    fn phi_f(x: f64, t: f64) -> f64 {
+        let lambda = 0.5;
+        if t == 0.0 {
+            return lambda * x;
+        }
+        let b = -lambda / (3.0 * t * t);
+        let c = b * t * t * t + lambda * t;
+        if x < -t {
+            lambda * x + c
+        } else if x > t {
+            lambda * x - c
+        } else {
+            -b * x * x * x
+        }
+    }
+
+    #[test]
+    fn integer_phi_follows_eq_9() {
+        for t in [0, 1, 7, 100, 2_000, MAX_TOL] {
+            for x in (-70_000..=70_000).step_by(37) {
+                let want = phi_f(x as f64, t as f64);
+                let got = phi(x, t);
+                assert!(
+                    (got as f64 - want).abs() <= 1.0,
+                    "φ({x}, {t}) = {got}, eq. 9: {want}"
+                );
+                assert_eq!(phi(-x, t), -got, "odd symmetry");
+            }
+        }
+        // Small errors are nudged slightly, large ones by about half.
+        assert_eq!(phi(10, 1000), 0);
+        assert_eq!(phi(10_000, 1000), 5000 - 333);
+        assert_eq!(nudge(7, 123, Target::NONE), 7);
+        assert_eq!(
+            nudge(
+                0,
+                0,
+                Target {
+                    height: 1000,
+                    tol: 0
+                }
+            ),
+            500
+        );
+    }
+
+    fn point(x: f64, y: f64, h: f64, r: f64) -> PointConstraint {
+        PointConstraint::new((x, y), h, 0.3, 0.2, r, 30.0).unwrap()
+    }
+
+    #[test]
+    fn a_lone_point_targets_its_plane_within_its_reach() {
+        let mut b = Blend::new(256, 256, 6, q());
+        assert!(b.targets(2, 30.0).is_none());
+        let p = point(100.0, 60.0, 400.0, 40.0);
+        b.add(&p);
+        assert!(b.targets(1, 30.0).is_none(), "off on the finest two levels");
+        for level in 2..=6 {
+            let t = b.targets(level, 30.0).unwrap();
+            let s = (1 << level) as f64;
+            let reach = 40f64.min(4.0 * s);
+            for y in 0..t.height {
+                for x in 0..t.width {
+                    let (ox, oy) = ((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
+                    let c = t.cells[y * t.width + x];
+                    match p.sample(ox, oy).filter(|s| s.distance <= reach) {
+                        None => assert_eq!(c, Target::NONE),
+                        Some(smp) => {
+                            let want = q().units(smp.target_m);
+                            assert!(
+                                (c.height as f64 - want).abs() <= 0.5 + 1.0 / 16.0,
+                                "{c:?} {want}"
+                            );
+                            let tol = S * smp.distance * 30.0 / q().scale_m;
+                            assert!((c.tol as f64 - tol.min(MAX_TOL as f64)).abs() <= 1.0);
+                        }
+                    }
+                }
+            }
+        }
+        b.subtract(&p);
+        assert!(b.is_empty());
+    }
+
+    #[test]
+    fn overlaps_blend_by_inverse_distance() {
+        let mut b = Blend::new(64, 64, 3, q());
+        let (p1, p2) = (point(12.0, 12.0, 0.0, 60.0), point(32.0, 12.0, 100.0, 60.0));
+        b.add(&p1);
+        b.add(&p2);
+        // Level-3 pixel (1, 1) is centred at (12, 12): p1's site, d₁ = 0;
+        // p2 is 20 px away, inside level 3's cap of 32 px.
+        let t = b.targets(3, 30.0).unwrap();
+        let c = t.cells[t.width + 1];
+        let (w1, w2) = (1.0, 1.0 / 21.0);
+        let (h1, h2) = (
+            q().units(p1.sample(12.0, 12.0).unwrap().target_m),
+            q().units(p2.sample(12.0, 12.0).unwrap().target_m),
+        );
+        let want = (w1 * h1 + w2 * h2) / (w1 + w2);
+        assert!((c.height as f64 - want).abs() <= 1.0, "{c:?} {want}");
+        let want_t = S * (w2 * 20.0) / (w1 + w2) * 30.0 / q().scale_m;
+        assert!((c.tol as f64 - want_t).abs() <= 1.0, "{c:?} {want_t}");
+        // At level 2 (cap 16 px) p2 does not reach: p1 alone.
+        let t = b.targets(2, 30.0).unwrap();
+        let c = t.cells[2 * t.width + 2];
+        let h = q().units(p1.sample(10.0, 10.0).unwrap().target_m);
+        assert!((c.height as f64 - h).abs() <= 1.0, "{c:?} {h}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// subtract → modify → add equals evaluation from scratch, exactly.
+        #[test]
+        fn running_sums_equal_evaluation_from_scratch(
+            pts in proptest::collection::vec(
+                (0.0..200.0f64, 0.0..150.0f64, -50.0..3000.0f64, 1.0..90.0f64), 1..6),
+            edit in 0usize..6,
+            moved in (0.0..200.0f64, 0.0..150.0f64, -50.0..3000.0f64, 1.0..90.0f64),
+        ) {
+            let make = |&(x, y, h, r): &(f64, f64, f64, f64)| point(x, y, h, r);
+            let mut cs: Vec<PointConstraint> = pts.iter().map(make).collect();
+            let mut running = Blend::new(200, 150, 6, q());
+            for c in &cs {
+                running.add(c);
+            }
+            let k = edit % cs.len();
+            running.subtract(&cs[k]);
+            cs[k] = make(&moved);
+            running.add(&cs[k]);
+            let mut scratch = Blend::new(200, 150, 6, q());
+            for c in &cs {
+                scratch.add(c);
+            }
+            prop_assert!(running == scratch);
+            for level in 0..=6 {
+                prop_assert_eq!(running.targets(level, 30.0), scratch.targets(level, 30.0));
+            }
+        }
+    }
+}
