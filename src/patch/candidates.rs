@@ -203,10 +203,11 @@ pub fn feature_nodes(
     let inside = |c: [f32; 2]| {
         c[0] >= margin && c[1] >= margin && c[0] <= w as f32 - margin && c[1] <= h as f32 - margin
     };
+    let idx = graph.exit_index();
     let mut nodes: Vec<FeatureNode> = centres
         .par_iter()
         .filter(|&&c| inside(c))
-        .filter_map(|&c| describe(field, w, h, c, &graph.exits(c, r), r, min_prom))
+        .filter_map(|&c| describe(field, w, h, c, &graph.exits_in(&idx, c, r), r, min_prom))
         .collect();
     if nodes.len() > cap {
         // Strongest first; ties by position for determinism.
@@ -221,9 +222,15 @@ pub fn feature_nodes(
     (graph, nodes)
 }
 
-/// Relief used to scale thresholds: the 2nd–98th percentile height range.
+/// Relief used to scale thresholds: the 2nd–98th percentile height range
+/// (of every 7th sample: plenty for percentiles, and 7× cheaper to sort).
 pub fn relief(v: &[f32]) -> f32 {
-    let mut s: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    let mut s: Vec<f32> = v
+        .iter()
+        .step_by(7)
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
     if s.is_empty() {
         return 0.0;
     }
@@ -233,15 +240,21 @@ pub fn relief(v: &[f32]) -> f32 {
 }
 
 impl PreparedSource {
-    /// Extracts features and candidates from one DEM.
-    pub fn prepare(name: &str, hf: &crate::Heightfield, params: &Params) -> crate::Result<Self> {
+    /// Extracts features and candidates from one DEM whose heights are
+    /// first multiplied by `scale` (see [`super::Library::prepare`]).
+    pub fn prepare(
+        name: &str,
+        hf: &crate::Heightfield,
+        params: &Params,
+        scale: f32,
+    ) -> crate::Result<Self> {
         let mut hf = hf.clone();
         if hf.nodata_count() > 0 {
             crate::fill::fill_nodata(&mut hf)?;
         }
         let (w, h) = (hf.width(), hf.height());
         let patch = params.patch;
-        let heights = hf.data().to_vec();
+        let heights: Vec<f32> = hf.data().iter().map(|v| v * scale).collect();
         let rel = relief(&heights).max(1.0);
         let ppa = ppa_params(patch, rel, params.source_dip);
         let margin = patch as f32 * 0.75;
@@ -301,17 +314,22 @@ impl PreparedSource {
             y += stride;
         }
         let valid = vec![true; patch * patch];
+        let lowest = dm.iter().copied().min().unwrap_or(0);
         let fill: Vec<FillCand> = pos
             .par_iter()
-            .map(|&(x, y)| {
+            .filter_map(|&(x, y)| {
                 let vals: Vec<i32> = (0..patch * patch)
                     .map(|i| dm[(y + i / patch) * w + x + i % patch])
                     .collect();
-                FillCand {
+                // Patches with more than 5 % of water-flat ground at the
+                // source's lowest level (SRTM sea is flat 0 m) would paste
+                // plateaus; they are not candidates.
+                let flat = vals.iter().filter(|&&v| v <= lowest + 5).count();
+                (flat * 20 <= vals.len()).then(|| FillCand {
                     x: x as u32,
                     y: y as u32,
                     noise: noise_levels(patch, &vals, &valid),
-                }
+                })
             })
             .collect();
         Ok(PreparedSource {

@@ -320,6 +320,7 @@ pub(crate) fn fill(
                             src.heights[(fc.y as usize + sy) * src.width + fc.x as usize + sx];
                     }
                 }
+                super::detrend(&mut patch, n);
                 let key = (si, 2u8, k);
                 let u = uses.get(&key).copied().unwrap_or(0);
                 let cost = round2_cost(&uw, &patch, &params.weights, u);

@@ -252,9 +252,48 @@ impl FeatureGraph {
         // Every path segment that enters the circle contributes; we walk each
         // path and record crossings of the circle from inside to outside,
         // seen from the point of the path nearest to c.
+        self.exits_in(&self.exit_index(), c, r)
+    }
+
+    /// Degrees and path bounding boxes, for many [`FeatureGraph::exits_in`] queries.
+    pub fn exit_index(&self) -> ExitIndex {
+        let bbox = self
+            .paths
+            .iter()
+            .map(|p| {
+                p.points.iter().fold(
+                    [
+                        f32::INFINITY,
+                        f32::INFINITY,
+                        f32::NEG_INFINITY,
+                        f32::NEG_INFINITY,
+                    ],
+                    |b, q| {
+                        [
+                            b[0].min(q[0]),
+                            b[1].min(q[1]),
+                            b[2].max(q[0]),
+                            b[3].max(q[1]),
+                        ]
+                    },
+                )
+            })
+            .collect();
+        ExitIndex {
+            deg: self.degrees(),
+            bbox,
+        }
+    }
+
+    /// [`FeatureGraph::exits`] with a prebuilt index (paths whose bounding
+    /// box is farther than `r` are skipped without looking at their points).
+    pub fn exits_in(&self, idx: &ExitIndex, c: [f32; 2], r: f32) -> Vec<[f32; 2]> {
         let mut out = Vec::new();
-        let deg = self.degrees();
-        for p in &self.paths {
+        let deg = &idx.deg;
+        for (p, b) in self.paths.iter().zip(&idx.bbox) {
+            if c[0] < b[0] - r || c[0] > b[2] + r || c[1] < b[1] - r || c[1] > b[3] + r {
+                continue;
+            }
             let pts = &p.points;
             // Nearest vertex of the path to c.
             let (near, dn) = pts
@@ -311,6 +350,13 @@ impl FeatureGraph {
         });
         merged
     }
+}
+
+/// Per-path data for fast exit queries.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExitIndex {
+    deg: Vec<usize>,
+    bbox: Vec<[f32; 4]>,
 }
 
 /// The point at arc length `s` along a polyline.

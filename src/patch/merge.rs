@@ -131,6 +131,41 @@ pub fn seam(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Se
     min_cut(n, n, &labels, &ch, &cv)
 }
 
+/// The seam cost at half resolution, for ranking finalists: the window and
+/// the patch are averaged over 2×2 blocks (a block counts as filled only if
+/// all four pixels are, and as core if any is) and cut there; the cost is
+/// doubled so that it estimates the full-resolution cut (a seam crosses
+/// half as many edges at half the resolution). Four times fewer nodes make
+/// it about eight times cheaper than [`seam`]; the winner is then cut at
+/// full resolution.
+pub fn seam_cost_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> i64 {
+    let n = win.n;
+    let m = n / 2;
+    let mut small = Canvas::new(m, m);
+    let mut sp = vec![0.0f32; m * m];
+    let mut sc = vec![false; m * m];
+    for y in 0..m {
+        for x in 0..m {
+            let (mut h, mut p, mut all, mut any_core) = (0.0f32, 0.0f32, true, false);
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let (px, py) = (2 * x + dx, 2 * y + dy);
+                let i = (win.y0 + py) * c.width + win.x0 + px;
+                all &= c.filled[i];
+                h += c.heights[i];
+                p += patch[py * n + px];
+                any_core |= core.is_some_and(|m| m[py * n + px]);
+            }
+            let k = y * m + x;
+            small.filled[k] = all;
+            small.heights[k] = h * 0.25;
+            sp[k] = p * 0.25;
+            sc[k] = any_core;
+        }
+    }
+    let win = Window { x0: 0, y0: 0, n: m };
+    2 * seam(&small, win, &sp, core.map(|_| &sc[..])).cost
+}
+
 /// Merges `patch` (already offset) into the canvas at `win`, taking the
 /// pixels `take_new`. Returns the Poisson solve's report (None when nothing
 /// old bordered the patch and it was copied as is).

@@ -146,7 +146,7 @@ impl Default for Params {
             max_source_nodes: 2500,
             best_per_source: 5,
             finalists: 5,
-            sketch_relief: 0.3,
+            sketch_relief: 0.6,
             weights: Weights::default(),
         }
     }
@@ -189,10 +189,23 @@ impl Library {
                 });
             }
         }
+        // Sources are brought to one relief, the median of their 2–98 %
+        // reliefs: patches of an alpine DEM and of a plain then sit side by
+        // side as one style instead of a patchwork of scales (seed 004 mixes
+        // sources without saying how; with our 8 DEMs spanning 345 m to
+        // 2.7 km of relief the unscaled result is dominated by whichever
+        // source the first patch came from).
+        let reliefs: Vec<f32> = sources
+            .iter()
+            .map(|(_, hf)| candidates::relief(hf.data()).max(1.0))
+            .collect();
+        let mut sorted = reliefs.clone();
+        sorted.sort_by(f32::total_cmp);
+        let target = sorted[sorted.len() / 2];
         progress.start("preparing sources", sources.len() as u64);
         let mut out = Vec::with_capacity(sources.len());
-        for (name, hf) in sources {
-            out.push(PreparedSource::prepare(name, hf, params)?);
+        for ((name, hf), rel) in sources.iter().zip(&reliefs) {
+            out.push(PreparedSource::prepare(name, hf, params, target / rel)?);
             progress.advance(1);
         }
         progress.finish();
@@ -329,8 +342,9 @@ pub fn user_patches(
     let mut graphs = Vec::new();
     for (kind, f) in [(Kind::Ridge, field), (Kind::Valley, &neg[..])] {
         let (_, g) = sketch_graph(field, w, h, patch, kind);
+        let idx = g.exit_index();
         for c in g.placements(patch as f32 / 2.0, patch as f32 / 4.0) {
-            if let Some(node) = candidates::describe(f, w, h, c, &g.exits(c, r), r, 0.02) {
+            if let Some(node) = candidates::describe(f, w, h, c, &g.exits_in(&idx, c, r), r, 0.02) {
                 out.push(UserPatch { kind, node });
             }
         }
@@ -437,6 +451,34 @@ pub fn sample_warped(
     Some(out)
 }
 
+/// Removes the least-squares tilt (the `x` and `y` slopes of the best-fit
+/// plane) from an `n × n` patch, keeping its mean. Gradient-domain merging
+/// keeps every patch's slopes, so the regional tilt each patch brings from
+/// its source (a ridge that runs downhill, a valley side) would add up from
+/// patch to patch into a random walk of height across the output; the
+/// broad shape is the sketch's to give ([`deform_by_sketch`]).
+pub fn detrend(patch: &mut [f32], n: usize) {
+    let c = (n as f64 - 1.0) / 2.0;
+    let (mut sx, mut sy, mut sxx) = (0.0f64, 0.0f64, 0.0f64);
+    for y in 0..n {
+        for x in 0..n {
+            let v = patch[y * n + x] as f64;
+            sx += (x as f64 - c) * v;
+            sy += (y as f64 - c) * v;
+        }
+    }
+    for x in 0..n {
+        sxx += (x as f64 - c).powi(2);
+    }
+    sxx *= n as f64;
+    let (bx, by) = (sx / sxx, sy / sxx);
+    for y in 0..n {
+        for x in 0..n {
+            patch[y * n + x] -= (bx * (x as f64 - c) + by * (y as f64 - c)) as f32;
+        }
+    }
+}
+
 /// Second-round scoring shared by feature and fill candidates.
 pub(crate) struct Scored {
     pub cost: f64,
@@ -510,8 +552,10 @@ pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses
 }
 
 /// Picks the winner among scored candidates: sort by cost (ties by key),
-/// add the graph-cut cost for the best `finalists`, take the minimum.
-/// Returns the winning patch (offset to the overlap) and its seam.
+/// add the graph-cut cost for the best `finalists` (estimated at half
+/// resolution, [`merge::seam_cost_coarse`]), take the minimum, and cut the
+/// winner at full resolution. Returns the winning patch (offset to the
+/// overlap) and its seam.
 pub(crate) fn select(
     c: &Canvas,
     win: Window,
@@ -522,18 +566,18 @@ pub(crate) fn select(
     scored.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.key.cmp(&b.key)));
     scored.truncate(params.finalists.max(1));
     let n = win.n as f64;
-    let results: Vec<(f64, Vec<f32>, graphcut::Seam)> = scored
+    let results: Vec<(f64, Vec<f32>)> = scored
         .par_iter()
         .map(|s| {
             let off = merge::offset(c, win, &s.patch);
             let p: Vec<f32> = s.patch.iter().map(|v| v + off).collect();
-            let seam = merge::seam(c, win, &p, core);
-            let cut = seam.cost as f64 / 256.0 / n;
-            (s.cost + params.weights.cut * cut, p, seam)
+            let cut = merge::seam_cost_coarse(c, win, &p, core) as f64 / 256.0 / n;
+            (s.cost + params.weights.cut * cut, p)
         })
         .collect();
     let best = (0..results.len()).min_by(|&a, &b| results[a].0.total_cmp(&results[b].0))?;
-    let (_, p, seam) = results.into_iter().nth(best)?;
+    let (_, p) = results.into_iter().nth(best)?;
+    let seam = merge::seam(c, win, &p, core);
     let mut win_s = scored.swap_remove(best);
     win_s.patch = p;
     Some((win_s, seam))
@@ -644,7 +688,8 @@ pub fn synthesize(
                 let src = &lib.sources[si];
                 let cand = &src.nodes(up.kind)[k as usize];
                 let (tps, deform) = feature_warp(&up.node, cand, t as usize, s as usize, r)?;
-                let patch = sample_warped(src, &tps, up.node.centre, cand.centre, r, win)?;
+                let mut patch = sample_warped(src, &tps, up.node.centre, cand.centre, r, win)?;
+                detrend(&mut patch, n);
                 let key = (si, kind_tag, k);
                 let u = uses.get(&key).copied().unwrap_or(0);
                 let feat = c1 as f64 / (d * (ALONG + ACROSS)) as f64 / (UNIT as f64 * UNIT as f64);

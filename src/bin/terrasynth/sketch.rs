@@ -61,7 +61,9 @@ pub fn run(a: Args) -> CliResult {
         ..Params::default()
     };
     let bar = Bar::new();
+    let t_prep = std::time::Instant::now();
     let lib = Library::prepare(&sources, &params, &bar)?;
+    let prep_ms = t_prep.elapsed().as_secs_f64() * 1e3;
     let result = patch::synthesize(&lib, &sketch, w, h, &bar)?;
     io::write(&result.heightfield, &a.output, &WriteOptions::default())?;
     let t = &result.timings;
@@ -76,7 +78,7 @@ pub fn run(a: Args) -> CliResult {
         s.fill_patches
     );
     eprintln!(
-        "ms: sketch {:.0}, feature round1 {:.0} round2 {:.0} merge {:.0}, fill round1 {:.0} round2 {:.0} merge {:.0}, total {:.0}",
+        "ms: source preparation {prep_ms:.0}; sketch {:.0}, feature round1 {:.0} round2 {:.0} merge {:.0}, fill round1 {:.0} round2 {:.0} merge {:.0}, total {:.0}",
         ms(t.sketch),
         ms(t.feature_round1),
         ms(t.feature_round2),
