@@ -187,22 +187,25 @@ pub(crate) fn fill(
     let mut bl = Blocks::new(canvas);
     let opts = solve_opts();
     let total_unfilled = canvas.filled.iter().filter(|f| !**f).count() as u64;
+    // The data term's gradient scale: the relief placed by the feature
+    // patches per patch width, fixed for the whole fill (recomputing it per
+    // step would scan the canvas every step for a normalisation constant).
+    let (lo, hi) = canvas
+        .heights
+        .iter()
+        .zip(&canvas.filled)
+        .filter(|(_, f)| **f)
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), (&v, _)| {
+            (a.min(v), b.max(v))
+        });
+    let g_ref = if hi > lo {
+        (hi - lo) as f64 / n as f64
+    } else {
+        1.0
+    };
     progress.start("filling", total_unfilled);
     loop {
         let t1 = Instant::now();
-        let (lo, hi) = canvas
-            .heights
-            .iter()
-            .zip(&canvas.filled)
-            .filter(|(_, f)| **f)
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), (&v, _)| {
-                (a.min(v), b.max(v))
-            });
-        let g_ref = if hi > lo {
-            (hi - lo) as f64 / n as f64
-        } else {
-            1.0
-        };
         let Some((b, dir)) = next_spot(&bl, n, g_ref.max(1e-6)) else {
             break;
         };

@@ -528,8 +528,12 @@ pub(crate) fn user_window(c: &Canvas, win: Window) -> UserWindow {
 }
 
 /// Round-two cost of a sampled candidate patch against the canvas window:
-/// `w_ssd · SSD_dc / (σ²_user + 1 m²) + w_noise · Σ(σu − σc)² / (Σσu² + Σσc² + 1 m²)
-/// + w_repeat · uses` (the SSD and noise terms only where something is placed).
+/// `w_ssd · SSD_dc / (σ²_user + σ²_cand + 1 m²) + w_noise · Σ(σu − σc)² /
+/// (Σσu² + Σσc² + 1 m²) + w_repeat · uses` (SSD and noise only where
+/// something is placed; variances over the overlap). Normalising the SSD by
+/// both variances (not the user's alone) keeps a smooth neighbourhood from
+/// admitting only smooth patches, which otherwise chains into long
+/// featureless bands.
 pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses: u32) -> f64 {
     let mut cost = weights.repeat * uses as f64;
     if u.overlap == 0 {
@@ -537,7 +541,16 @@ pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses
     }
     let pdm: Vec<i32> = patch.iter().map(|v| (v * 10.0).round() as i32).collect();
     let (ssd, _) = costs::ssd_dc(&u.dm, &pdm, &u.valid);
-    cost += weights.ssd * (ssd as f64 / 100.0) / (u.var_m2 + 1.0);
+    let (mut s, mut s2) = (0.0f64, 0.0f64);
+    for (&v, &ok) in patch.iter().zip(&u.valid) {
+        if ok {
+            s += v as f64;
+            s2 += (v as f64) * (v as f64);
+        }
+    }
+    let k = u.overlap as f64;
+    let var_c = (s2 / k - (s / k).powi(2)).max(0.0);
+    cost += weights.ssd * (ssd as f64 / 100.0) / (u.var_m2 + var_c + 1.0);
     let all = vec![true; patch.len()];
     let cn = noise_levels(u.dm.len().isqrt(), &pdm, &all);
     let num = costs::noise_cost(&u.noise, &cn) as f64;
@@ -787,7 +800,9 @@ fn median_cell(lib: &Library) -> f64 {
 
 /// Feature adherence (issue 7): mean output height within `radius` of the
 /// sketched ridge strokes minus that near the valley strokes, divided by the
-/// output's relief (max − min). `None` if either kind is absent.
+/// output's relief (max − min). A sketch with only ridges (Zhou's λ) is
+/// measured against the background instead: pixels farther than
+/// `4 · radius` from every stroke. `None` without ridge strokes.
 pub fn adherence(hf: &Heightfield, sketch: &Sketch, radius: f32) -> Option<f64> {
     let (w, h) = (hf.width(), hf.height());
     let stats = hf.stats()?;
@@ -801,6 +816,13 @@ pub fn adherence(hf: &Heightfield, sketch: &Sketch, radius: f32) -> Option<f64> 
         if k == 0 { None } else { Some(s / k as f64) }
     };
     let ridge = mean(&sketch::stroke_mask(sketch, Kind::Ridge, w, h, radius))?;
-    let valley = mean(&sketch::stroke_mask(sketch, Kind::Valley, w, h, radius))?;
-    Some((ridge - valley) / relief.max(1e-9))
+    let low = match mean(&sketch::stroke_mask(sketch, Kind::Valley, w, h, radius)) {
+        Some(v) => v,
+        None => {
+            let near = sketch::stroke_mask(sketch, Kind::Ridge, w, h, 4.0 * radius);
+            let far: Vec<bool> = near.iter().map(|n| !n).collect();
+            mean(&far)?
+        }
+    };
+    Some((ridge - low) / relief.max(1e-9))
 }

@@ -89,7 +89,7 @@ pub fn run(a: Args) -> CliResult {
         ms(t.total)
     );
     if let Some(adh) = patch::adherence(&result.heightfield, &sketch, a.patch as f32 / 16.0) {
-        eprintln!("feature adherence (ridge mean - valley mean) / relief: {adh:.3}");
+        eprintln!("feature adherence (ridge mean - valley or background mean) / relief: {adh:.3}");
     }
     if let Some(p) = &a.preview {
         let preview = render::render(&result.heightfield, &RenderOptions::default())?;
