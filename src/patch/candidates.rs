@@ -3,7 +3,7 @@
 //! A [`PreparedSource`] holds everything synthesis needs from one DEM:
 //! ridge and valley feature nodes with control points and profiles, the
 //! grid of non-feature candidates with their noise statistics, and a
-//! 4×-reduced integer copy for the first round of hole-filling costs.
+//! 8×-reduced integer copy for the first round of hole-filling costs.
 //! Preparing is the expensive part (PPA on the whole DEM); it is done once
 //! per source and the value is kept by the caller — the [`super::Library`]
 //! caches it in memory for as many sketches as are synthesized with it
@@ -136,6 +136,12 @@ pub fn fill_map(v: usize, x: usize, y: usize, n: usize) -> (usize, usize) {
     }
 }
 
+/// Reduction of the grid on which round one of hole filling compares
+/// patches: 8 × 8 block means, so a 64-pixel patch is 64 numbers (the
+/// winner is checked at full resolution in round two). Patch sizes are
+/// multiples of 8.
+pub const COARSE: usize = 8;
+
 /// Number of non-feature transforms.
 pub const FILL_TRANSFORMS: usize = 6;
 
@@ -152,7 +158,7 @@ pub struct PreparedSource {
     pub dm: Vec<i32>,
     pub ridges: Vec<FeatureNode>,
     pub valleys: Vec<FeatureNode>,
-    /// 4×4 block means of `dm`.
+    /// [`COARSE`]² block means of `dm` (round one of hole filling).
     pub coarse: Vec<i32>,
     pub coarse_w: usize,
     pub fill: Vec<FillCand>,
@@ -287,22 +293,22 @@ impl PreparedSource {
             },
         );
         let dm: Vec<i32> = heights.iter().map(|v| (v * 10.0).round() as i32).collect();
-        let cw = w / 4;
-        let ch = h / 4;
+        let cw = w / COARSE;
+        let ch = h / COARSE;
         let coarse: Vec<i32> = (0..cw * ch)
             .into_par_iter()
             .map(|i| {
                 let (bx, by) = (i % cw, i / cw);
                 let mut s = 0i64;
-                for y in 0..4 {
-                    for x in 0..4 {
-                        s += dm[(4 * by + y) * w + 4 * bx + x] as i64;
+                for y in 0..COARSE {
+                    for x in 0..COARSE {
+                        s += dm[(COARSE * by + y) * w + COARSE * bx + x] as i64;
                     }
                 }
-                s.div_euclid(16) as i32
+                s.div_euclid((COARSE * COARSE) as i64) as i32
             })
             .collect();
-        let stride = (patch / 2).max(4) & !3;
+        let stride = (patch / 2).max(COARSE) & !(COARSE - 1);
         let mut pos = Vec::new();
         let mut y = 0;
         while y + patch <= h {

@@ -10,12 +10,12 @@
 //! Candidates: every source's patches on a patch/2 grid under 6 transforms
 //! (four 90° rotations and two mirrors, which need no resampling). Round
 //! one is integer and data-parallel: DC-corrected SSD against the window's
-//! fully filled 4×4 cells on the 4× reduced grid, plus the noise-variance
+//! fully filled 8×8 cells on the 8× reduced grid, plus the noise-variance
 //! difference; the user window is permuted into each transform's frame
 //! once, so every candidate reads contiguous source rows. The best 5 per
 //! source go to round two and the graph-cut finalists ([`super::select`]).
 
-use super::candidates::{FILL_TRANSFORMS, fill_map};
+use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
 use super::costs::noise_cost;
 use super::merge::{self, Canvas, Window};
 use super::{Library, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window};
@@ -182,7 +182,7 @@ pub(crate) fn fill(
 ) {
     let params = &lib.params;
     let n = params.patch;
-    let m = n / B;
+    let m = n / COARSE;
     let (w, h) = (canvas.width, canvas.height);
     let mut bl = Blocks::new(canvas);
     let opts = solve_opts();
@@ -230,14 +230,14 @@ pub(crate) fn fill(
             for cx in 0..m {
                 let mut s = 0i64;
                 let mut all = true;
-                for y in 0..B {
-                    for x in 0..B {
-                        let k = (cy * B + y) * n + cx * B + x;
+                for y in 0..COARSE {
+                    for x in 0..COARSE {
+                        let k = (cy * COARSE + y) * n + cx * COARSE + x;
                         all &= uw.valid[k];
                         s += uw.dm[k] as i64;
                     }
                 }
-                uc[cy * m + cx] = s.div_euclid(16) as i32;
+                uc[cy * m + cx] = s.div_euclid((COARSE * COARSE) as i64) as i32;
                 uv[cy * m + cx] = all;
             }
         }
@@ -265,7 +265,7 @@ pub(crate) fn fill(
                 .par_iter()
                 .enumerate()
                 .map(|(k, fc)| {
-                    let (ox, oy) = (fc.x as usize / B, fc.y as usize / B);
+                    let (ox, oy) = (fc.x as usize / COARSE, fc.y as usize / COARSE);
                     let nc = noise_cost(&uw.noise, &fc.noise) * params.weights.fill_noise;
                     let mut b = (u64::MAX, 0u8);
                     for (v, (a, ok)) in perms.iter().enumerate() {

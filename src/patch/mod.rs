@@ -16,7 +16,7 @@
 //! 4. [`merge`]: graph-cut seam ([`graphcut`]), Shepard-interpolated gradient
 //!    correction and a Poisson solve;
 //! 5. [`fill`]: the rest, by priority order, from non-feature candidates
-//!    under 6 transforms (integer SSD + noise on a 4× reduced grid, then the
+//!    under 6 transforms (integer SSD + noise on an 8× reduced grid, then the
 //!    same second round and merge).
 //!
 //! Everything is deterministic: no randomness; parallel loops write
