@@ -9,12 +9,14 @@
 //! See `DESIGN.md` in the repository for the architecture.
 
 pub mod backend;
+pub mod blend;
 pub mod database;
 pub mod error;
 pub mod fill;
 pub mod hash;
 pub mod heightfield;
 pub mod io;
+pub mod patch;
 pub mod poisson;
 pub mod procedural;
 pub mod progress;

@@ -9,6 +9,7 @@ mod generate;
 mod info;
 mod progress;
 mod render;
+mod sketch;
 mod synth;
 
 use clap::{Parser, Subcommand};
@@ -45,6 +46,8 @@ enum Command {
     Render(render::Args),
     /// Generate a procedural terrain in a default exemplar style (see --list).
     Generate(generate::Args),
+    /// Turn a ridge/valley sketch into terrain made of real DEM patches.
+    Sketch(sketch::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
         Command::Synth(a) => synth::run(a),
         Command::Edit(a) => edit::run(a),
         Command::Generate(a) => generate::run(a),
+        Command::Sketch(a) => sketch::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,369 @@
+//! Non-feature filling (seed 004 §4.2.2, after Criminisi et al. 2004 with
+//! Nie et al.'s additive priority): while holes remain, the unfilled spot
+//! of highest priority `P = C + D` gets a patch, where `C` is the filled
+//! fraction of its window (confidence) and `D = min(1, |∇h⊥ · n̂| / g_ref)`
+//! the strength of the isophote that meets the fill front (`n̂` the front's
+//! normal, `g_ref` = canvas relief / patch). Priorities are evaluated on a
+//! 4-pixel block lattice with summed-area tables (exact enough for choosing
+//! the next spot, and O(blocks) per step).
+//!
+//! Candidates: every source's patches on a patch/2 grid under 6 transforms
+//! (four 90° rotations and two mirrors, which need no resampling). Round
+//! one is integer and data-parallel: DC-corrected SSD against the window's
+//! fully filled 8×8 cells on the 8× reduced grid, plus the noise-variance
+//! difference; the user window is permuted into each transform's frame
+//! once, so every candidate reads contiguous source rows. The best 5 per
+//! source go to round two and the graph-cut finalists ([`super::select`]).
+
+use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
+use super::costs::noise_cost;
+use super::merge::{self, Canvas, Window};
+use super::{Library, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window};
+use crate::progress::Progress;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+const B: usize = 4;
+
+struct Blocks {
+    bw: usize,
+    bh: usize,
+    cnt: Vec<u32>,
+    area: Vec<u32>,
+    hsum: Vec<f64>,
+}
+
+impl Blocks {
+    fn new(c: &Canvas) -> Blocks {
+        let (bw, bh) = (c.width.div_ceil(B), c.height.div_ceil(B));
+        let mut b = Blocks {
+            bw,
+            bh,
+            cnt: vec![0; bw * bh],
+            area: vec![0; bw * bh],
+            hsum: vec![0.0; bw * bh],
+        };
+        b.update(c, 0, 0, c.width, c.height);
+        b
+    }
+
+    /// Recounts the blocks touching the pixel rectangle.
+    fn update(&mut self, c: &Canvas, x0: usize, y0: usize, x1: usize, y1: usize) {
+        for by in y0 / B..y1.div_ceil(B).min(self.bh) {
+            for bx in x0 / B..x1.div_ceil(B).min(self.bw) {
+                let (mut k, mut a, mut s) = (0u32, 0u32, 0.0f64);
+                for y in by * B..((by + 1) * B).min(c.height) {
+                    for x in bx * B..((bx + 1) * B).min(c.width) {
+                        let i = y * c.width + x;
+                        a += 1;
+                        if c.filled[i] {
+                            k += 1;
+                            s += c.heights[i] as f64;
+                        }
+                    }
+                }
+                let b = by * self.bw + bx;
+                self.cnt[b] = k;
+                self.area[b] = a;
+                self.hsum[b] = s;
+            }
+        }
+    }
+}
+
+/// Summed-area table with a zero border row and column.
+fn sat<T: Copy + Default + std::ops::Add<Output = T> + std::ops::Sub<Output = T>>(
+    v: &[T],
+    w: usize,
+    h: usize,
+) -> Vec<T> {
+    let mut s = vec![T::default(); (w + 1) * (h + 1)];
+    for y in 0..h {
+        let mut row = T::default();
+        for x in 0..w {
+            row = row + v[y * w + x];
+            s[(y + 1) * (w + 1) + x + 1] = s[y * (w + 1) + x + 1] + row;
+        }
+    }
+    s
+}
+
+fn rect<T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T>>(
+    s: &[T],
+    w: usize,
+    x0: usize,
+    y0: usize,
+    x1: usize,
+    y1: usize,
+) -> T {
+    let k = w + 1;
+    s[y1 * k + x1] + s[y0 * k + x0] - s[y0 * k + x1] - s[y1 * k + x0]
+}
+
+/// The next block to fill (highest priority, lowest index on ties).
+fn next_spot(bl: &Blocks, n: usize, g_ref: f64) -> Option<(usize, [f32; 2])> {
+    let (bw, bh) = (bl.bw, bl.bh);
+    let cs = sat(
+        &bl.cnt.iter().map(|&c| c as u64).collect::<Vec<_>>(),
+        bw,
+        bh,
+    );
+    let hs = sat(&bl.hsum, bw, bh);
+    let rb = (n / B / 2).max(1);
+    let any_filled = bl.cnt.iter().any(|&c| c > 0);
+    let pr: Vec<(f64, usize, [f32; 2])> = (0..bw * bh)
+        .into_par_iter()
+        .filter(|&b| bl.cnt[b] < bl.area[b])
+        .filter_map(|b| {
+            let (bx, by) = (b % bw, b / bw);
+            let (x0, y0) = (bx.saturating_sub(rb), by.saturating_sub(rb));
+            let (x1, y1) = ((bx + rb + 1).min(bw), (by + rb + 1).min(bh));
+            let filled = rect(&cs, bw, x0, y0, x1, y1);
+            if filled == 0 {
+                return None;
+            }
+            let conf = filled as f64 / (n * n) as f64;
+            // Front normal and height gradient from half-window differences.
+            let half = |ax0, ay0, ax1, ay1| {
+                let k = rect(&cs, bw, ax0, ay0, ax1, ay1) as f64;
+                let s = rect(&hs, bw, ax0, ay0, ax1, ay1);
+                (k, if k > 0.0 { Some(s / k) } else { None })
+            };
+            let (kl, ml) = half(x0, y0, bx, y1);
+            let (kr, mr) = half(bx + 1, y0, x1, y1);
+            let (kt, mt) = half(x0, y0, x1, by);
+            let (kd, md) = half(x0, by + 1, x1, y1);
+            let (nx, ny) = (kr - kl, kd - kt);
+            let nl = (nx * nx + ny * ny).sqrt();
+            let span = (rb * B) as f64;
+            let gx = match (ml, mr) {
+                (Some(a), Some(c)) => (c - a) / span,
+                _ => 0.0,
+            };
+            let gy = match (mt, md) {
+                (Some(a), Some(c)) => (c - a) / span,
+                _ => 0.0,
+            };
+            let data = if nl > 0.0 {
+                ((-gy * nx + gx * ny) / nl).abs() / g_ref
+            } else {
+                0.0
+            };
+            let dir = if nl > 0.0 {
+                [(nx / nl) as f32, (ny / nl) as f32]
+            } else {
+                [0.0, 0.0]
+            };
+            Some((conf + data.min(1.0), b, dir))
+        })
+        .collect();
+    if !any_filled {
+        // Nothing placed yet (a sketch without features): start in the middle.
+        return (0..bw * bh)
+            .find(|&b| b == (bh / 2) * bw + bw / 2 && bl.cnt[b] < bl.area[b])
+            .or_else(|| (0..bw * bh).find(|&b| bl.cnt[b] < bl.area[b]))
+            .map(|b| (b, [0.0, 0.0]));
+    }
+    pr.into_iter()
+        .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)))
+        .map(|(_, b, d)| (b, d))
+}
+
+/// Fills every hole of the canvas.
+pub(crate) fn fill(
+    lib: &Library,
+    canvas: &mut Canvas,
+    uses: &mut BTreeMap<(usize, u8, u32), u32>,
+    timings: &mut Timings,
+    stats: &mut Stats,
+    solo: &rayon::ThreadPool,
+    progress: &dyn Progress,
+) {
+    let params = &lib.params;
+    let n = params.patch;
+    let m = n / COARSE;
+    let (w, h) = (canvas.width, canvas.height);
+    let mut bl = Blocks::new(canvas);
+    let opts = solve_opts();
+    let total_unfilled = canvas.filled.iter().filter(|f| !**f).count() as u64;
+    // The data term's gradient scale: the relief placed by the feature
+    // patches per patch width, fixed for the whole fill (recomputing it per
+    // step would scan the canvas every step for a normalisation constant).
+    let (lo, hi) = canvas
+        .heights
+        .iter()
+        .zip(&canvas.filled)
+        .filter(|(_, f)| **f)
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), (&v, _)| {
+            (a.min(v), b.max(v))
+        });
+    let g_ref = if hi > lo {
+        (hi - lo) as f64 / n as f64
+    } else {
+        1.0
+    };
+    progress.start("filling", total_unfilled);
+    loop {
+        let t1 = Instant::now();
+        let Some((b, dir)) = next_spot(&bl, n, g_ref.max(1e-6)) else {
+            break;
+        };
+        let (bx, by) = (b % bl.bw, b / bl.bw);
+        // Centre the window a quarter patch away from the filled side (the
+        // front normal points toward it), so that about a quarter of it
+        // overlaps (seed 001: overlap about a third of a patch). The window
+        // still holds the chosen block, so every step fills something.
+        let shift = (n / 4) as f32 - B as f32;
+        let win = Window::around(
+            (bx * B) as f32 + B as f32 / 2.0 - dir[0] * shift,
+            (by * B) as f32 + B as f32 / 2.0 - dir[1] * shift,
+            n,
+            w,
+            h,
+        );
+        let uw = user_window(canvas, win);
+        // User cells on the reduced grid.
+        let mut uc = vec![0i32; m * m];
+        let mut uv = vec![false; m * m];
+        for cy in 0..m {
+            for cx in 0..m {
+                let mut s = 0i64;
+                let mut all = true;
+                for y in 0..COARSE {
+                    for x in 0..COARSE {
+                        let k = (cy * COARSE + y) * n + cx * COARSE + x;
+                        all &= uw.valid[k];
+                        s += uw.dm[k] as i64;
+                    }
+                }
+                uc[cy * m + cx] = s.div_euclid((COARSE * COARSE) as i64) as i32;
+                uv[cy * m + cx] = all;
+            }
+        }
+        // Permute into each transform's source frame.
+        let perms: Vec<(Vec<i32>, Vec<bool>)> = (0..FILL_TRANSFORMS)
+            .map(|v| {
+                let mut a = vec![0i32; m * m];
+                let mut ok = vec![false; m * m];
+                for cy in 0..m {
+                    for cx in 0..m {
+                        let (sx, sy) = fill_map(v, cx, cy, m);
+                        a[sy * m + sx] = uc[cy * m + cx];
+                        ok[sy * m + sx] = uv[cy * m + cx];
+                    }
+                }
+                (a, ok)
+            })
+            .collect();
+        let any_cell = uv.iter().any(|&v| v);
+        let mut best: Vec<(usize, u32, u8)> = Vec::new();
+        for (si, src) in lib.sources.iter().enumerate() {
+            let cw = src.coarse_w;
+            let mut scored: Vec<(u64, u32, u8)> = src
+                .fill
+                .par_iter()
+                .enumerate()
+                .map(|(k, fc)| {
+                    let (ox, oy) = (fc.x as usize / COARSE, fc.y as usize / COARSE);
+                    let nc = noise_cost(&uw.noise, &fc.noise) * params.weights.fill_noise;
+                    let mut b = (u64::MAX, 0u8);
+                    for (v, (a, ok)) in perms.iter().enumerate() {
+                        let ssd = if any_cell {
+                            let mut cand = [0i32; 64];
+                            let mut total = (0i64, 0i64, 0i64);
+                            for row in 0..m {
+                                let srow =
+                                    &src.coarse[(oy + row) * cw + ox..(oy + row) * cw + ox + m];
+                                cand[..m].copy_from_slice(srow);
+                                let (s, s2, c) = row_sums(
+                                    &a[row * m..(row + 1) * m],
+                                    &cand[..m],
+                                    &ok[row * m..(row + 1) * m],
+                                );
+                                total.0 += s;
+                                total.1 += s2;
+                                total.2 += c;
+                            }
+                            let (s, s2, c) = total;
+                            if c > 0 {
+                                ((c * s2 - s * s) / (c * c)) as u64
+                            } else {
+                                0
+                            }
+                        } else {
+                            0
+                        };
+                        let cost = ssd.saturating_add(nc);
+                        if cost < b.0 {
+                            b = (cost, v as u8);
+                        }
+                    }
+                    (b.0, k as u32, b.1)
+                })
+                .collect();
+            stats.round1_fill += (scored.len() * FILL_TRANSFORMS) as u64;
+            scored.sort_unstable();
+            for &(_, k, v) in scored.iter().take(params.best_per_source) {
+                best.push((si, k, v));
+            }
+        }
+        timings.fill_round1 += t1.elapsed();
+        let t2 = Instant::now();
+        let scored: Vec<Scored> = best
+            .par_iter()
+            .map(|&(si, k, v)| {
+                let src = &lib.sources[si];
+                let fc = src.fill[k as usize];
+                let mut patch = vec![0.0f32; n * n];
+                for y in 0..n {
+                    for x in 0..n {
+                        let (sx, sy) = fill_map(v as usize, x, y, n);
+                        patch[y * n + x] =
+                            src.heights[(fc.y as usize + sy) * src.width + fc.x as usize + sx];
+                    }
+                }
+                super::detrend(&mut patch, n);
+                let key = (si, 2u8, k);
+                let u = uses.get(&key).copied().unwrap_or(0);
+                let cost = round2_cost(&uw, &patch, &params.weights, u);
+                Scored { cost, patch, key }
+            })
+            .collect();
+        let chosen = select(canvas, win, scored, None, params);
+        timings.fill_round2 += t2.elapsed();
+        let Some((s, seam)) = chosen else {
+            break;
+        };
+        let t3 = Instant::now();
+        *uses.entry(s.key).or_insert(0) += 1;
+        let before = uw.overlap;
+        if let Some(rep) =
+            solo.install(|| merge::apply(canvas, win, &s.patch, &seam.take_new, &opts))
+        {
+            stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
+        }
+        bl.update(canvas, win.x0, win.y0, win.x0 + n, win.y0 + n);
+        let after = (0..n * n)
+            .filter(|&i| canvas.filled[(win.y0 + i / n) * w + win.x0 + i % n])
+            .count();
+        progress.advance(after.saturating_sub(before) as u64);
+        stats.fill_patches += 1;
+        timings.fill_merge += t3.elapsed();
+    }
+    progress.finish();
+}
+
+/// `(Σd, Σd², count)` of `d = a − b` over valid samples of one row. Plain
+/// fixed-length integer loops, which the compiler vectorises.
+#[inline]
+fn row_sums(a: &[i32], b: &[i32], ok: &[bool]) -> (i64, i64, i64) {
+    let (mut s, mut s2, mut c) = (0i64, 0i64, 0i64);
+    for ((&x, &y), &v) in a.iter().zip(b).zip(ok) {
+        let d = ((x - y) * v as i32) as i64;
+        s += d;
+        s2 += d * d;
+        c += v as i64;
+    }
+    (s, s2, c)
+}
