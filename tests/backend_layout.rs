@@ -3,7 +3,10 @@
 //! and member offsets on both sides.
 
 use std::mem::{offset_of, size_of};
-use terrasynth::backend::kernels::{self, CorrectUniform, ReconstructUniform, UpsampleUniform};
+use terrasynth::backend::kernels::{
+    self, CorrectUniform, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
+    UpsampleUniform,
+};
 use terrasynth::render::shade::ShadeParams;
 use terrasynth::synth::atlas::Column;
 
@@ -131,6 +134,28 @@ fn parameter_structs_match_their_wgsl_declarations() {
         })
     );
     assert_eq!(
+        wgsl_struct(&module(kernels::REDUCE_TYPES), "ReduceTypesParams"),
+        rust_layout!(ReduceTypesUniform {
+            width,
+            height,
+            child_width,
+            child_height,
+            full,
+            pad0,
+            pad1,
+            pad2
+        })
+    );
+    assert_eq!(
+        wgsl_struct(&module(kernels::REDUCE_WEIGHTS), "ReduceWeightsParams"),
+        rust_layout!(ReduceWeightsUniform {
+            width,
+            height,
+            child_width,
+            child_height
+        })
+    );
+    assert_eq!(
         wgsl_struct(&module(kernels::RECONSTRUCT), "ReconstructParams"),
         rust_layout!(ReconstructUniform {
             width,
@@ -236,6 +261,17 @@ fn shade_constants_match() {
     }
     assert_eq!(shade::NODATA, i32::MIN);
     assert!(src.contains("const NODATA: i32 = -2147483647 - 1;"));
+}
+
+#[test]
+fn all_types_matches_reduce_types() {
+    assert_eq!(terrasynth::synth::stages::correct::ALL_TYPES, u32::MAX);
+    assert!(
+        kernels::REDUCE_TYPES
+            .source
+            .contains("const ALL_TYPES: u32 = 4294967295u;"),
+        "ALL_TYPES must be u32::MAX in reduce_types.wgsl"
+    );
 }
 
 #[test]

@@ -1,11 +1,13 @@
 //! The CPU backend: the rayon + SIMD stages of `synth::stages`, state in
 //! host memory. The reference every other backend is checked against.
 
-use super::{Backend, BackendError};
+use super::{Backend, BackendError, Raster};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::fixed::Coord;
 use crate::synth::stages::correct::{self, CorrectParams};
 use crate::synth::stages::reconstruct;
+use crate::synth::stages::reduce_types::reduce_types;
+use crate::synth::stages::reduce_weights::reduce_weights;
 use crate::synth::stages::upsample_jitter::{self, Step, UpsampleParams};
 use crate::synth::state::State;
 
@@ -18,6 +20,8 @@ pub struct Cpu<'a, 'db> {
 
 impl Backend for Cpu<'_, '_> {
     type State = State;
+    type Types = Raster<u32>;
+    type Weights = Raster<u8>;
 
     fn name(&self) -> &'static str {
         "cpu"
@@ -46,6 +50,51 @@ impl Backend for Cpu<'_, '_> {
 
     fn download(&self, st: &State) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {
         Ok((st.coords(), st.offsets()))
+    }
+
+    fn upload_types(&self, data: &[u32], w: usize, h: usize) -> Result<Raster<u32>, BackendError> {
+        Raster::new("type sets", data, w, h)
+    }
+
+    fn upload_weights(&self, data: &[u8], w: usize, h: usize) -> Result<Raster<u8>, BackendError> {
+        Raster::new("coherence weights", data, w, h)
+    }
+
+    fn reduce_types(
+        &self,
+        child: &Raster<u32>,
+        width: usize,
+        height: usize,
+        full: u32,
+    ) -> Result<Raster<u32>, BackendError> {
+        let data = reduce_types(&child.data, child.width, child.height, width, height, full);
+        Ok(Raster {
+            width,
+            height,
+            data,
+        })
+    }
+
+    fn reduce_weights(
+        &self,
+        child: &Raster<u8>,
+        width: usize,
+        height: usize,
+    ) -> Result<Raster<u8>, BackendError> {
+        let data = reduce_weights(&child.data, child.width, child.height, width, height);
+        Ok(Raster {
+            width,
+            height,
+            data,
+        })
+    }
+
+    fn download_types(&self, r: &Raster<u32>) -> Result<Vec<u32>, BackendError> {
+        Ok(r.data.clone())
+    }
+
+    fn download_weights(&self, r: &Raster<u8>) -> Result<Vec<u8>, BackendError> {
+        Ok(r.data.clone())
     }
 
     fn finish(&self) -> Result<(), BackendError> {

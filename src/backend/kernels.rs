@@ -41,6 +41,15 @@ pub const RECONSTRUCT: Kernel = Kernel {
     source: include_str!("../../kernels/reconstruct.wgsl"),
 };
 
+pub const REDUCE_TYPES: Kernel = Kernel {
+    name: "reduce_types",
+    source: include_str!("../../kernels/reduce_types.wgsl"),
+};
+pub const REDUCE_WEIGHTS: Kernel = Kernel {
+    name: "reduce_weights",
+    source: include_str!("../../kernels/reduce_weights.wgsl"),
+};
+
 /// The preview renderer's stage (`render::shade`); its parameter block is
 /// `render::shade::ShadeParams` itself, already `#[repr(C)]` and Pod.
 pub const SHADE: Kernel = Kernel {
@@ -49,7 +58,14 @@ pub const SHADE: Kernel = Kernel {
 };
 
 /// Every kernel, for tests that check them all.
-pub const ALL: [Kernel; 4] = [UPSAMPLE_JITTER, CORRECT, RECONSTRUCT, SHADE];
+pub const ALL: [Kernel; 6] = [
+    UPSAMPLE_JITTER,
+    CORRECT,
+    REDUCE_TYPES,
+    REDUCE_WEIGHTS,
+    RECONSTRUCT,
+    SHADE,
+];
 
 /// Workgroup side of every kernel (`@workgroup_size(8, 8)`).
 pub const WORKGROUP: u32 = 8;
@@ -96,4 +112,30 @@ pub struct ReconstructUniform {
     pub height: u32,
     pub pad0: u32,
     pub pad1: u32,
+}
+
+/// `ReduceTypesParams` of `kernels/reduce_types.wgsl` (padded to 32 bytes,
+/// a whole number of 16-byte uniform rows).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct ReduceTypesUniform {
+    pub width: u32,
+    pub height: u32,
+    pub child_width: u32,
+    pub child_height: u32,
+    /// Every type of the database (`reduce_types`' `full`).
+    pub full: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
+}
+
+/// `ReduceWeightsParams` of `kernels/reduce_weights.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct ReduceWeightsUniform {
+    pub width: u32,
+    pub height: u32,
+    pub child_width: u32,
+    pub child_height: u32,
 }

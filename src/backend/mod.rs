@@ -48,10 +48,19 @@ pub struct StageTime {
 /// per-level inputs of later stages (the user-control rasters of
 /// `synth::control`: targets, allowed types, coherence weights) fit the
 /// same way: uploaded once per level as a backend-side associated type,
-/// passed to [`Backend::correct`] next to the state.
+/// passed to [`Backend::correct`] next to the state. The pyramids of two of
+/// them are stages of their own ([`Backend::reduce_types`],
+/// [`Backend::reduce_weights`]), so a backend builds every level's raster
+/// from level 0's where it keeps them.
 pub trait Backend {
     /// One level's coordinates S and offsets V, where this backend keeps them.
     type State;
+    /// One level's target type sets R^i (u32 masks of type ids), where this
+    /// backend keeps them.
+    type Types;
+    /// One level's coherence weights W^i (quarters, u8 on the host), where
+    /// this backend keeps them.
+    type Weights;
 
     /// `"cpu"` or `"gpu"`, for reports.
     fn name(&self) -> &'static str;
@@ -74,6 +83,39 @@ pub trait Backend {
     fn reconstruct(&self, st: &Self::State) -> Result<Vec<i32>, BackendError>;
     /// A copy of a state's coordinates and offsets, row-major.
     fn download(&self, st: &Self::State) -> Result<(Vec<Coord>, Vec<i32>), BackendError>;
+    /// Moves a `width × height` raster of type sets to the backend.
+    fn upload_types(
+        &self,
+        data: &[u32],
+        width: usize,
+        height: usize,
+    ) -> Result<Self::Types, BackendError>;
+    /// Moves a `width × height` raster of coherence weights to the backend.
+    fn upload_weights(
+        &self,
+        data: &[u8],
+        width: usize,
+        height: usize,
+    ) -> Result<Self::Weights, BackendError>;
+    /// Stage `reduce_types`: the `width × height` level above `child`.
+    fn reduce_types(
+        &self,
+        child: &Self::Types,
+        width: usize,
+        height: usize,
+        full: u32,
+    ) -> Result<Self::Types, BackendError>;
+    /// Stage `reduce_weights`: the `width × height` level above `child`.
+    fn reduce_weights(
+        &self,
+        child: &Self::Weights,
+        width: usize,
+        height: usize,
+    ) -> Result<Self::Weights, BackendError>;
+    /// A copy of a type-set raster, row-major.
+    fn download_types(&self, r: &Self::Types) -> Result<Vec<u32>, BackendError>;
+    /// A copy of a weight raster, row-major.
+    fn download_weights(&self, r: &Self::Weights) -> Result<Vec<u8>, BackendError>;
     /// Waits until every queued stage has run (so a caller's clock measures
     /// the work, not its submission).
     fn finish(&self) -> Result<(), BackendError>;
@@ -87,6 +129,52 @@ pub trait Backend {
     fn device_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {
         Ok(None)
     }
+}
+
+/// A control raster in host memory (the CPU backend's [`Backend::Types`]
+/// and [`Backend::Weights`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Raster<T> {
+    pub width: usize,
+    pub height: usize,
+    /// Row-major, `width × height` values.
+    pub data: Vec<T>,
+}
+
+impl<T: Clone> Raster<T> {
+    /// A raster of `data`, which must hold `width × height` values.
+    pub fn new(
+        what: &'static str,
+        data: &[T],
+        width: usize,
+        height: usize,
+    ) -> Result<Raster<T>, BackendError> {
+        check_raster(what, data.len(), width, height)?;
+        Ok(Raster {
+            width,
+            height,
+            data: data.to_vec(),
+        })
+    }
+}
+
+/// Rejects a raster whose length is not `width × height` (the stages index
+/// it by pixel, so a short one would read out of bounds).
+pub fn check_raster(
+    what: &'static str,
+    len: usize,
+    width: usize,
+    height: usize,
+) -> Result<(), BackendError> {
+    if width.checked_mul(height) != Some(len) {
+        return Err(BackendError::RasterSize {
+            what,
+            len,
+            width,
+            height,
+        });
+    }
+    Ok(())
 }
 
 /// Which backend a user asked for (`--backend`).
@@ -118,6 +206,13 @@ pub enum BackendError {
         what: &'static str,
         bytes: u64,
         limit: u64,
+    },
+    #[error("{what} raster holds {len} values, but {width} × {height} were given")]
+    RasterSize {
+        what: &'static str,
+        len: usize,
+        width: usize,
+        height: usize,
     },
     #[error("GPU error: {0}")]
     Gpu(String),

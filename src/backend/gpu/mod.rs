@@ -12,8 +12,11 @@
 //! runs them in order, and wgpu orders storage-buffer accesses across
 //! submissions, so one subpass sees the previous one's writes.
 
-use super::kernels::{self, CorrectUniform, Kernel, ReconstructUniform, UpsampleUniform};
-use super::{Backend, BackendError, Stage, StageTime};
+use super::kernels::{
+    self, CorrectUniform, Kernel, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
+    UpsampleUniform,
+};
+use super::{Backend, BackendError, Stage, StageTime, check_raster};
 use crate::render::shade::{ShadeBuffers, ShadeParams};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::fixed::Coord;
@@ -34,6 +37,8 @@ pub struct Context {
     limits: wgpu::Limits,
     upsample_jitter: wgpu::ComputePipeline,
     correct: wgpu::ComputePipeline,
+    reduce_types: wgpu::ComputePipeline,
+    reduce_weights: wgpu::ComputePipeline,
     reconstruct: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
     /// Timestamp queries, where the adapter has them.
@@ -104,6 +109,8 @@ impl Context {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let upsample_jitter = pipeline(kernels::UPSAMPLE_JITTER);
         let correct = pipeline(kernels::CORRECT);
+        let reduce_types = pipeline(kernels::REDUCE_TYPES);
+        let reduce_weights = pipeline(kernels::REDUCE_WEIGHTS);
         let reconstruct = pipeline(kernels::RECONSTRUCT);
         let shade = pipeline(kernels::SHADE);
         if let Some(e) = scope.pop().await {
@@ -128,6 +135,8 @@ impl Context {
             limits,
             upsample_jitter,
             correct,
+            reduce_types,
+            reduce_weights,
             reconstruct,
             shade,
         }))
@@ -419,8 +428,62 @@ impl Gpu {
     }
 }
 
+/// One level's control raster on the device, one u32 per pixel: type sets
+/// as they are, coherence weights widened from u8 (see
+/// `kernels/reduce_weights.wgsl`).
+pub struct GpuRaster {
+    pub width: usize,
+    pub height: usize,
+    buf: wgpu::Buffer,
+}
+
+impl Gpu {
+    fn upload_raster(
+        &self,
+        what: &'static str,
+        data: &[u32],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        check_raster(what, data.len(), width, height)?;
+        Ok(GpuRaster {
+            width,
+            height,
+            buf: self.ctx.storage(what, bytemuck::cast_slice(data))?,
+        })
+    }
+
+    /// One dispatch of a reduction from `child` into a new `width × height`
+    /// raster.
+    fn reduce(
+        &self,
+        what: &'static str,
+        pipeline: &wgpu::ComputePipeline,
+        uniform: &[u8],
+        child: &GpuRaster,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        let bytes = (width as u64)
+            .checked_mul(height as u64)
+            .and_then(|n| n.checked_mul(4))
+            .unwrap_or(u64::MAX);
+        let buf = self.ctx.storage_empty(what, bytes)?;
+        self.ctx.dispatch(
+            None,
+            pipeline,
+            uniform,
+            &[&child.buf, &buf],
+            (groups(width), groups(height)),
+        );
+        Ok(GpuRaster { width, height, buf })
+    }
+}
+
 impl Backend for Gpu {
     type State = GpuState;
+    type Types = GpuRaster;
+    type Weights = GpuRaster;
 
     fn name(&self) -> &'static str {
         "gpu"
@@ -537,6 +600,77 @@ impl Backend for Gpu {
         let s: Vec<u64> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.s)?);
         let v: Vec<i32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.v)?);
         Ok((s.into_iter().map(Coord::unpack).collect(), v))
+    }
+
+    fn upload_types(
+        &self,
+        data: &[u32],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        self.upload_raster("type sets", data, width, height)
+    }
+
+    fn upload_weights(
+        &self,
+        data: &[u8],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        let wide: Vec<u32> = data.iter().map(|&w| w as u32).collect();
+        self.upload_raster("coherence weights", &wide, width, height)
+    }
+
+    fn reduce_types(
+        &self,
+        child: &GpuRaster,
+        width: usize,
+        height: usize,
+        full: u32,
+    ) -> Result<GpuRaster, BackendError> {
+        let u = ReduceTypesUniform {
+            width: width as u32,
+            height: height as u32,
+            child_width: child.width as u32,
+            child_height: child.height as u32,
+            full,
+            ..Default::default()
+        };
+        let p = &self.ctx.reduce_types;
+        self.reduce("type sets", p, bytemuck::bytes_of(&u), child, width, height)
+    }
+
+    fn reduce_weights(
+        &self,
+        child: &GpuRaster,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        let u = ReduceWeightsUniform {
+            width: width as u32,
+            height: height as u32,
+            child_width: child.width as u32,
+            child_height: child.height as u32,
+        };
+        let p = &self.ctx.reduce_weights;
+        self.reduce(
+            "coherence weights",
+            p,
+            bytemuck::bytes_of(&u),
+            child,
+            width,
+            height,
+        )
+    }
+
+    fn download_types(&self, r: &GpuRaster) -> Result<Vec<u32>, BackendError> {
+        Ok(bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?))
+    }
+
+    fn download_weights(&self, r: &GpuRaster) -> Result<Vec<u8>, BackendError> {
+        let wide: Vec<u32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?);
+        // Every stored weight is ≤ 255 (an uploaded u8 or a reduction's ≤ 4).
+        Ok(wide.into_iter().map(|w| w as u8).collect())
     }
 
     fn finish(&self) -> Result<(), BackendError> {
