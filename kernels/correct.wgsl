@@ -1,6 +1,8 @@
-// Stage `correct`, one subpass (paper eq. 3–7): the mirror of
-// src/synth/stages/correct/scalar.rs, function for function, one invocation
-// per pixel of the parity class (p.px, p.py). See the Rust module docs of
+// Stage `correct`, one subpass (paper eq. 3–7, and the controls of §5): the
+// mirror of src/synth/stages/correct/scalar.rs (`correct_pixel_guided`),
+// function for function, one invocation per pixel of the parity class
+// (p.px, p.py). Each control is on when its flag is set; without flags the
+// control bindings are placeholders and never read. See the Rust module docs of
 // src/synth/stages/correct.rs for the arithmetic (N_S kept ×3, h by floor
 // division, residuals clamped to ±CLAMP so a κ = 2 score fits a u32, ties
 // keep the earlier candidate).
@@ -10,7 +12,23 @@ struct CorrectParams {
     height: u32,
     px: u32,
     py: u32,
+    // F_* bits: which controls apply.
+    flags: u32,
+    // The level index (salts the type-seeding hash).
+    level: u32,
+    // Types of the database (length of `seed_counts`).
+    type_count: u32,
+    pad0: u32,
+    // Only pixels in [x0, x1) × [y0, y1) are corrected (Guide::window).
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
 }
+
+const F_TARGETS: u32 = 1u;
+const F_ALLOWED: u32 = 2u;
+const F_COHERENCE: u32 = 4u;
 
 @group(0) @binding(0) var<uniform> p: CorrectParams;
 @group(0) @binding(1) var<storage, read_write> state_s: array<vec2<i32>>;
@@ -20,6 +38,30 @@ struct CorrectParams {
 @group(0) @binding(4) var<storage, read> appearance: array<vec2<u32>>;
 // C₂ per texel, packed x | y << 16.
 @group(0) @binding(5) var<storage, read> similar: array<u32>;
+
+// Type id per atlas texel, four u8 per word (Level::types' bytes).
+@group(0) @binding(6) var<storage, read> types: array<u32>;
+// Seed texels per type, SEEDS_PER_TYPE slots each, packed x | y << 16.
+@group(0) @binding(7) var<storage, read> seeds: array<u32>;
+@group(0) @binding(8) var<storage, read> seed_counts: array<u32>;
+// blend::Target per pixel: (height, tol).
+@group(0) @binding(9) var<storage, read> targets: array<vec2<i32>>;
+// R^i per pixel.
+@group(0) @binding(10) var<storage, read> allowed_set: array<u32>;
+// The previous frame's S, V and W^i (widened to u32) per pixel.
+@group(0) @binding(11) var<storage, read> prev_s: array<vec2<i32>>;
+@group(0) @binding(12) var<storage, read> prev_v: array<i32>;
+@group(0) @binding(13) var<storage, read> weights: array<u32>;
+
+// correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT;
+// types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; blend::MAX_ERROR.
+const ALL_TYPES: u32 = 4294967295u;
+const W_FREE: u32 = 4u;
+const SEEDS_PER_ALLOWED_TYPE: u32 = 9u;
+const SEED_SALT: u32 = 2120089600u;
+const SEEDS_PER_TYPE: u32 = 64u;
+const MODE1_BIAS: i32 = -32768;
+const MAX_ERROR: i32 = 16777216;
 
 // correct::CLAMP.
 const CLAMP: i32 = 11584;
@@ -76,6 +118,13 @@ struct Scored {
 
 // scalar::score: κ · min_h ‖N_S − N_E(q, h)‖² and the minimising h.
 fn score(ns_in: array<vec4<i32>, 4>, qx: i32, qy: i32, kappa: u32) -> Scored {
+    return score_with(ns_in, qx, qy, kappa, false, 0);
+}
+
+// scalar::score_with: h fixed to `fixed_h` when `fixed`.
+fn score_with(
+    ns_in: array<vec4<i32>, 4>, qx: i32, qy: i32, kappa: u32, fixed: bool, fixed_h: i32,
+) -> Scored {
     var ns = ns_in;
     var diag = DIAGONALS;
     var d: array<vec4<i32>, 4>;
@@ -85,7 +134,10 @@ fn score(ns_in: array<vec4<i32>, 4>, qx: i32, qy: i32, kappa: u32) -> Scored {
         d[k] = ns[k] - 3 * m;
         sum1 += d[k].x;
     }
-    let h = div_floor(sum1 + 6, 12);
+    var h = div_floor(sum1 + 6, 12);
+    if (fixed) {
+        h = fixed_h;
+    }
     var s = 0u;
     for (var k = 0; k < 4; k++) {
         let r1 = clamp(d[k].x - 3 * h, -CLAMP, CLAMP);
@@ -128,35 +180,32 @@ fn neighbour(x: i32, y: i32) -> Neighbour {
     return Neighbour(t, frac, state_v[i]);
 }
 
-// scalar::correct_pixel, writing its result in place.
-@compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let ux = 2u * gid.x + p.px;
-    let uy = 2u * gid.y + p.py;
-    if (ux >= p.width || uy >= p.height) {
-        return;
-    }
-    let x = i32(ux);
-    let y = i32(uy);
+// Type id of atlas texel q (Level::types).
+fn texel_type(q: vec2<i32>) -> u32 {
+    let i = atlas_index(q.x, q.y);
+    return (types[i >> 2u] >> ((i & 3u) * 8u)) & 0xFFu;
+}
 
-    var diag = DIAGONALS;
-    var ns: array<vec4<i32>, 4>;
-    for (var k = 0; k < 4; k++) {
-        let dx = diag[k].x;
-        let dy = diag[k].y;
-        var vs = array<vec2<i32>, 3>(vec2<i32>(0, 0), vec2<i32>(dx, 0), vec2<i32>(0, dy));
-        var acc = vec4<i32>(0);
-        for (var j = 0; j < 3; j++) {
-            let v = vs[j];
-            let n = neighbour(x + dx + v.x, y + dy + v.y);
-            acc += texel(n.t.x - v.x, n.t.y - v.y) + vec4<i32>(n.v, 0, 0, 0);
-        }
-        ns[k] = acc;
-    }
+// `mask >> t & 1 == 1` as Rust computes it in release builds (the shift
+// amount wraps at 32; WGSL/SPIR-V leave larger shifts undefined).
+fn has_type(mask: u32, t: u32) -> bool {
+    return ((mask >> (t & 31u)) & 1u) == 1u;
+}
 
-    var best_score = 0xFFFFFFFFu;
-    var best_s = vec2<i32>(0);
-    var best_h = 0;
+// The best candidate so far (scalar::Best): cost, coordinate, offset, and
+// its texel where `has_q` (not for a previous result taken as is).
+struct Best {
+    score: u32,
+    s: vec2<i32>,
+    h: i32,
+    has_q: bool,
+    q: vec2<i32>,
+}
+
+// The k-coherence candidates of pixel (x, y) admitted by `admit` (the
+// closure `candidates` of scalar::correct_pixel_guided); whether any was.
+fn candidates(ns: array<vec4<i32>, 4>, x: i32, y: i32, admit: u32, best: ptr<function, Best>) -> bool {
+    var admitted = false;
     let unseen = bitcast<i32>(0x80000000u);
     var seen: array<vec2<i32>, 9>;
     for (var k = 0; k < 9; k++) {
@@ -178,22 +227,168 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         seen[k] = u;
         let c1 = clamp_interior(u);
-        let r1 = score(ns, c1.x, c1.y, 1u);
-        if (r1.score < best_score) {
-            best_score = r1.score;
-            best_s = (c1 << vec2<u32>(FRAC_BITS)) + n.frac;
-            best_h = r1.h;
+        if (admit == ALL_TYPES || has_type(admit, texel_type(c1))) {
+            admitted = true;
+            let r1 = score(ns, c1.x, c1.y, 1u);
+            if (r1.score < (*best).score) {
+                *best = Best(r1.score, (c1 << vec2<u32>(FRAC_BITS)) + n.frac, r1.h, true, c1);
+            }
         }
         let e = similar[atlas_index(u.x, u.y)];
         let c2 = vec2<i32>(i32(e & 0xFFFFu), i32(e >> 16u));
-        let r2 = score(ns, c2.x, c2.y, 2u);
-        if (r2.score < best_score) {
-            best_score = r2.score;
-            best_s = (c2 << vec2<u32>(FRAC_BITS)) + n.frac;
-            best_h = r2.h;
+        if (admit == ALL_TYPES || has_type(admit, texel_type(c2))) {
+            admitted = true;
+            let r2 = score(ns, c2.x, c2.y, 2u);
+            if (r2.score < (*best).score) {
+                *best = Best(r2.score, (c2 << vec2<u32>(FRAC_BITS)) + n.frac, r2.h, true, c2);
+            }
         }
     }
+    return admitted;
+}
+
+// correct::weigh: ⌊score · w / 4⌋ without leaving 32 bits.
+fn weigh(score: u32, w: u32) -> u32 {
+    return (score >> 2u) * w + (((score & 3u) * w) >> 2u);
+}
+
+// The high word of a 32 × 32-bit product (from 16-bit halves).
+fn mul_hi(a: u32, b: u32) -> u32 {
+    let a0 = a & 0xFFFFu;
+    let a1 = a >> 16u;
+    let b0 = b & 0xFFFFu;
+    let b1 = b >> 16u;
+    let p00 = a0 * b0;
+    let p01 = a0 * b1;
+    let p10 = a1 * b0;
+    let mid = (p00 >> 16u) + (p01 & 0xFFFFu) + (p10 & 0xFFFFu);
+    return a1 * b1 + (p01 >> 16u) + (p10 >> 16u) + (mid >> 16u);
+}
+
+// hash::below: ⌊h · n / 2³²⌋.
+fn below(h: u32, n: u32) -> u32 {
+    return mul_hi(h, n);
+}
+
+// i32::saturating_sub.
+fn saturating_sub(a: i32, b: i32) -> i32 {
+    let d = a - b;
+    if (((a ^ b) & (a ^ d)) < 0) {
+        if (a < 0) {
+            return bitcast<i32>(0x80000000u);
+        }
+        return 2147483647;
+    }
+    return d;
+}
+
+// blend::phi: φ_d of eq. 9 with λ = ½, integer.
+fn phi(x_in: i32, tol: i32) -> i32 {
+    let x = clamp(x_in, -MAX_ERROR, MAX_ERROR);
+    let a = u32(abs(x));
+    let t = u32(tol);
+    var mag = 0u;
+    if (a > t) {
+        mag = (3u * a - 2u * t + 3u) / 6u;
+    } else if (a != 0u) {
+        let r = (a << 15u) / t;
+        let r2 = (r * r) >> 15u;
+        mag = (a * r2 + 3u * (1u << 15u)) / (6u << 15u);
+    }
+    if (x < 0) {
+        return -i32(mag);
+    }
+    return i32(mag);
+}
+
+// blend::nudge.
+fn nudge(v: i32, h_c: i32, goal: vec2<i32>) -> i32 {
+    if (goal.y < 0) {
+        return v;
+    }
+    return v + phi(saturating_sub(goal.x, h_c), goal.y);
+}
+
+// scalar::correct_pixel_guided, writing its result in place.
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let ux = 2u * gid.x + p.px;
+    let uy = 2u * gid.y + p.py;
+    if (ux >= p.width || uy >= p.height || ux < p.x0 || uy < p.y0 || ux >= p.x1 || uy >= p.y1) {
+        return;
+    }
+    let x = i32(ux);
+    let y = i32(uy);
+
+    var diag = DIAGONALS;
+    var ns: array<vec4<i32>, 4>;
+    for (var k = 0; k < 4; k++) {
+        let dx = diag[k].x;
+        let dy = diag[k].y;
+        var vs = array<vec2<i32>, 3>(vec2<i32>(0, 0), vec2<i32>(dx, 0), vec2<i32>(0, dy));
+        var acc = vec4<i32>(0);
+        for (var j = 0; j < 3; j++) {
+            let v = vs[j];
+            let n = neighbour(x + dx + v.x, y + dy + v.y);
+            acc += texel(n.t.x - v.x, n.t.y - v.y) + vec4<i32>(n.v, 0, 0, 0);
+        }
+        ns[k] = acc;
+    }
+
     let i = uy * p.width + ux;
-    state_s[i] = best_s;
-    state_v[i] = best_h;
+    var best = Best(0xFFFFFFFFu, vec2<i32>(0), 0, false, vec2<i32>(0));
+    var allowed = ALL_TYPES;
+    if ((p.flags & F_ALLOWED) != 0u) {
+        allowed = allowed_set[i];
+    }
+    if ((p.flags & F_COHERENCE) != 0u) {
+        let s = prev_s[i];
+        let v = prev_v[i];
+        let q = vec2<i32>(round_fixed(s.x), round_fixed(s.y));
+        let w = weights[i];
+        // A previous result of a type no longer allowed is no candidate,
+        // unless frozen (freezing dominates).
+        if (allowed == ALL_TYPES || w == 0u || has_type(allowed, texel_type(q))) {
+            if (w == 0u) {
+                best = Best(0u, s, v, false, q);
+            } else if (w >= W_FREE) {
+                let r = score(ns, q.x, q.y, 1u);
+                best = Best(weigh(r.score, w), s, r.h, true, q);
+            } else {
+                let r = score_with(ns, q.x, q.y, 1u, true, v);
+                best = Best(weigh(r.score, w), s, v, false, q);
+            }
+        }
+    }
+    if (!candidates(ns, x, y, allowed, &best)) {
+        var seeded = false;
+        for (var t = 0u; t < p.type_count; t++) {
+            let count = seed_counts[t];
+            if (!has_type(allowed, t) || count == 0u) {
+                continue;
+            }
+            seeded = true;
+            for (var k = 0u; k < SEEDS_PER_ALLOWED_TYPE; k++) {
+                let salt = t * SEEDS_PER_ALLOWED_TYPE + k;
+                let hash = hash4(SEED_SALT | p.level, salt, ux, uy);
+                let c = seeds[t * SEEDS_PER_TYPE + below(hash, count)];
+                let q = vec2<i32>(i32(c & 0xFFFFu), i32(c >> 16u));
+                let r = score(ns, q.x, q.y, 1u);
+                if (r.score < best.score) {
+                    best = Best(r.score, q << vec2<u32>(FRAC_BITS), r.h, true, q);
+                }
+            }
+        }
+        if (!seeded) {
+            // No exemplar texel of any allowed type at this level.
+            _ = candidates(ns, x, y, ALL_TYPES, &best);
+        }
+    }
+    var v = best.h;
+    if (best.has_q && (p.flags & F_TARGETS) != 0u) {
+        let h_c = texel(best.q.x, best.q.y).x - MODE1_BIAS + v;
+        v = nudge(v, h_c, targets[i]);
+    }
+    state_s[i] = best.s;
+    state_v[i] = v;
 }

@@ -130,7 +130,15 @@ fn parameter_structs_match_their_wgsl_declarations() {
             width,
             height,
             px,
-            py
+            py,
+            flags,
+            level,
+            type_count,
+            pad0,
+            x0,
+            y0,
+            x1,
+            y1
         })
     );
     assert_eq!(
@@ -261,6 +269,38 @@ fn shade_constants_match() {
     }
     assert_eq!(shade::NODATA, i32::MIN);
     assert!(src.contains("const NODATA: i32 = -2147483647 - 1;"));
+}
+
+#[test]
+fn correct_constants_match() {
+    use terrasynth::database::appearance::MODE1_BIAS;
+    use terrasynth::database::types::SEEDS_PER_TYPE;
+    use terrasynth::synth::control::blend::MAX_ERROR;
+    use terrasynth::synth::stages::correct::{
+        ALL_TYPES, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE,
+    };
+    let src = kernels::CORRECT.source;
+    for (name, v) in [
+        ("F_TARGETS", kernels::CORRECT_TARGETS),
+        ("F_ALLOWED", kernels::CORRECT_ALLOWED),
+        ("F_COHERENCE", kernels::CORRECT_COHERENCE),
+        ("ALL_TYPES", ALL_TYPES),
+        ("W_FREE", W_FREE as u32),
+        ("SEEDS_PER_ALLOWED_TYPE", SEEDS_PER_ALLOWED_TYPE),
+        ("SEED_SALT", SEED_SALT),
+        ("SEEDS_PER_TYPE", SEEDS_PER_TYPE as u32),
+    ] {
+        assert!(
+            src.contains(&format!("const {name}: u32 = {v}u;")),
+            "{name} must be {v} in correct.wgsl"
+        );
+    }
+    for (name, v) in [("MODE1_BIAS", MODE1_BIAS), ("MAX_ERROR", MAX_ERROR)] {
+        assert!(
+            src.contains(&format!("const {name}: i32 = {v};")),
+            "{name} must be {v} in correct.wgsl"
+        );
+    }
 }
 
 #[test]

@@ -101,7 +101,24 @@ pub struct CorrectUniform {
     pub height: u32,
     pub px: u32,
     pub py: u32,
+    /// `CORRECT_*` bits: which controls apply.
+    pub flags: u32,
+    /// `Guide::level`.
+    pub level: u32,
+    /// Types of the database (`AtlasLevel::seed_counts.len()`).
+    pub type_count: u32,
+    pub pad0: u32,
+    /// `Guide::window` (the whole level without one).
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
 }
+
+/// `CorrectUniform::flags`: geometric targets, type sets, coherence.
+pub const CORRECT_TARGETS: u32 = 1;
+pub const CORRECT_ALLOWED: u32 = 2;
+pub const CORRECT_COHERENCE: u32 = 4;
 
 /// `ReconstructParams` of `kernels/reconstruct.wgsl` (padded to 16 bytes,
 /// the uniform block granularity).

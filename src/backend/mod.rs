@@ -48,7 +48,10 @@ pub struct StageTime {
 /// per-level inputs of later stages (the user-control rasters of
 /// `synth::control`: targets, allowed types, coherence weights) fit the
 /// same way: uploaded once per level as a backend-side associated type,
-/// passed to [`Backend::correct`] next to the state. The pyramids of two of
+/// passed to `correct` next to the state (so far `gpu::Gpu::upload_guide`
+/// and `gpu::Gpu::correct_guided`, cross-checked against
+/// `correct::correct_guided`; the synthesizer's controlled loop,
+/// `Synthesizer::run_with`, still runs on the CPU). The pyramids of two of
 /// them are stages of their own ([`Backend::reduce_types`],
 /// [`Backend::reduce_weights`]), so a backend builds every level's raster
 /// from level 0's where it keeps them.
