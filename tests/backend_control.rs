@@ -14,7 +14,7 @@ use std::path::Path;
 use std::sync::{Arc, OnceLock};
 use terrasynth::backend::gpu::{Context, Gpu};
 use terrasynth::backend::{Backend, BackendError, cpu::Cpu};
-use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, default, layout::MARGIN};
+use terrasynth::database::{self, BuildOptions, Database, default, layout::MARGIN};
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::progress::Silent;
 use terrasynth::synth::atlas::AtlasLevel;
@@ -29,7 +29,8 @@ use terrasynth::synth::stages::reduce_weights::reduce_weights;
 use terrasynth::synth::state::{State, level_size, top_level};
 use terrasynth::synth::{Guides, LevelGuide, Params, Synthesizer};
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
+use common::dem::{self, DEM};
 
 /// Both backends over the default database (the reductions read none of
 /// it, but a backend is bound to one).
@@ -258,26 +259,7 @@ fn reductions_match_on_shared_dem_type_masks() {
 fn typed_db() -> Option<&'static Database> {
     static DB: OnceLock<Option<Database>> = OnceLock::new();
     DB.get_or_init(|| {
-        let crop = |name: &str, x: usize, y: usize| -> Option<ExemplarInput> {
-            let (w, h) = (160, 160);
-            let p = Path::new(DEM).join(format!("{name}.png"));
-            let hf = terrasynth::io::read(&p, &Default::default()).ok()?;
-            let m = TypeMask::read(&Path::new(DEM).join(format!("{name}_types.png"))).ok()?;
-            let mut idx = Vec::with_capacity(w * h);
-            for yy in y..y + h {
-                idx.extend_from_slice(&m.indices[yy * m.width + x..yy * m.width + x + w]);
-            }
-            Some(ExemplarInput {
-                name: name.into(),
-                heights: hf.crop(x, y, w, h).ok()?,
-                types: Some(TypeMask {
-                    width: w,
-                    height: h,
-                    indices: idx,
-                    names: m.names,
-                }),
-            })
-        };
+        let crop = |name: &str, x: usize, y: usize| dem::exemplar(name, (x, y, 160, 160), true);
         let inputs = vec![
             crop("riviera_coast", 100, 150)?,
             crop("pyrenees_andorra", 300, 200)?,

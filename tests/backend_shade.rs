@@ -123,16 +123,7 @@ fn shade_matches_on_shared_dems() {
         let (w, h) = (hf.width().min(256), hf.height().min(256));
         let (x0, y0) = ((hf.width() - w) / 2, (hf.height() - h) / 2);
         let crop = hf.crop(x0, y0, w, h).unwrap();
-        let mut idx = Vec::with_capacity(w * h);
-        for y in y0..y0 + h {
-            idx.extend_from_slice(&m.indices[y * m.width + x0..y * m.width + x0 + w]);
-        }
-        let mask = TypeMask {
-            width: w,
-            height: h,
-            indices: idx,
-            names: m.names,
-        };
+        let mask = m.crop(x0, y0, w, h).unwrap();
         for (k, lighting) in [Lighting::default(), Lighting::usgs()]
             .into_iter()
             .enumerate()

@@ -9,11 +9,10 @@
 #![cfg(feature = "gpu")]
 
 use proptest::prelude::*;
-use std::path::Path;
 use std::sync::{Arc, OnceLock};
 use terrasynth::backend::gpu::{Context, Gpu};
 use terrasynth::backend::{Backend, cpu::Cpu};
-use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, default, layout::MARGIN};
+use terrasynth::database::{self, BuildOptions, Database, default, layout::MARGIN};
 use terrasynth::progress::Silent;
 use terrasynth::synth::atlas::AtlasLevel;
 use terrasynth::synth::fixed::{Coord, FRAC_BITS};
@@ -22,7 +21,8 @@ use terrasynth::synth::stages::upsample_jitter::{Step, UpsampleParams};
 use terrasynth::synth::state::State;
 use terrasynth::synth::{Params, Synthesizer};
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
+use common::dem::{self, DEM};
 
 /// The shared device, or `None` (with the reason printed once per test).
 fn ctx() -> Option<Arc<Context>> {
@@ -46,15 +46,7 @@ fn default_db() -> &'static Database {
 fn dem_db() -> Option<&'static Database> {
     static DB: OnceLock<Option<Database>> = OnceLock::new();
     DB.get_or_init(|| {
-        let crop = |name: &str, x, y| -> Option<ExemplarInput> {
-            let p = Path::new(DEM).join(format!("{name}.png"));
-            let hf = terrasynth::io::read(&p, &Default::default()).ok()?;
-            Some(ExemplarInput {
-                name: name.into(),
-                heights: hf.crop(x, y, 192, 192).ok()?,
-                types: None,
-            })
-        };
+        let crop = |name: &str, x, y| dem::exemplar(name, (x, y, 192, 192), false);
         let inputs = vec![
             crop("pyrenees_andorra", 300, 200)?,
             crop("franconian_jura", 200, 300)?,

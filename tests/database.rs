@@ -1,36 +1,20 @@
 //! Exemplar database: contents, invariants and the file format.
 
 use proptest::prelude::*;
-use std::path::Path;
 use std::sync::OnceLock;
 use terrasynth::database::{
     self, BuildOptions, Database, ExemplarInput, TypeMask, appearance, layout, types,
 };
 use terrasynth::{Heightfield, progress::Silent};
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
+use common::dem::{self, DEM};
 
 /// Two exemplars: real DEM crops when ../shared is present (with their type
 /// masks), synthetic ridges otherwise.
 fn inputs() -> Vec<ExemplarInput> {
-    let crop = |name: &str, x: usize, y: usize, w: usize, h: usize| -> Option<ExemplarInput> {
-        let p = Path::new(DEM).join(format!("{name}.png"));
-        let hf = terrasynth::io::read(&p, &Default::default()).ok()?;
-        let m = TypeMask::read(&Path::new(DEM).join(format!("{name}_types.png"))).ok()?;
-        let mut idx = Vec::with_capacity(w * h);
-        for yy in y..y + h {
-            idx.extend_from_slice(&m.indices[yy * m.width + x..yy * m.width + x + w]);
-        }
-        Some(ExemplarInput {
-            name: name.into(),
-            heights: hf.crop(x, y, w, h).unwrap(),
-            types: Some(TypeMask {
-                width: w,
-                height: h,
-                indices: idx,
-                names: m.names,
-            }),
-        })
+    let crop = |name: &str, x: usize, y: usize, w: usize, h: usize| {
+        dem::exemplar(name, (x, y, w, h), true)
     };
     match (
         crop("riviera_coast", 100, 150, 200, 160),

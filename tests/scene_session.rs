@@ -6,13 +6,14 @@
 use serde_json::json;
 use std::path::Path;
 use std::sync::OnceLock;
-use terrasynth::database::{BuildOptions, Database, ExemplarInput, TypeMask};
+use terrasynth::database::{BuildOptions, Database};
 use terrasynth::progress::Silent;
 use terrasynth::scene::{Scene, SceneEdits};
 use terrasynth::synth::control::Constraint;
 use terrasynth::synth::session::{Edit, Session};
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
+use common::dem::{self, DEM};
 const SIZE: usize = 256;
 
 /// A 320² crop of the Pyrenees DEM (alpine relief, 92.6 m cells) with its
@@ -20,30 +21,8 @@ const SIZE: usize = 256;
 fn db() -> Option<&'static (Database, f64, f64)> {
     static DB: OnceLock<Option<(Database, f64, f64)>> = OnceLock::new();
     DB.get_or_init(|| {
-        let name = "pyrenees_andorra";
-        let hf = terrasynth::io::read(
-            &Path::new(DEM).join(format!("{name}.png")),
-            &Default::default(),
-        )
-        .ok()?;
-        let m = TypeMask::read(&Path::new(DEM).join(format!("{name}_types.png"))).ok()?;
-        let (x, y, w, h) = (300, 250, 320, 320);
-        let crop = hf.crop(x, y, w, h).unwrap();
-        let s = crop.stats().unwrap();
-        let mut idx = Vec::with_capacity(w * h);
-        for yy in y..y + h {
-            idx.extend_from_slice(&m.indices[yy * m.width + x..yy * m.width + x + w]);
-        }
-        let input = ExemplarInput {
-            name: name.into(),
-            heights: crop,
-            types: Some(TypeMask {
-                width: w,
-                height: h,
-                indices: idx,
-                names: m.names,
-            }),
-        };
+        let input = dem::exemplar("pyrenees_andorra", (300, 250, 320, 320), true)?;
+        let s = input.heights.stats().unwrap();
         let opts = BuildOptions {
             levels: 5,
             ..Default::default()

@@ -3,9 +3,8 @@
 //! exact restricted re-synthesis. A small database is built from two 256²
 //! crops of ../shared/dem (with their type masks); skipped when absent.
 
-use std::path::Path;
 use std::sync::{Arc, OnceLock};
-use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
+use terrasynth::database::{self, BuildOptions, Database};
 use terrasynth::heightfield::Heightfield;
 use terrasynth::progress::Silent;
 use terrasynth::synth::Params;
@@ -14,29 +13,14 @@ use terrasynth::synth::control::{
 };
 use terrasynth::synth::session::{Edit, Session};
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
+use common::dem::{self, DEM};
 const N: usize = 256;
 
 fn db() -> Option<&'static Database> {
     static DB: OnceLock<Option<Database>> = OnceLock::new();
     DB.get_or_init(|| {
-        let crop = |name: &str, x: usize, y: usize| -> Option<ExemplarInput> {
-            let dir = Path::new(DEM);
-            let hf =
-                terrasynth::io::read(&dir.join(format!("{name}.png")), &Default::default()).ok()?;
-            let mask = TypeMask::read(&dir.join(format!("{name}_types.png"))).ok()?;
-            let mut m = TypeMask::new(N, N, vec![0; N * N]).ok()?;
-            for r in 0..N {
-                m.indices[r * N..(r + 1) * N]
-                    .copy_from_slice(&mask.indices[(y + r) * mask.width + x..][..N]);
-            }
-            m.names = mask.names.clone();
-            Some(ExemplarInput {
-                name: name.into(),
-                heights: hf.crop(x, y, N, N).ok()?,
-                types: Some(m),
-            })
-        };
+        let crop = |name: &str, x: usize, y: usize| dem::exemplar(name, (x, y, N, N), true);
         let inputs = vec![
             crop("pyrenees_andorra", 300, 200)?,
             crop("catalan_coast_hills", 300, 300)?,

@@ -42,6 +42,37 @@ impl TypeMask {
         })
     }
 
+    /// An owned copy of a window (names kept), e.g. the mask of a cropped
+    /// exemplar; the window must lie inside the mask.
+    pub fn crop(
+        &self,
+        x: usize,
+        y: usize,
+        w: usize,
+        h: usize,
+    ) -> Result<TypeMask, crate::error::SizeError> {
+        if w == 0 || h == 0 || x + w > self.width || y + h > self.height {
+            return Err(crate::error::SizeError::Window {
+                x,
+                y,
+                w,
+                h,
+                width: self.width,
+                height: self.height,
+            });
+        }
+        let indices = (y..y + h)
+            .flat_map(|r| &self.indices[r * self.width + x..][..w])
+            .copied()
+            .collect();
+        Ok(TypeMask {
+            width: w,
+            height: h,
+            indices,
+            names: self.names.clone(),
+        })
+    }
+
     /// The name of an index.
     pub fn name_of(&self, index: u8) -> String {
         self.names
@@ -208,6 +239,20 @@ fn parse_names(json: &[u8]) -> Result<BTreeMap<u8, String>, FormatError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn crop_copies_the_window_and_refuses_one_outside() {
+        let mut m = TypeMask::new(4, 3, (0..12).collect()).unwrap();
+        m.names = [(5, "hills".into())].into();
+        let c = m.crop(1, 1, 2, 2).unwrap();
+        assert_eq!(
+            (c.width, c.height, c.indices.clone()),
+            (2, 2, vec![5, 6, 9, 10])
+        );
+        assert_eq!(c.name_of(5), "hills");
+        assert!(m.crop(3, 0, 2, 1).is_err());
+        assert!(m.crop(0, 0, 0, 1).is_err());
+    }
 
     #[test]
     fn round_trips_and_reads_shared_masks() {

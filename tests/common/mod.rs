@@ -1,5 +1,7 @@
-//! Helpers shared by the io integration tests.
+//! Helpers shared by the integration tests.
 #![allow(dead_code)]
+
+pub mod dem;
 
 use terrasynth::Heightfield;
 use terrasynth::io::Format;
