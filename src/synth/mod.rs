@@ -22,8 +22,8 @@ use atlas::AtlasLevel;
 use control::Target;
 use fixed::{Coord, FRAC_BITS};
 use stages::correct::{self, Coherence, CorrectParams, Guide, SUBPASSES};
-use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
-use stages::upsample_jitter::{self, Step, UpsampleParams};
+use stages::reconstruct::HEIGHT_FRAC_BITS;
+use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -382,22 +382,9 @@ impl<'db> Synthesizer<'db> {
         height: usize,
         seed: u32,
     ) -> Result<Synthesis, SynthError> {
-        crate::heightfield::check_dims(width, height)?;
         let t0 = Instant::now();
-        let m = top_level(width, height);
-        let l = self.coarsest();
-        let mut timings = Timings {
-            levels: vec![LevelTiming::default(); m + 1],
-            ..Default::default()
-        };
+        let (top, l, mut timings) = self.plan(width, height)?;
         let mut kept = Vec::new();
-        // With jitter, levels above `top` would only be a spread-out copy of
-        // the start exemplar; they are skipped (see `initial`).
-        let top = if self.jitter > 0 {
-            m.min(l + COARSE_BLOCK_BITS)
-        } else {
-            m
-        };
         // Without a device clock, the loop waits after each stage so that
         // wall clock measures it; with one, stages queue back to back.
         let device_clock = b.has_device_clock();
@@ -408,13 +395,7 @@ impl<'db> Synthesizer<'db> {
             if level < top {
                 let t = Instant::now();
                 let child = b.alloc(w, h)?;
-                let params = UpsampleParams {
-                    seed,
-                    level: level as u32,
-                    jitter: self.jitter,
-                    step: self.step(level, l),
-                };
-                b.upsample_jitter(&state, &child, level, &params);
+                b.upsample_jitter(&state, &child, level, &self.upsample_params(seed, level));
                 if !device_clock {
                     b.finish()?;
                 }
@@ -486,25 +467,13 @@ impl<'db> Synthesizer<'db> {
         prev: Option<&Frames>,
         record: bool,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
-        crate::heightfield::check_dims(width, height)?;
         let t0 = Instant::now();
-        let m = top_level(width, height);
-        let l = self.coarsest();
-        let mut timings = Timings {
-            levels: vec![LevelTiming::default(); m + 1],
-            ..Default::default()
-        };
+        let (top, l, mut timings) = self.plan(width, height)?;
+        let cpu = self.cpu();
         let mut kept = Vec::new();
         let mut frames = record.then(|| Frames {
-            levels: vec![Vec::new(); l.min(m) + 1],
+            levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
         });
-        // With jitter, levels above `top` would only be a spread-out copy of
-        // the start exemplar; they are skipped (see `initial`).
-        let top = if self.jitter > 0 {
-            m.min(l + COARSE_BLOCK_BITS)
-        } else {
-            m
-        };
         let mut state = self.initial(width, height, top, seed);
         // Bounds of the pixels of the level above that differ from the
         // previous frame (restricted re-synthesis only).
@@ -514,14 +483,7 @@ impl<'db> Synthesizer<'db> {
                 let t = Instant::now();
                 let (w, h) = level_size(width, height, level);
                 let child = State::new(w, h);
-                let params = UpsampleParams {
-                    seed,
-                    level: level as u32,
-                    jitter: self.jitter,
-                    step: self.step(level, l),
-                };
-                let atlas = (level <= l && level < l).then(|| &self.atlas[level]);
-                upsample_jitter::upsample_jitter(&state, &child, atlas, &params);
+                cpu.upsample_jitter(&state, &child, level, &self.upsample_params(seed, level));
                 state = child;
                 timings.levels[level].upsample = t.elapsed();
             }
@@ -587,7 +549,7 @@ impl<'db> Synthesizer<'db> {
         }
         kept.reverse();
         let t = Instant::now();
-        let fixed = reconstruct::reconstruct(&self.atlas[0], self.db.heights(), &state);
+        let fixed = cpu.reconstruct(&state)?;
         let heightfield = self.to_metres(&fixed, state.width, width, height)?;
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
@@ -609,6 +571,36 @@ impl<'db> Synthesizer<'db> {
     /// Output cell size, metres (the start exemplar's).
     pub fn cell_size_m(&self) -> f64 {
         self.db.meta().exemplars[self.params.start_exemplar].cell_size_m
+    }
+
+    /// The levels a `width × height` synthesis runs: the coarsest synthesized
+    /// level `top`, the database's coarsest level L, and empty timings.
+    fn plan(&self, width: usize, height: usize) -> Result<(usize, usize, Timings), SynthError> {
+        crate::heightfield::check_dims(width, height)?;
+        let m = top_level(width, height);
+        let l = self.coarsest();
+        let timings = Timings {
+            levels: vec![LevelTiming::default(); m + 1],
+            ..Default::default()
+        };
+        // With jitter, levels above `top` would only be a spread-out copy of
+        // the start exemplar; they are skipped (see `initial`).
+        let top = if self.jitter > 0 {
+            m.min(l + COARSE_BLOCK_BITS)
+        } else {
+            m
+        };
+        Ok((top, l, timings))
+    }
+
+    /// Parameters of the upsampling into level `level`.
+    fn upsample_params(&self, seed: u32, level: usize) -> UpsampleParams {
+        UpsampleParams {
+            seed,
+            level: level as u32,
+            jitter: self.jitter,
+            step: self.step(level, self.coarsest()),
+        }
     }
 
     /// How level `level` is made from the one above.
