@@ -28,34 +28,27 @@ impl Kernel {
     }
 }
 
-pub const UPSAMPLE_JITTER: Kernel = Kernel {
-    name: "upsample_jitter",
-    source: include_str!("../../kernels/upsample_jitter.wgsl"),
-};
-pub const CORRECT: Kernel = Kernel {
-    name: "correct",
-    source: include_str!("../../kernels/correct.wgsl"),
-};
-pub const RECONSTRUCT: Kernel = Kernel {
-    name: "reconstruct",
-    source: include_str!("../../kernels/reconstruct.wgsl"),
-};
+/// A kernel named like its `.wgsl` file (and its CPU mirror), so the three
+/// names cannot drift apart.
+macro_rules! kernel {
+    ($name:literal) => {
+        Kernel {
+            name: $name,
+            source: include_str!(concat!("../../kernels/", $name, ".wgsl")),
+        }
+    };
+}
 
-pub const REDUCE_TYPES: Kernel = Kernel {
-    name: "reduce_types",
-    source: include_str!("../../kernels/reduce_types.wgsl"),
-};
-pub const REDUCE_WEIGHTS: Kernel = Kernel {
-    name: "reduce_weights",
-    source: include_str!("../../kernels/reduce_weights.wgsl"),
-};
+pub const UPSAMPLE_JITTER: Kernel = kernel!("upsample_jitter");
+pub const CORRECT: Kernel = kernel!("correct");
+pub const RECONSTRUCT: Kernel = kernel!("reconstruct");
+
+pub const REDUCE_TYPES: Kernel = kernel!("reduce_types");
+pub const REDUCE_WEIGHTS: Kernel = kernel!("reduce_weights");
 
 /// The preview renderer's stage (`render::shade`); its parameter block is
 /// `render::shade::ShadeParams` itself, already `#[repr(C)]` and Pod.
-pub const SHADE: Kernel = Kernel {
-    name: "shade",
-    source: include_str!("../../kernels/shade.wgsl"),
-};
+pub const SHADE: Kernel = kernel!("shade");
 
 /// Every kernel, for tests that check them all.
 pub const ALL: [Kernel; 6] = [
