@@ -19,7 +19,8 @@ struct CorrectParams {
     // Types of the database (length of `seed_counts`).
     type_count: u32,
     pad0: u32,
-    // Only pixels in [x0, x1) × [y0, y1) are corrected (Guide::window).
+    // Only pixels in [x0, x1) × [y0, y1) are corrected (Guide::window); with
+    // F_COHERENCE the others take the previous result.
     x0: u32,
     y0: u32,
     x1: u32,
@@ -314,7 +315,16 @@ fn nudge(v: i32, h_c: i32, goal: vec2<i32>) -> i32 {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ux = 2u * gid.x + p.px;
     let uy = 2u * gid.y + p.py;
-    if (ux >= p.width || uy >= p.height || ux < p.x0 || uy < p.y0 || ux >= p.x1 || uy >= p.y1) {
+    if (ux >= p.width || uy >= p.height) {
+        return;
+    }
+    if (ux < p.x0 || uy < p.y0 || ux >= p.x1 || uy >= p.y1) {
+        // Outside the window: the previous frame's result (correct::keep_outside).
+        if ((p.flags & F_COHERENCE) != 0u) {
+            let k = uy * p.width + ux;
+            state_s[k] = prev_s[k];
+            state_v[k] = prev_v[k];
+        }
         return;
     }
     let x = i32(ux);

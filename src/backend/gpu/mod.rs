@@ -16,7 +16,7 @@ use super::kernels::{
     self, CorrectUniform, Kernel, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
     UpsampleUniform,
 };
-use super::{Backend, BackendError, Stage, StageTime, check_raster};
+use super::{Backend, BackendError, Stage, StageTime, check_guide, check_raster};
 use crate::render::shade::{ShadeBuffers, ShadeParams};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::fixed::Coord;
@@ -463,114 +463,6 @@ impl Gpu {
     pub fn context(&self) -> &Arc<Context> {
         &self.ctx
     }
-
-    /// Moves the control inputs of a `width × height` level to the device.
-    pub fn upload_guide(
-        &self,
-        g: &Guide<'_>,
-        width: usize,
-        height: usize,
-    ) -> Result<GpuGuide, BackendError> {
-        let targets = g
-            .targets
-            .map(|t| {
-                check_raster("targets", t.len(), width, height)?;
-                let cells: Vec<[i32; 2]> = t.iter().map(|t| [t.height, t.tol]).collect();
-                self.ctx.storage("targets", bytemuck::cast_slice(&cells))
-            })
-            .transpose()?;
-        let allowed = g
-            .allowed
-            .map(|a| {
-                self.upload_raster("type sets", a, width, height)
-                    .map(|r| r.buf)
-            })
-            .transpose()?;
-        let coherence = g
-            .coherence
-            .map(|c| {
-                check_raster("previous coordinates", c.coords.len(), width, height)?;
-                check_raster("previous offsets", c.offsets.len(), width, height)?;
-                let s: Vec<u64> = c.coords.iter().map(|c| c.pack()).collect();
-                let w: Vec<u32> = c.weights.iter().map(|&w| w as u32).collect();
-                check_raster("coherence weights", w.len(), width, height)?;
-                Ok::<_, BackendError>([
-                    self.ctx.storage("previous S", bytemuck::cast_slice(&s))?,
-                    self.ctx
-                        .storage("previous V", bytemuck::cast_slice(c.offsets))?,
-                    self.ctx
-                        .storage("coherence weights", bytemuck::cast_slice(&w))?,
-                ])
-            })
-            .transpose()?;
-        Ok(GpuGuide {
-            level: g.level,
-            window: g.window,
-            targets,
-            allowed,
-            coherence,
-        })
-    }
-
-    /// One subpass of stage `correct` under control inputs (the mirror of
-    /// `correct::correct_guided`).
-    pub fn correct_guided(&self, st: &GpuState, level: usize, p: &CorrectParams, g: &GpuGuide) {
-        let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, st.width, st.height]);
-        let mut u = CorrectUniform {
-            width: st.width as u32,
-            height: st.height as u32,
-            px: p.px,
-            py: p.py,
-            level: g.level,
-            type_count: self.levels[level].type_count,
-            x0: x0 as u32,
-            y0: y0 as u32,
-            x1: x1.min(st.width) as u32,
-            y1: y1.min(st.height) as u32,
-            ..Default::default()
-        };
-        let none = &self.placeholder;
-        if g.targets.is_some() {
-            u.flags |= kernels::CORRECT_TARGETS;
-        }
-        if g.allowed.is_some() {
-            u.flags |= kernels::CORRECT_ALLOWED;
-        }
-        if g.coherence.is_some() {
-            u.flags |= kernels::CORRECT_COHERENCE;
-        }
-        let [prev_s, prev_v, weights] = match &g.coherence {
-            Some([s, v, w]) => [s, v, w],
-            None => [none, none, none],
-        };
-        let l = &self.levels[level];
-        // Pixels of the parity class per axis: ⌈(n − parity) / 2⌉.
-        let class = |n: usize, parity: u32| (n - parity as usize).div_ceil(2);
-        self.ctx.dispatch(
-            Some((Stage::Correct, level)),
-            &self.ctx.correct,
-            bytemuck::bytes_of(&u),
-            &[
-                &st.s,
-                &st.v,
-                &l.columns,
-                &l.appearance,
-                &l.similar,
-                &l.types,
-                &l.seeds,
-                &l.seed_counts,
-                g.targets.as_ref().unwrap_or(none),
-                g.allowed.as_ref().unwrap_or(none),
-                prev_s,
-                prev_v,
-                weights,
-            ],
-            (
-                groups(class(st.width, p.px)),
-                groups(class(st.height, p.py)),
-            ),
-        );
-    }
 }
 
 /// One level's control raster on the device, one u32 per pixel: type sets
@@ -629,6 +521,7 @@ impl Backend for Gpu {
     type State = GpuState;
     type Types = GpuRaster;
     type Weights = GpuRaster;
+    type Guide<'g> = GpuGuide;
 
     fn name(&self) -> &'static str {
         "gpu"
@@ -709,6 +602,108 @@ impl Backend for Gpu {
             coherence: None,
         };
         self.correct_guided(st, level, p, &none);
+    }
+
+    fn upload_guide(
+        &self,
+        g: &Guide<'_>,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuGuide, BackendError> {
+        check_guide(g, width, height)?;
+        let targets = g
+            .targets
+            .map(|t| {
+                let cells: Vec<[i32; 2]> = t.iter().map(|t| [t.height, t.tol]).collect();
+                self.ctx.storage("targets", bytemuck::cast_slice(&cells))
+            })
+            .transpose()?;
+        let allowed = g
+            .allowed
+            .map(|a| {
+                self.upload_raster("type sets", a, width, height)
+                    .map(|r| r.buf)
+            })
+            .transpose()?;
+        let coherence = g
+            .coherence
+            .map(|c| {
+                let s: Vec<u64> = c.coords.iter().map(|c| c.pack()).collect();
+                let w: Vec<u32> = c.weights.iter().map(|&w| w as u32).collect();
+                Ok::<_, BackendError>([
+                    self.ctx.storage("previous S", bytemuck::cast_slice(&s))?,
+                    self.ctx
+                        .storage("previous V", bytemuck::cast_slice(c.offsets))?,
+                    self.ctx
+                        .storage("coherence weights", bytemuck::cast_slice(&w))?,
+                ])
+            })
+            .transpose()?;
+        Ok(GpuGuide {
+            level: g.level,
+            window: g.window,
+            targets,
+            allowed,
+            coherence,
+        })
+    }
+
+    fn correct_guided(&self, st: &GpuState, level: usize, p: &CorrectParams, g: &GpuGuide) {
+        let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, st.width, st.height]);
+        let mut u = CorrectUniform {
+            width: st.width as u32,
+            height: st.height as u32,
+            px: p.px,
+            py: p.py,
+            level: g.level,
+            type_count: self.levels[level].type_count,
+            x0: x0 as u32,
+            y0: y0 as u32,
+            x1: x1.min(st.width) as u32,
+            y1: y1.min(st.height) as u32,
+            ..Default::default()
+        };
+        let none = &self.placeholder;
+        if g.targets.is_some() {
+            u.flags |= kernels::CORRECT_TARGETS;
+        }
+        if g.allowed.is_some() {
+            u.flags |= kernels::CORRECT_ALLOWED;
+        }
+        if g.coherence.is_some() {
+            u.flags |= kernels::CORRECT_COHERENCE;
+        }
+        let [prev_s, prev_v, weights] = match &g.coherence {
+            Some([s, v, w]) => [s, v, w],
+            None => [none, none, none],
+        };
+        let l = &self.levels[level];
+        // Pixels of the parity class per axis: ⌈(n − parity) / 2⌉.
+        let class = |n: usize, parity: u32| (n - parity as usize).div_ceil(2);
+        self.ctx.dispatch(
+            Some((Stage::Correct, level)),
+            &self.ctx.correct,
+            bytemuck::bytes_of(&u),
+            &[
+                &st.s,
+                &st.v,
+                &l.columns,
+                &l.appearance,
+                &l.similar,
+                &l.types,
+                &l.seeds,
+                &l.seed_counts,
+                g.targets.as_ref().unwrap_or(none),
+                g.allowed.as_ref().unwrap_or(none),
+                prev_s,
+                prev_v,
+                weights,
+            ],
+            (
+                groups(class(st.width, p.px)),
+                groups(class(st.height, p.py)),
+            ),
+        );
     }
 
     fn reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
