@@ -81,6 +81,10 @@ fn backends_write_the_same_bytes_and_auto_falls_back_with_a_notice() {
             "auto found no GPU but gpu ran: {auto_notes:?}"
         );
     } else {
+        assert!(
+            !cfg!(feature = "gpu") || std::env::var_os("TERRASYNTH_REQUIRE_GPU").is_none(),
+            "TERRASYNTH_REQUIRE_GPU is set but --backend gpu failed: {err}"
+        );
         assert!(err.starts_with("error: "), "{err}");
         if cfg!(feature = "gpu") {
             assert!(err.contains("no usable GPU adapter"), "{err}");
@@ -155,6 +159,10 @@ fn edit_sessions_write_the_same_frames_on_every_backend() {
             "gpu frames must match cpu"
         );
     } else {
+        assert!(
+            std::env::var_os("TERRASYNTH_REQUIRE_GPU").is_none(),
+            "TERRASYNTH_REQUIRE_GPU is set but the GPU session failed: {err}"
+        );
         eprintln!("no GPU: only the CPU session ran ({})", err.trim());
         assert!(err.starts_with("error: "), "{err}");
         assert!(gpu_frames.is_none(), "no frames on failure");

@@ -11,8 +11,8 @@
 
 use proptest::prelude::*;
 use std::path::Path;
-use std::sync::{Arc, OnceLock};
-use terrasynth::backend::gpu::{Context, Gpu};
+use std::sync::OnceLock;
+use terrasynth::backend::gpu::Gpu;
 use terrasynth::backend::{Backend, BackendError, cpu::Cpu};
 use terrasynth::database::{self, BuildOptions, Database, default, layout::MARGIN};
 use terrasynth::io::type_mask::TypeMask;
@@ -52,29 +52,23 @@ impl Pair {
 /// The default database, built once.
 static DB_DEFAULT: OnceLock<Database> = OnceLock::new();
 
-/// The shared pair, or `None` (with the reason printed) without an adapter.
+/// The shared pair, or `None` without an adapter (see `common::gpu`).
 fn pair() -> Option<&'static Pair> {
-    static PAIR: OnceLock<Result<Pair, String>> = OnceLock::new();
-    let r = PAIR.get_or_init(|| {
-        let ctx: Arc<Context> = Context::new().map_err(|e| e.to_string())?;
+    static PAIR: OnceLock<Option<Pair>> = OnceLock::new();
+    PAIR.get_or_init(|| {
+        let ctx = common::gpu::context()?;
         let db = DB_DEFAULT.get_or_init(|| default::build_default(&Silent).unwrap());
         let atlas: Vec<_> = (0..db.level_count())
             .map(|i| AtlasLevel::new(db, i))
             .collect();
-        let gpu = Gpu::new(ctx, &atlas, db.heights()).map_err(|e| e.to_string())?;
-        Ok(Pair {
+        let gpu = Gpu::new(ctx, &atlas, db.heights()).unwrap();
+        Some(Pair {
             atlas,
             heights: db.heights(),
             gpu,
         })
-    });
-    match r {
-        Ok(p) => Some(p),
-        Err(e) => {
-            eprintln!("skipping the GPU cross-check: {e}");
-            None
-        }
-    }
+    })
+    .as_ref()
 }
 
 /// Reduces `r0` (`w × h`) level by level on both backends, with the level
@@ -354,7 +348,7 @@ fn typed_gpu() -> Option<(
     static G: OnceLock<Option<(Vec<AtlasLevel<'static>>, Gpu)>> = OnceLock::new();
     let db = typed_db()?;
     let g = G.get_or_init(|| {
-        let ctx = Context::new().ok()?;
+        let ctx = common::gpu::context()?;
         let atlas: Vec<_> = (0..db.level_count())
             .map(|i| AtlasLevel::new(db, i))
             .collect();
