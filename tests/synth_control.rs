@@ -48,8 +48,19 @@ fn session(db: &Database) -> Session<'_> {
     Session::new(db, Params::default(), N, N, 7).unwrap()
 }
 
+/// Height at output position (x, y), bilinear between pixel centres (at
+/// +0.5): the height *at a site*, wherever it falls in its pixel.
 fn at(hf: &Heightfield, x: f64, y: f64) -> f64 {
-    hf.get(x as usize, y as usize) as f64
+    let (w, h) = (hf.width(), hf.height());
+    let (fx, fy) = (x - 0.5, y - 0.5);
+    let (x0, y0) = (
+        fx.floor().clamp(0.0, (w - 2) as f64),
+        fy.floor().clamp(0.0, (h - 2) as f64),
+    );
+    let (tx, ty) = ((fx - x0).clamp(0.0, 1.0), (fy - y0).clamp(0.0, 1.0));
+    let g = |i: f64, j: f64| hf.get(i as usize, j as usize) as f64;
+    (g(x0, y0) * (1.0 - tx) + g(x0 + 1.0, y0) * tx) * (1.0 - ty)
+        + (g(x0, y0 + 1.0) * (1.0 - tx) + g(x0 + 1.0, y0 + 1.0) * tx) * ty
 }
 
 /// Mean height in a (2r+1)² window around (x, y).
@@ -92,13 +103,12 @@ fn point_constraint_sets_height_and_slope() {
         worst = worst.max(err);
         // Slope: the terrain descends along the direction across the site.
         let (dx, dy) = (dir.cos(), dir.sin());
-        let (xi, yi) = (x as usize, y as usize);
         let o = 12.0;
         let up = mean_around(hf, (x - o * dx) as usize, (y - o * dy) as usize, 2);
         let down = mean_around(hf, (x + o * dx) as usize, (y + o * dy) as usize, 2);
         println!(
             "point {k}: target {h:.1} m, got {:.1} m (error {:.2}% of relief {rel:.0} m); uphill {up:.1} m, downhill {down:.1} m (plane: {:.1} m apart)",
-            hf.get(xi, yi),
+            at(hf, x, y),
             err * 100.0,
             2.0 * o * cell * 20f64.to_radians().tan()
         );

@@ -20,9 +20,10 @@ pub use point::PointConstraint;
 
 use thiserror::Error;
 
-/// Geometric constraints act on levels ≥ this one (paper §5.1: "disabling
-/// geometric constraints on the finest two levels"); type constraints too
-/// (§5.2).
+/// Type constraints act on levels ≥ this one (paper §5.2: "disabling type
+/// constraints when synthesizing the finest two levels"). Geometric
+/// constraints act on every level: see [`blend`] for why this departs from
+/// §5.1.
 pub const FIRST_LEVEL: usize = 2;
 
 /// What one geometric constraint asks of one output position.
