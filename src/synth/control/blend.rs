@@ -72,6 +72,10 @@ const B_ONE: f64 = (1u64 << 20) as f64;
 /// tolerance step of s·cell/256, 6 cm at 30 m cells) in the sums.
 const H_FRAC: f64 = 16.0;
 const D_FRAC: f64 = 256.0;
+/// Side of the tiles, in level pixels, that [`Blend`] skips at once where a
+/// constraint cannot reach (most of its bounds at the finest levels, whose
+/// reach cap is 4 and 8 output pixels).
+const TILE: usize = 8;
 /// Largest tolerance handed to the kernel (keeps φ's products in 32 bits).
 /// Past it the cone stops widening: with 5 cm units that is 1.6 km of
 /// height, far outside any error φ's cubic would still act on.
@@ -174,21 +178,35 @@ impl Blend {
                 lo..hi.max(lo)
             };
             let (w, h) = (level.width, level.height);
-            for y in range(y0, y1, h) {
-                for x in range(x0, x1, w) {
-                    let (ox, oy) = ((x as f64 + 0.5) * scale, (y as f64 + 0.5) * scale);
-                    let Some(s) = c.sample(ox, oy) else { continue };
-                    // NaN distances (a broken constraint) never count.
-                    let inside = s.distance <= s.reach.min(cap);
-                    if !inside {
+            let (ys, xs) = (range(y0, y1, h), range(x0, x1, w));
+            for ty in ys.clone().step_by(TILE) {
+                for tx in xs.clone().step_by(TILE) {
+                    let (ty1, tx1) = ((ty + TILE).min(ys.end), (tx + TILE).min(xs.end));
+                    // Skip a tile whose every pixel centre is beyond the cap
+                    // (exact: see `Constraint::distance_bound`).
+                    let centre = |a: usize, b: usize| (a + b) as f64 / 2.0 * scale;
+                    let spread = ((tx1 - 1 - tx) as f64).hypot((ty1 - 1 - ty) as f64);
+                    let bound = c.distance_bound(centre(tx, tx1), centre(ty, ty1));
+                    if bound - spread * scale / 2.0 > cap {
                         continue;
                     }
-                    let d_tol = (s.distance - half).max(0.0);
-                    let (b, bh, bd) = contribution(&q, s.target_m, s.distance, d_tol);
-                    let cell = &mut level.sums[y * w + x];
-                    cell.b += sign * b;
-                    cell.bh += sign * bh;
-                    cell.bd += sign * bd;
+                    for y in ty..ty1 {
+                        for x in tx..tx1 {
+                            let (ox, oy) = ((x as f64 + 0.5) * scale, (y as f64 + 0.5) * scale);
+                            let Some(s) = c.sample(ox, oy) else { continue };
+                            // NaN distances (a broken constraint) never count.
+                            let inside = s.distance <= s.reach.min(cap);
+                            if !inside {
+                                continue;
+                            }
+                            let d_tol = (s.distance - half).max(0.0);
+                            let (b, bh, bd) = contribution(&q, s.target_m, s.distance, d_tol);
+                            let cell = &mut level.sums[y * w + x];
+                            cell.b += sign * b;
+                            cell.bh += sign * bh;
+                            cell.bd += sign * bd;
+                        }
+                    }
                 }
             }
         }
@@ -373,6 +391,47 @@ mod tests {
         }
         b.subtract(&p);
         assert!(b.is_empty());
+    }
+
+    #[test]
+    fn skipped_tiles_hold_no_curve_sample_within_the_cap() {
+        use crate::synth::control::curve::{CurveSpec, FieldCache, Widget, build};
+        use glam::DVec2;
+        let points = (0..=12)
+            .map(|k| {
+                let t = k as f64 / 12.0;
+                DVec2::new(20.0 + 260.0 * t, 120.0 + 70.0 * (t * 7.0).sin())
+            })
+            .collect();
+        let widget = |at, reach: f64| Widget {
+            at,
+            height_m: 300.0,
+            slope_deg: [20.0, -10.0],
+            reach_px: [reach, 0.6 * reach],
+        };
+        let spec = CurveSpec {
+            points,
+            widgets: vec![widget(0.0, 50.0), widget(1.0, 6.0)],
+            smoothing: 2,
+        };
+        let (curves, _) = build(&[spec], &[], 30.0, &FieldCache::new()).unwrap();
+        let mut b = Blend::new(300, 240, 6, q());
+        b.add(&curves[0]);
+        for level in 0..=6 {
+            let t = b.targets(level, 30.0).unwrap();
+            let s = (1 << level) as f64;
+            let mut reached = 0;
+            for y in 0..t.height {
+                for x in 0..t.width {
+                    let smp = curves[0].sample((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
+                    let inside = smp.is_some_and(|m| m.distance <= m.reach.min(4.0 * s));
+                    let c = t.cells[y * t.width + x];
+                    assert_eq!(c != Target::NONE, inside, "level {level} ({x}, {y})");
+                    reached += inside as usize;
+                }
+            }
+            assert!(reached > 0, "level {level}");
+        }
     }
 
     #[test]

@@ -46,6 +46,11 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     fn bounds(&self) -> [f64; 4];
     /// The sample at output position (x, y); None outside its reach.
     fn sample(&self, x: f64, y: f64) -> Option<Sample>;
+    /// A lower bound ℓ on the site distance around (x, y): wherever
+    /// `sample(p)` is Some, `sample(p).distance ≥ ℓ − |p − (x, y)|`. The
+    /// blend skips whole tiles of a level beyond its reach cap with it, so
+    /// the finest levels cost a band around the constraint, not its bounds.
+    fn distance_bound(&self, x: f64, y: f64) -> f64;
 }
 
 /// Invalid control inputs. Messages name the field and the allowed range.
