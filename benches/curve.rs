@@ -3,13 +3,15 @@
 //! meandering curve from scratch (smoothing, distance field, envelope
 //! isocurve and its smoothing), `curve/reach/1024` rebuilds it with a new
 //! reach and `curve/height/1024` with new heights — both reuse the cached
-//! distance field, as an edit does — and `curve/sample/1024` evaluates it
-//! at every level-2 pixel centre (what the blend does per frame).
+//! distance field, as an edit does — and `curve/blend/1024` adds it to the
+//! overlap blend of every level and subtracts it again (what an edit of
+//! the curve does to the blend's running sums).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec2;
 use std::hint::black_box;
-use terrasynth::synth::control::Constraint;
+use terrasynth::database::Quantization;
+use terrasynth::synth::control::Blend;
 use terrasynth::synth::control::curve::{CurveSpec, FieldCache, Widget, build};
 
 fn spec(height: f64, reach: f64) -> CurveSpec {
@@ -51,16 +53,15 @@ fn bench(c: &mut Criterion) {
         b.iter(|| build(&[spec(black_box(1100.0), 80.0)], &[], 30.0, &cache).unwrap())
     });
     let (curves, _) = build(&[spec(1000.0, 60.0)], &[], 30.0, &cache).unwrap();
-    g.bench_function("sample/1024", |b| {
+    let q = Quantization {
+        offset_m: 0.0,
+        scale_m: 0.05,
+    };
+    let mut blend = Blend::new(1024, 1024, 10, q);
+    g.bench_function("blend/1024", |b| {
         b.iter(|| {
-            let mut n = 0usize;
-            for y in 0..256 {
-                for x in 0..256 {
-                    let p = ((x as f64 + 0.5) * 4.0, (y as f64 + 0.5) * 4.0);
-                    n += curves[0].sample(p.0, p.1).is_some() as usize;
-                }
-            }
-            n
+            blend.add(&curves[0]);
+            blend.subtract(&curves[0]);
         })
     });
     g.finish();

@@ -1,7 +1,8 @@
 //! Scenes through editing sessions, on a real DEM: a curve constraint's
-//! height profile (measured against the 2 % goal, see the test), scene-to-scene edits (only what changed is re-set, the
-//! curve's distance field is reused, the change stays local), and the CLI
-//! (`synth --scene`, `edit`). Skips with a message when ../shared/dem is absent.
+//! height profile (within the 2 % of relief), scene-to-scene edits
+//! (only what changed is re-set, the curve's distance field is reused, the
+//! change stays local), and the CLI (`synth --scene`, `edit`). Skips with a
+//! message when ../shared/dem is absent.
 
 use serde_json::json;
 use std::path::Path;
@@ -111,24 +112,52 @@ fn curve_height_profile_follows_the_widgets_on_a_real_dem() {
         "unconstrained terrain along the same curve: mean |error| {:.2} % of relief",
         100.0 * free_err / n as f64
     );
-    // Measured: mean 4.84 %, median 4.19 %, p90 9.5 %, max 15.2 % (seed 5);
-    // unconstrained 11.9 %. The goal is 2 %: not reached — the
-    // constraint acts on levels >= 2 only and phi_d moves a far-off
-    // candidate by lambda = 1/2 of its error per correction, so the finest
-    // levels' free detail (hundreds of metres at 92 m cells here) stays.
-    // Asserted: the profile is followed to within 8 % on average and the
-    // constraint at least halves (x 1.6) the unconstrained error.
+    // Realism along the curve: the fine relief (RMS of the 3×3 high-pass)
+    // within 2 px of it, against the unconstrained terrain's there. A curve
+    // pinned to its smooth profile would leave a smooth band (paper §5.1's
+    // "visually intrusive" over-constraint).
+    let near: Vec<(usize, usize)> = (1..SIZE - 1)
+        .flat_map(|y| (1..SIZE - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            c.points().iter().any(|q| q.distance(p) <= 2.0)
+        })
+        .collect();
+    let texture = |hf: &terrasynth::Heightfield| {
+        let s2: f64 = near
+            .iter()
+            .map(|&(x, y)| {
+                let mut m = 0.0;
+                for v in y - 1..=y + 1 {
+                    for u in x - 1..=x + 1 {
+                        m += hf.get(u, v) as f64 / 9.0;
+                    }
+                }
+                (hf.get(x, y) as f64 - m).powi(2)
+            })
+            .sum();
+        (s2 / near.len() as f64).sqrt()
+    };
+    let (t_curve, t_free) = (texture(hf), texture(&plain));
+    eprintln!("fine relief within 2 px of the curve: {t_curve:.2} m (unconstrained {t_free:.2} m)");
+    assert!(t_curve >= 0.6 * t_free, "{t_curve:.2} m vs {t_free:.2} m");
+    // Measured: mean 1.02 %, median 0.82 %, p90 2.25 %, max 3.67 % (seed 5;
+    // seeds 1, 2, 3, 9 give 0.85–1.02 % at pixel centres); unconstrained
+    // 11.9 %; fine relief 93 % of the unconstrained terrain's. The issue's
+    // goal: within 2 % of relief along the curve's length, asserted on the
+    // mean and the median (single samples keep the finest level's detail,
+    // see control::blend).
     assert!(
-        free_err / n as f64 > 1.6 * mean,
+        free_err / n as f64 > 5.0 * mean,
         "the constraint must matter"
     );
     assert!(
-        mean <= 0.08,
+        mean <= 0.02,
         "mean profile error {:.2} % of relief",
         100.0 * mean
     );
     assert!(
-        median <= 0.08,
+        median <= 0.02,
         "median profile error {:.2} % of relief",
         100.0 * median
     );

@@ -1,7 +1,8 @@
 //! User control on real DEMs (issue 5 "Done means"): point accuracy and
 //! slope, painted types, freezing, coherence locality, copy-paste, and
 //! exact restricted re-synthesis. A small database is built from two 256²
-//! crops of ../shared/dem (with their type masks); skipped when absent.
+//! crops of ../shared/dem (with their type masks), a second one from a
+//! Yosemite crop for points at another output size; skipped when absent.
 
 use std::sync::{Arc, OnceLock};
 use terrasynth::database::{self, BuildOptions, Database};
@@ -48,8 +49,19 @@ fn session(db: &Database) -> Session<'_> {
     Session::new(db, Params::default(), N, N, 7).unwrap()
 }
 
+/// Height at output position (x, y), bilinear between pixel centres (at
+/// +0.5): the height *at a site*, wherever it falls in its pixel.
 fn at(hf: &Heightfield, x: f64, y: f64) -> f64 {
-    hf.get(x as usize, y as usize) as f64
+    let (w, h) = (hf.width(), hf.height());
+    let (fx, fy) = (x - 0.5, y - 0.5);
+    let (x0, y0) = (
+        fx.floor().clamp(0.0, (w - 2) as f64),
+        fy.floor().clamp(0.0, (h - 2) as f64),
+    );
+    let (tx, ty) = ((fx - x0).clamp(0.0, 1.0), (fy - y0).clamp(0.0, 1.0));
+    let g = |i: f64, j: f64| hf.get(i as usize, j as usize) as f64;
+    (g(x0, y0) * (1.0 - tx) + g(x0 + 1.0, y0) * tx) * (1.0 - ty)
+        + (g(x0, y0 + 1.0) * (1.0 - tx) + g(x0 + 1.0, y0 + 1.0) * tx) * ty
 }
 
 /// Mean height in a (2r+1)² window around (x, y).
@@ -92,13 +104,12 @@ fn point_constraint_sets_height_and_slope() {
         worst = worst.max(err);
         // Slope: the terrain descends along the direction across the site.
         let (dx, dy) = (dir.cos(), dir.sin());
-        let (xi, yi) = (x as usize, y as usize);
         let o = 12.0;
         let up = mean_around(hf, (x - o * dx) as usize, (y - o * dy) as usize, 2);
         let down = mean_around(hf, (x + o * dx) as usize, (y + o * dy) as usize, 2);
         println!(
             "point {k}: target {h:.1} m, got {:.1} m (error {:.2}% of relief {rel:.0} m); uphill {up:.1} m, downhill {down:.1} m (plane: {:.1} m apart)",
-            hf.get(xi, yi),
+            at(hf, x, y),
             err * 100.0,
             2.0 * o * cell * 20f64.to_radians().tan()
         );
@@ -374,4 +385,91 @@ fn sessions_are_identical_on_one_and_two_threads() {
             .all(|(x, y)| x.to_bits() == y.to_bits())
     );
     assert!(a.1 == b.1);
+}
+
+/// A second database and output size: a 384² crop of the Yosemite DEM
+/// (granite domes and glacial canyons, 30.8 m cells), synthesized at
+/// 320 × 224.
+fn yosemite() -> Option<&'static Database> {
+    static DB: OnceLock<Option<Database>> = OnceLock::new();
+    DB.get_or_init(|| {
+        let input = dem::exemplar("yosemite_half_dome", (200, 220, 384, 384), false)?;
+        let opts = BuildOptions {
+            levels: 5,
+            ..Default::default()
+        };
+        Some(database::build(vec![input], &opts, &Silent).unwrap().0)
+    })
+    .as_ref()
+    .or_else(|| {
+        eprintln!("{DEM} not found: control tests on real DEMs skipped");
+        None
+    })
+}
+
+/// RMS of the 3×3 high-pass (height − its 3×3 mean) over the pixels within
+/// `r` of (x, y): the terrain's fine texture there.
+fn texture(hf: &Heightfield, (x, y): (f64, f64), r: f64) -> f64 {
+    let (mut s2, mut n) = (0.0, 0);
+    for v in 1..hf.height() - 1 {
+        for u in 1..hf.width() - 1 {
+            if (u as f64 + 0.5 - x).hypot(v as f64 + 0.5 - y) > r {
+                continue;
+            }
+            let m = mean_around(hf, u, v, 1);
+            s2 += (hf.get(u, v) as f64 - m).powi(2);
+            n += 1;
+        }
+    }
+    (s2 / n as f64).sqrt()
+}
+
+#[test]
+fn lowered_and_raised_points_on_a_second_dem_and_size() {
+    let Some(db) = yosemite() else { return };
+    let (w, h) = (320, 224);
+    let rel = relief(db);
+    for (k, (site, dir, lift)) in [((110.3, 96.8), 2.4, -0.22), ((214.6, 130.2), -0.9, 0.22)]
+        .into_iter()
+        .enumerate()
+    {
+        let mut s = Session::new(db, Params::default(), w, h, 11).unwrap();
+        let base = s.apply(vec![]).unwrap().heightfield;
+        let cell = s.synthesizer().cell_size_m();
+        let target = at(&base, site.0, site.1) + lift * rel;
+        let radius = 48.0;
+        let slope = 15f64.to_radians();
+        let p = PointConstraint::new(site, target, dir, slope, radius, cell).unwrap();
+        let out = s
+            .apply(vec![Edit::SetConstraint(ConstraintId(1), Arc::new(p))])
+            .unwrap()
+            .heightfield;
+        let got = at(&out, site.0, site.1);
+        let err = (got - target).abs() / rel;
+        let (dx, dy) = (dir.cos(), dir.sin());
+        let o = 10.0;
+        let probe = |sign: f64| {
+            let (u, v) = (site.0 + sign * o * dx, site.1 + sign * o * dy);
+            mean_around(&out, u as usize, v as usize, 2)
+        };
+        let (up, down) = (probe(-1.0), probe(1.0));
+        let (t_new, t_old) = (texture(&out, site, radius), texture(&base, site, radius));
+        println!(
+            "{} point {k}: target {target:.1} m, got {got:.1} m (error {:.2}% of relief {rel:.0} m); uphill {up:.1} m, downhill {down:.1} m; texture within the radius {t_new:.2} m (unconstrained {t_old:.2} m)",
+            if lift < 0.0 { "lowered" } else { "raised" },
+            err * 100.0,
+        );
+        assert!(
+            err <= 0.02,
+            "point {k}: site off by {:.2}% of relief",
+            err * 100.0
+        );
+        assert!(up > down, "point {k}: no descent along the slope direction");
+        // The disc keeps the exemplar's fine relief: a constraint that pinned
+        // it to its target plane (the old terraced pits) would leave none.
+        assert!(
+            t_new >= 0.5 * t_old,
+            "point {k}: texture {t_new:.2} m vs {t_old:.2} m unconstrained"
+        );
+    }
 }

@@ -20,9 +20,10 @@ pub use point::PointConstraint;
 
 use thiserror::Error;
 
-/// Geometric constraints act on levels ≥ this one (paper §5.1: "disabling
-/// geometric constraints on the finest two levels"); type constraints too
-/// (§5.2).
+/// Type constraints act on levels ≥ this one (paper §5.2: "disabling type
+/// constraints when synthesizing the finest two levels"). Geometric
+/// constraints act on every level: see [`blend`] for why this departs from
+/// §5.1.
 pub const FIRST_LEVEL: usize = 2;
 
 /// What one geometric constraint asks of one output position.
@@ -45,6 +46,11 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     fn bounds(&self) -> [f64; 4];
     /// The sample at output position (x, y); None outside its reach.
     fn sample(&self, x: f64, y: f64) -> Option<Sample>;
+    /// A lower bound ℓ on the site distance around (x, y): wherever
+    /// `sample(p)` is Some, `sample(p).distance ≥ ℓ − |p − (x, y)|`. The
+    /// blend skips whole tiles of a level beyond its reach cap with it, so
+    /// the finest levels cost a band around the constraint, not its bounds.
+    fn distance_bound(&self, x: f64, y: f64) -> f64;
 }
 
 /// Invalid control inputs. Messages name the field and the allowed range.

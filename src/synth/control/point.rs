@@ -96,6 +96,11 @@ impl Constraint for PointConstraint {
             reach: self.radius,
         })
     }
+
+    /// Exact: `sample` reports the Euclidean distance to the site.
+    fn distance_bound(&self, x: f64, y: f64) -> f64 {
+        (x - self.x).hypot(y - self.y)
+    }
 }
 
 #[cfg(test)]

@@ -4,13 +4,14 @@
 //! horizontal shape of the curve changes").
 //!
 //! Nodes sit at integer output coordinates, i.e. on output pixel corners.
-//! That is exactly where constraints are evaluated: a level-i pixel centre
-//! maps to ((x + ½)·2^i, (y + ½)·2^i), an integer for every i ≥ 1, and
-//! geometric constraints only run on levels ≥ 2. Storing the closest
-//! *segment* (not the distance) keeps the distance exact: a query projects
-//! onto the stored segment(s), so at a node it equals the brute-force
-//! closest-point distance, and between nodes it takes the best of the four
-//! surrounding nodes' segments.
+//! That is where constraints are evaluated on every level but the finest:
+//! a level-i pixel centre maps to ((x + ½)·2^i, (y + ½)·2^i), an integer
+//! for every i ≥ 1. Storing the closest *segment* (not the distance) keeps
+//! the distance exact there: a query projects onto the stored segment(s),
+//! so at a node it equals the brute-force closest-point distance. Between
+//! nodes (level-0 pixel centres) it takes the best of the four surrounding
+//! nodes' segments, which is the true closest point except where those
+//! nodes straddle a medial axis of the curve, and never closer than it.
 //!
 //! [`FieldCache`] keys fields on the resampled shape, so changing a widget's
 //! height, slope or reach reuses the field; only a reach that outgrows the

@@ -590,6 +590,24 @@ impl Constraint for Curve {
             reach,
         })
     }
+
+    /// From the lattice node n nearest to p (|p − n| ≤ √½): a sample's
+    /// distance is to a point of the curve, so it is at least the true
+    /// distance, which is 1-Lipschitz and at n is exactly the projection on
+    /// n's stored segment, or more than the field's margin where n stores
+    /// none (or lies off the lattice, which extends past the margin).
+    fn distance_bound(&self, x: f64, y: f64) -> f64 {
+        let f = &self.field;
+        let (i, j) = ((x - f.x0 as f64).round(), (y - f.y0 as f64).round());
+        let n = DVec2::new(f.x0 as f64 + i, f.y0 as f64 + j);
+        let s = f.node(i as i64, j as i64);
+        let at_node = if s == field::NONE {
+            f.margin
+        } else {
+            f.segments.project(s, n).dist
+        };
+        at_node - n.distance(DVec2::new(x, y))
+    }
 }
 
 #[cfg(test)]
