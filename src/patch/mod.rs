@@ -566,9 +566,10 @@ pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses
 
 /// Picks the winner among scored candidates: sort by cost (ties by key),
 /// add the graph-cut cost for the best `finalists` (estimated at half
-/// resolution, [`merge::seam_cost_coarse`]), take the minimum, and cut the
-/// winner at full resolution. Returns the winning patch (offset to the
-/// overlap) and its seam.
+/// resolution, [`merge::seam_coarse`]), take the minimum (ties by rank),
+/// and cut the winner at full resolution in a band around its half-
+/// resolution seam ([`merge::seam_banded`]). Returns the winning patch
+/// (offset to the overlap) and its seam.
 pub(crate) fn select(
     c: &Canvas,
     win: Window,
@@ -579,18 +580,19 @@ pub(crate) fn select(
     scored.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.key.cmp(&b.key)));
     scored.truncate(params.finalists.max(1));
     let n = win.n as f64;
-    let results: Vec<(f64, Vec<f32>)> = scored
+    let results: Vec<(f64, Vec<f32>, graphcut::Seam)> = scored
         .par_iter()
         .map(|s| {
             let off = merge::offset(c, win, &s.patch);
             let p: Vec<f32> = s.patch.iter().map(|v| v + off).collect();
-            let cut = merge::seam_cost_coarse(c, win, &p, core) as f64 / 256.0 / n;
-            (s.cost + params.weights.cut * cut, p)
+            let coarse = merge::seam_coarse(c, win, &p, core);
+            let cut = coarse.cost as f64 / 256.0 / n;
+            (s.cost + params.weights.cut * cut, p, coarse)
         })
         .collect();
     let best = (0..results.len()).min_by(|&a, &b| results[a].0.total_cmp(&results[b].0))?;
-    let (_, p) = results.into_iter().nth(best)?;
-    let seam = merge::seam(c, win, &p, core);
+    let (_, p, coarse) = results.into_iter().nth(best)?;
+    let seam = merge::seam_banded(c, win, &p, core, &coarse);
     let mut win_s = scored.swap_remove(best);
     win_s.patch = p;
     Some((win_s, seam))
