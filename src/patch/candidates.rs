@@ -12,7 +12,7 @@
 //! (about a quarter of a second per 800² source on 2 cores).
 
 use super::Params;
-use super::costs::{TURN, noise_levels};
+use super::costs::{TURN, centre_cells, noise_levels};
 use super::graph::{FeatureGraph, dist, point_at};
 use super::ppa::{self, PpaParams};
 use super::sketch::Kind;
@@ -162,6 +162,10 @@ pub struct PreparedSource {
     pub coarse: Vec<i32>,
     pub coarse_w: usize,
     pub fill: Vec<FillCand>,
+    /// Per fill candidate, its `(patch/COARSE)²` reduced cells, contiguous,
+    /// centred and clamped ([`super::costs::centre_cells`]): what the
+    /// round-one kernel reads, so it streams instead of gathering rows.
+    pub fill_cells: Vec<i32>,
     /// The patch size this was prepared for.
     pub patch: usize,
 }
@@ -338,6 +342,18 @@ impl PreparedSource {
                 })
             })
             .collect();
+        let m = patch / COARSE;
+        let fill_cells: Vec<i32> = fill
+            .par_iter()
+            .flat_map_iter(|fc| {
+                let (ox, oy) = (fc.x as usize / COARSE, fc.y as usize / COARSE);
+                let mut cells: Vec<i32> = (0..m * m)
+                    .map(|i| coarse[(oy + i / m) * cw + ox + i % m])
+                    .collect();
+                centre_cells(&mut cells, None);
+                cells
+            })
+            .collect();
         Ok(PreparedSource {
             name: name.to_string(),
             width: w,
@@ -350,6 +366,7 @@ impl PreparedSource {
             coarse,
             coarse_w: cw,
             fill,
+            fill_cells,
             patch,
         })
     }

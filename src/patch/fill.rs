@@ -10,13 +10,14 @@
 //! Candidates: every source's patches on a patch/2 grid under 6 transforms
 //! (four 90° rotations and two mirrors, which need no resampling). Round
 //! one is integer and data-parallel: DC-corrected SSD against the window's
-//! fully filled 8×8 cells on the 8× reduced grid, plus the noise-variance
-//! difference; the user window is permuted into each transform's frame
-//! once, so every candidate reads contiguous source rows. The best 5 per
+//! fully filled 8×8 cells on the 8× reduced grid ([`fill_ssd`], explicit
+//! SIMD), plus the noise-variance difference; the user window is permuted
+//! into each transform's frame once, and every candidate's cells are stored
+//! contiguously, so the kernel streams both. The best 5 per
 //! source go to round two and the graph-cut finalists ([`super::select`]).
 
 use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
-use super::costs::noise_cost;
+use super::costs::{centre_cells, fill_ssd, noise_cost};
 use super::merge::{self, Canvas, Window};
 use super::{Library, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window};
 use crate::progress::Progress;
@@ -223,7 +224,9 @@ pub(crate) fn fill(
             h,
         );
         let uw = user_window(canvas, win);
-        // User cells on the reduced grid.
+        // User cells on the reduced grid, centred and clamped like the
+        // candidates' ([`centre_cells`]), then permuted into each
+        // transform's source frame with an all-bits mask of valid cells.
         let mut uc = vec![0i32; m * m];
         let mut uv = vec![false; m * m];
         for cy in 0..m {
@@ -241,60 +244,33 @@ pub(crate) fn fill(
                 uv[cy * m + cx] = all;
             }
         }
-        // Permute into each transform's source frame.
-        let perms: Vec<(Vec<i32>, Vec<bool>)> = (0..FILL_TRANSFORMS)
+        let count = centre_cells(&mut uc, Some(&uv));
+        let perms: Vec<(Vec<i32>, Vec<i32>)> = (0..FILL_TRANSFORMS)
             .map(|v| {
                 let mut a = vec![0i32; m * m];
-                let mut ok = vec![false; m * m];
+                let mut mask = vec![0i32; m * m];
                 for cy in 0..m {
                     for cx in 0..m {
                         let (sx, sy) = fill_map(v, cx, cy, m);
                         a[sy * m + sx] = uc[cy * m + cx];
-                        ok[sy * m + sx] = uv[cy * m + cx];
+                        mask[sy * m + sx] = -(uv[cy * m + cx] as i32);
                     }
                 }
-                (a, ok)
+                (a, mask)
             })
             .collect();
-        let any_cell = uv.iter().any(|&v| v);
         let mut best: Vec<(usize, u32, u8)> = Vec::new();
         for (si, src) in lib.sources.iter().enumerate() {
-            let cw = src.coarse_w;
             let mut scored: Vec<(u64, u32, u8)> = src
                 .fill
                 .par_iter()
+                .zip(src.fill_cells.par_chunks(m * m))
                 .enumerate()
-                .map(|(k, fc)| {
-                    let (ox, oy) = (fc.x as usize / COARSE, fc.y as usize / COARSE);
+                .map(|(k, (fc, cells))| {
                     let nc = noise_cost(&uw.noise, &fc.noise) * params.weights.fill_noise;
                     let mut b = (u64::MAX, 0u8);
-                    for (v, (a, ok)) in perms.iter().enumerate() {
-                        let ssd = if any_cell {
-                            let mut cand = [0i32; 64];
-                            let mut total = (0i64, 0i64, 0i64);
-                            for row in 0..m {
-                                let srow =
-                                    &src.coarse[(oy + row) * cw + ox..(oy + row) * cw + ox + m];
-                                cand[..m].copy_from_slice(srow);
-                                let (s, s2, c) = row_sums(
-                                    &a[row * m..(row + 1) * m],
-                                    &cand[..m],
-                                    &ok[row * m..(row + 1) * m],
-                                );
-                                total.0 += s;
-                                total.1 += s2;
-                                total.2 += c;
-                            }
-                            let (s, s2, c) = total;
-                            if c > 0 {
-                                ((c * s2 - s * s) / (c * c)) as u64
-                            } else {
-                                0
-                            }
-                        } else {
-                            0
-                        };
-                        let cost = ssd.saturating_add(nc);
+                    for (v, (a, mask)) in perms.iter().enumerate() {
+                        let cost = fill_ssd(a, mask, cells, count).saturating_add(nc);
                         if cost < b.0 {
                             b = (cost, v as u8);
                         }
@@ -352,18 +328,4 @@ pub(crate) fn fill(
         timings.fill_merge += t3.elapsed();
     }
     progress.finish();
-}
-
-/// `(Σd, Σd², count)` of `d = a − b` over valid samples of one row. Plain
-/// fixed-length integer loops, which the compiler vectorises.
-#[inline]
-fn row_sums(a: &[i32], b: &[i32], ok: &[bool]) -> (i64, i64, i64) {
-    let (mut s, mut s2, mut c) = (0i64, 0i64, 0i64);
-    for ((&x, &y), &v) in a.iter().zip(b).zip(ok) {
-        let d = ((x - y) * v as i32) as i64;
-        s += d;
-        s2 += d * d;
-        c += v as i64;
-    }
-    (s, s2, c)
 }
