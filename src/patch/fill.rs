@@ -102,73 +102,132 @@ fn rect<T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T>>(
     s[y1 * k + x1] + s[y0 * k + x0] - s[y0 * k + x1] - s[y1 * k + x0]
 }
 
-/// The next block to fill (highest priority, lowest index on ties).
-fn next_spot(bl: &Blocks, n: usize, g_ref: f64) -> Option<(usize, [f32; 2])> {
+/// Priorities of the unfilled blocks, kept between steps: a block's
+/// priority depends only on the blocks within `rb` of it, so after a patch
+/// only those around its window are re-evaluated (instead of all of them,
+/// which cost more than the candidate search at 1024²).
+struct Priorities {
+    rb: usize,
+    g_ref: f64,
+    n: usize,
+    prio: Vec<Option<(f64, [f32; 2])>>,
+}
+
+impl Priorities {
+    fn new(bl: &Blocks, n: usize, g_ref: f64) -> Priorities {
+        let mut p = Priorities {
+            rb: (n / B / 2).max(1),
+            g_ref,
+            n,
+            prio: vec![None; bl.bw * bl.bh],
+        };
+        p.refresh(bl, 0, 0, bl.bw, bl.bh);
+        p
+    }
+
+    /// Re-evaluates the blocks within `rb` of the block rectangle
+    /// `[x0, x1) × [y0, y1)` (whose counts changed).
+    fn refresh(&mut self, bl: &Blocks, x0: usize, y0: usize, x1: usize, y1: usize) {
+        let (bw, bh, rb) = (bl.bw, bl.bh, self.rb);
+        let cs = sat(
+            &bl.cnt.iter().map(|&c| c as u64).collect::<Vec<_>>(),
+            bw,
+            bh,
+        );
+        let hs = sat(&bl.hsum, bw, bh);
+        let (rx0, ry0) = (x0.saturating_sub(rb), y0.saturating_sub(rb));
+        let (rx1, ry1) = ((x1 + rb).min(bw), (y1 + rb).min(bh));
+        let rw = rx1 - rx0;
+        let (n, g_ref) = (self.n, self.g_ref);
+        let fresh: Vec<Option<(f64, [f32; 2])>> = (0..rw * (ry1 - ry0))
+            .into_par_iter()
+            .map(|k| {
+                let b = (ry0 + k / rw) * bw + rx0 + k % rw;
+                priority(bl, &cs, &hs, b, rb, n, g_ref)
+            })
+            .collect();
+        for (k, p) in fresh.into_iter().enumerate() {
+            self.prio[(ry0 + k / rw) * bw + rx0 + k % rw] = p;
+        }
+    }
+}
+
+/// Priority `C + D` of block `b` and its front normal, `None` when it is
+/// filled or nothing near it is (see the module docs).
+fn priority(
+    bl: &Blocks,
+    cs: &[u64],
+    hs: &[f64],
+    b: usize,
+    rb: usize,
+    n: usize,
+    g_ref: f64,
+) -> Option<(f64, [f32; 2])> {
     let (bw, bh) = (bl.bw, bl.bh);
-    let cs = sat(
-        &bl.cnt.iter().map(|&c| c as u64).collect::<Vec<_>>(),
-        bw,
-        bh,
-    );
-    let hs = sat(&bl.hsum, bw, bh);
-    let rb = (n / B / 2).max(1);
-    let any_filled = bl.cnt.iter().any(|&c| c > 0);
-    let pr: Vec<(f64, usize, [f32; 2])> = (0..bw * bh)
-        .into_par_iter()
-        .filter(|&b| bl.cnt[b] < bl.area[b])
-        .filter_map(|b| {
-            let (bx, by) = (b % bw, b / bw);
-            let (x0, y0) = (bx.saturating_sub(rb), by.saturating_sub(rb));
-            let (x1, y1) = ((bx + rb + 1).min(bw), (by + rb + 1).min(bh));
-            let filled = rect(&cs, bw, x0, y0, x1, y1);
-            if filled == 0 {
-                return None;
-            }
-            let conf = filled as f64 / (n * n) as f64;
-            // Front normal and height gradient from half-window differences.
-            let half = |ax0, ay0, ax1, ay1| {
-                let k = rect(&cs, bw, ax0, ay0, ax1, ay1) as f64;
-                let s = rect(&hs, bw, ax0, ay0, ax1, ay1);
-                (k, if k > 0.0 { Some(s / k) } else { None })
-            };
-            let (kl, ml) = half(x0, y0, bx, y1);
-            let (kr, mr) = half(bx + 1, y0, x1, y1);
-            let (kt, mt) = half(x0, y0, x1, by);
-            let (kd, md) = half(x0, by + 1, x1, y1);
-            let (nx, ny) = (kr - kl, kd - kt);
-            let nl = (nx * nx + ny * ny).sqrt();
-            let span = (rb * B) as f64;
-            let gx = match (ml, mr) {
-                (Some(a), Some(c)) => (c - a) / span,
-                _ => 0.0,
-            };
-            let gy = match (mt, md) {
-                (Some(a), Some(c)) => (c - a) / span,
-                _ => 0.0,
-            };
-            let data = if nl > 0.0 {
-                ((-gy * nx + gx * ny) / nl).abs() / g_ref
-            } else {
-                0.0
-            };
-            let dir = if nl > 0.0 {
-                [(nx / nl) as f32, (ny / nl) as f32]
-            } else {
-                [0.0, 0.0]
-            };
-            Some((conf + data.min(1.0), b, dir))
-        })
-        .collect();
-    if !any_filled {
+    if bl.cnt[b] >= bl.area[b] {
+        return None;
+    }
+    let (bx, by) = (b % bw, b / bw);
+    let (x0, y0) = (bx.saturating_sub(rb), by.saturating_sub(rb));
+    let (x1, y1) = ((bx + rb + 1).min(bw), (by + rb + 1).min(bh));
+    let filled = rect(cs, bw, x0, y0, x1, y1);
+    if filled == 0 {
+        return None;
+    }
+    let conf = filled as f64 / (n * n) as f64;
+    // Front normal and height gradient from half-window differences.
+    let half = |ax0, ay0, ax1, ay1| {
+        let k = rect(cs, bw, ax0, ay0, ax1, ay1) as f64;
+        let s = rect(hs, bw, ax0, ay0, ax1, ay1);
+        (k, if k > 0.0 { Some(s / k) } else { None })
+    };
+    let (kl, ml) = half(x0, y0, bx, y1);
+    let (kr, mr) = half(bx + 1, y0, x1, y1);
+    let (kt, mt) = half(x0, y0, x1, by);
+    let (kd, md) = half(x0, by + 1, x1, y1);
+    let (nx, ny) = (kr - kl, kd - kt);
+    let nl = (nx * nx + ny * ny).sqrt();
+    let span = (rb * B) as f64;
+    let gx = match (ml, mr) {
+        (Some(a), Some(c)) => (c - a) / span,
+        _ => 0.0,
+    };
+    let gy = match (mt, md) {
+        (Some(a), Some(c)) => (c - a) / span,
+        _ => 0.0,
+    };
+    let data = if nl > 0.0 {
+        ((-gy * nx + gx * ny) / nl).abs() / g_ref
+    } else {
+        0.0
+    };
+    let dir = if nl > 0.0 {
+        [(nx / nl) as f32, (ny / nl) as f32]
+    } else {
+        [0.0, 0.0]
+    };
+    Some((conf + data.min(1.0), dir))
+}
+
+/// The next block to fill (highest priority, lowest index on ties).
+fn next_spot(bl: &Blocks, pr: &Priorities) -> Option<(usize, [f32; 2])> {
+    let (bw, bh) = (bl.bw, bl.bh);
+    if !bl.cnt.iter().any(|&c| c > 0) {
         // Nothing placed yet (a sketch without features): start in the middle.
         return (0..bw * bh)
             .find(|&b| b == (bh / 2) * bw + bw / 2 && bl.cnt[b] < bl.area[b])
             .or_else(|| (0..bw * bh).find(|&b| bl.cnt[b] < bl.area[b]))
             .map(|b| (b, [0.0, 0.0]));
     }
-    pr.into_iter()
-        .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)))
-        .map(|(_, b, d)| (b, d))
+    let mut best: Option<(f64, usize, [f32; 2])> = None;
+    for (b, p) in pr.prio.iter().enumerate() {
+        if let Some((v, d)) = *p
+            && best.is_none_or(|(bv, _, _)| v > bv)
+        {
+            best = Some((v, b, d));
+        }
+    }
+    best.map(|(_, b, d)| (b, d))
 }
 
 /// Fills every hole of the canvas.
@@ -204,10 +263,11 @@ pub(crate) fn fill(
     } else {
         1.0
     };
+    let mut pr = Priorities::new(&bl, n, g_ref.max(1e-6));
     progress.start("filling", total_unfilled);
     loop {
         let t1 = Instant::now();
-        let Some((b, dir)) = next_spot(&bl, n, g_ref.max(1e-6)) else {
+        let Some((b, dir)) = next_spot(&bl, &pr) else {
             break;
         };
         let (bx, by) = (b % bl.bw, b / bl.bw);
@@ -320,6 +380,13 @@ pub(crate) fn fill(
             stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
         }
         bl.update(canvas, win.x0, win.y0, win.x0 + n, win.y0 + n);
+        pr.refresh(
+            &bl,
+            win.x0 / B,
+            win.y0 / B,
+            (win.x0 + n).div_ceil(B),
+            (win.y0 + n).div_ceil(B),
+        );
         let after = (0..n * n)
             .filter(|&i| canvas.filled[(win.y0 + i / n) * w + win.x0 + i % n])
             .count();
