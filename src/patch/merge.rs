@@ -149,20 +149,27 @@ fn cut(
             take_new: vec![true; n * n],
         };
     }
+    // Heights in integer decimetres, rounded once per pixel.
     let dm = |v: f32| (v * 10.0).round() as i64;
-    let a = |x: usize, y: usize| dm(c.heights[idx(x, y)]);
-    let f = |x: usize, y: usize| c.filled[idx(x, y)];
-    let b = |x: usize, y: usize| dm(patch[y * n + x]);
-    let edge = |(sx, sy): (usize, usize), (tx, ty): (usize, usize)| -> i64 {
-        let (fs, ft) = (f(sx, sy), f(tx, ty));
-        let gb = 2 * (b(tx, ty) - b(sx, sy)).abs();
-        match (fs, ft) {
+    let mut a = vec![0i64; n * n];
+    let mut f = vec![false; n * n];
+    for y in 0..n {
+        for x in 0..n {
+            let i = idx(x, y);
+            a[y * n + x] = dm(c.heights[i]);
+            f[y * n + x] = c.filled[i];
+        }
+    }
+    let b: Vec<i64> = patch.iter().map(|&v| dm(v)).collect();
+    let edge = |s: usize, t: usize| -> i64 {
+        let gb = 2 * (b[t] - b[s]).abs();
+        match (f[s], f[t]) {
             (true, true) => {
-                let ga = 2 * (a(tx, ty) - a(sx, sy)).abs();
-                kwatra(a(sx, sy) - b(sx, sy), a(tx, ty) - b(tx, ty), ga + gb)
+                let ga = 2 * (a[t] - a[s]).abs();
+                kwatra(a[s] - b[s], a[t] - b[t], ga + gb)
             }
-            (true, false) => kwatra(2 * (a(sx, sy) - b(sx, sy)), 0, gb),
-            (false, true) => kwatra(2 * (a(tx, ty) - b(tx, ty)), 0, gb),
+            (true, false) => kwatra(2 * (a[s] - b[s]), 0, gb),
+            (false, true) => kwatra(2 * (a[t] - b[t]), 0, gb),
             (false, false) => 0,
         }
     };
@@ -175,10 +182,10 @@ fn cut(
         for x in 0..n {
             let k = y * n + x;
             if x + 1 < n && !fixed_same(k, k + 1) {
-                ch[k] = edge((x, y), (x + 1, y));
+                ch[k] = edge(k, k + 1);
             }
             if y + 1 < n && !fixed_same(k, k + n) {
-                cv[k] = edge((x, y), (x, y + 1));
+                cv[k] = edge(k, k + n);
             }
         }
     }

@@ -23,6 +23,7 @@
 //! per-candidate results that are reduced in index order with ties broken
 //! by index, so the bytes do not depend on the thread count.
 
+pub mod cache;
 pub mod candidates;
 pub mod costs;
 pub mod fill;
@@ -175,6 +176,28 @@ impl Library {
         params: &Params,
         progress: &dyn Progress,
     ) -> Result<Library, PatchError> {
+        Ok(Self::prepare_in(sources, params, None, progress)?.0)
+    }
+
+    /// [`Self::prepare`] through the disk cache in `dir` ([`cache`]): each
+    /// source's features are read from there when an intact entry for the
+    /// same DEM, parameters and code exists, and computed and stored
+    /// otherwise. Returns the library and how many sources were read.
+    pub fn prepare_cached(
+        sources: &[(String, Heightfield)],
+        params: &Params,
+        dir: &std::path::Path,
+        progress: &dyn Progress,
+    ) -> Result<(Library, usize), PatchError> {
+        Self::prepare_in(sources, params, Some(dir), progress)
+    }
+
+    fn prepare_in(
+        sources: &[(String, Heightfield)],
+        params: &Params,
+        dir: Option<&std::path::Path>,
+        progress: &dyn Progress,
+    ) -> Result<(Library, usize), PatchError> {
         params.check()?;
         if sources.is_empty() {
             return Err(PatchError::NoSources);
@@ -204,15 +227,27 @@ impl Library {
         let target = sorted[sorted.len() / 2];
         progress.start("preparing sources", sources.len() as u64);
         let mut out = Vec::with_capacity(sources.len());
+        let mut hits = 0;
         for ((name, hf), rel) in sources.iter().zip(&reliefs) {
-            out.push(PreparedSource::prepare(name, hf, params, target / rel)?);
+            let scale = target / rel;
+            out.push(match dir {
+                Some(d) => {
+                    let (s, o) = cache::prepare(d, name, hf, params, scale)?;
+                    hits += (o == cache::Outcome::Hit) as usize;
+                    s
+                }
+                None => PreparedSource::prepare(name, hf, params, scale)?,
+            });
             progress.advance(1);
         }
         progress.finish();
-        Ok(Library {
-            sources: out,
-            params: *params,
-        })
+        Ok((
+            Library {
+                sources: out,
+                params: *params,
+            },
+            hits,
+        ))
     }
 }
 
