@@ -362,7 +362,7 @@ pub(crate) fn fill(
                 super::detrend(&mut patch, n);
                 let key = (si, 2u8, k);
                 let u = uses.get(&key).copied().unwrap_or(0);
-                let cost = round2_cost(&uw, &patch, &params.weights, u);
+                let cost = round2_cost(&uw, &patch, &params.weights, &lib.noise_ref, u);
                 Scored { cost, patch, key }
             })
             .collect();

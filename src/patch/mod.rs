@@ -98,6 +98,16 @@ pub struct Weights {
     pub noise: f64,
     pub cut: f64,
     pub repeat: f64,
+    /// Weight of the detail cost: `Σ_l ln((σ_c,l + 1 m) / (σ_ref,l + 1 m))²`
+    /// between a candidate's wavelet noise levels and the library's
+    /// typical ones ([`Library::noise_ref`]). Not in the seeds: with many
+    /// sources of different character (plains next to alpine ranges), the
+    /// relief-normalised profile costs cannot tell a faint ridge of a plain
+    /// from a real one, and whole sketched features came out as smooth,
+    /// detail-free bands (or single rough masses); this keeps every patch
+    /// near the library's typical roughness. With one source it only
+    /// prefers that source's typical patches.
+    pub detail: f64,
     /// Weight of the noise cost against the SSD in the integer first round
     /// of hole filling.
     pub fill_noise: u64,
@@ -112,6 +122,7 @@ impl Default for Weights {
             noise: 0.5,
             cut: 0.5,
             repeat: 0.5,
+            detail: 1.0,
             fill_noise: 4,
         }
     }
@@ -167,6 +178,10 @@ impl Params {
 pub struct Library {
     pub sources: Vec<PreparedSource>,
     pub params: Params,
+    /// The library's typical roughness: per wavelet level, the median
+    /// noise statistic ([`costs::noise_levels`], decimetres) of every
+    /// source's non-feature candidates; see [`Weights::detail`].
+    pub noise_ref: [u32; 3],
 }
 
 impl Library {
@@ -241,10 +256,20 @@ impl Library {
             progress.advance(1);
         }
         progress.finish();
+        let mut noise_ref = [0u32; 3];
+        for (l, r) in noise_ref.iter_mut().enumerate() {
+            let mut v: Vec<u32> = out
+                .iter()
+                .flat_map(|s| s.fill.iter().map(move |c| c.noise[l]))
+                .collect();
+            v.sort_unstable();
+            *r = v.get(v.len() / 2).copied().unwrap_or(0);
+        }
         Ok((
             Library {
                 sources: out,
                 params: *params,
+                noise_ref,
             },
             hits,
         ))
@@ -564,17 +589,31 @@ pub(crate) fn user_window(c: &Canvas, win: Window) -> UserWindow {
 
 /// Round-two cost of a sampled candidate patch against the canvas window:
 /// `w_ssd · SSD_dc / (σ²_user + σ²_cand + 1 m²) + w_noise · Σ(σu − σc)² /
-/// (Σσu² + Σσc² + 1 m²) + w_repeat · uses` (SSD and noise only where
-/// something is placed; variances over the overlap). Normalising the SSD by
+/// (Σσu² + Σσc² + 1 m²) + w_repeat · uses + w_detail · detail` (SSD and
+/// noise only where something is placed; variances over the overlap;
+/// detail as at [`Weights::detail`]). Normalising the SSD by
 /// both variances (not the user's alone) keeps a smooth neighbourhood from
 /// admitting only smooth patches, which otherwise chains into long
 /// featureless bands.
-pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses: u32) -> f64 {
-    let mut cost = weights.repeat * uses as f64;
+pub(crate) fn round2_cost(
+    u: &UserWindow,
+    patch: &[f32],
+    weights: &Weights,
+    noise_ref: &[u32; 3],
+    uses: u32,
+) -> f64 {
+    let pdm: Vec<i32> = patch.iter().map(|v| (v * 10.0).round() as i32).collect();
+    let all = vec![true; patch.len()];
+    let cn = noise_levels(u.dm.len().isqrt(), &pdm, &all);
+    let detail: f64 = cn
+        .iter()
+        .zip(noise_ref)
+        .map(|(&c, &r)| ((c as f64 + 10.0) / (r as f64 + 10.0)).ln().powi(2))
+        .sum();
+    let mut cost = weights.repeat * uses as f64 + weights.detail * detail;
     if u.overlap == 0 {
         return cost;
     }
-    let pdm: Vec<i32> = patch.iter().map(|v| (v * 10.0).round() as i32).collect();
     let (ssd, _) = costs::ssd_dc(&u.dm, &pdm, &u.valid);
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for (&v, &ok) in patch.iter().zip(&u.valid) {
@@ -586,8 +625,6 @@ pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses
     let k = u.overlap as f64;
     let var_c = (s2 / k - (s / k).powi(2)).max(0.0);
     cost += weights.ssd * (ssd as f64 / 100.0) / (u.var_m2 + var_c + 1.0);
-    let all = vec![true; patch.len()];
-    let cn = noise_levels(u.dm.len().isqrt(), &pdm, &all);
     let num = costs::noise_cost(&u.noise, &cn) as f64;
     let den: f64 = u
         .noise
@@ -615,10 +652,34 @@ pub(crate) fn select(
     scored.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.key.cmp(&b.key)));
     scored.truncate(params.finalists.max(1));
     let n = win.n as f64;
+    // A patch that overlaps nothing (the first of a sketch component) is
+    // put at the mean level of what is placed so far, not at its source's
+    // absolute level: otherwise separate components (Zhou's λ inside its
+    // circle) start hundreds of metres apart and the fill between them
+    // turns that into basins and plateaus the sketch never asked for.
+    let overlaps = (0..win.n * win.n)
+        .any(|i| c.filled[(win.y0 + i / win.n) * c.width + win.x0 + i % win.n]);
+    let level = if overlaps {
+        None
+    } else {
+        let (s, k) = c
+            .heights
+            .iter()
+            .zip(&c.filled)
+            .filter(|(_, f)| **f)
+            .fold((0.0f64, 0usize), |(s, k), (&v, _)| (s + v as f64, k + 1));
+        (k > 0).then(|| s / k as f64)
+    };
     let results: Vec<(f64, Vec<f32>, graphcut::Seam)> = scored
         .par_iter()
         .map(|s| {
-            let off = merge::offset(c, win, &s.patch);
+            let off = match level {
+                Some(l) => {
+                    let m = s.patch.iter().map(|&v| v as f64).sum::<f64>() / s.patch.len() as f64;
+                    (l - m) as f32
+                }
+                None => merge::offset(c, win, &s.patch),
+            };
             let p: Vec<f32> = s.patch.iter().map(|v| v + off).collect();
             let coarse = merge::seam_coarse(c, win, &p, core);
             let cut = coarse.cost as f64 / 256.0 / n;
@@ -745,7 +806,7 @@ pub fn synthesize(
                 let feat = c1 as f64 / (d * (ALONG + ACROSS)) as f64 / (UNIT as f64 * UNIT as f64);
                 let cost = params.weights.feature * feat
                     + params.weights.deform * deform
-                    + round2_cost(&uw, &patch, &params.weights, u);
+                    + round2_cost(&uw, &patch, &params.weights, &lib.noise_ref, u);
                 Some(Scored { cost, patch, key })
             })
             .collect();
@@ -780,6 +841,7 @@ pub fn synthesize(
         &solo,
         progress,
     );
+    remove_drift(&mut canvas.heights, w, h, n);
     deform_by_sketch(&mut canvas.heights, &field, w, h, n, params.sketch_relief);
     let cell = median_cell(lib);
     let hf = Heightfield::from_vec(w, h, cell, canvas.heights).map_err(crate::Error::from)?;
@@ -824,6 +886,27 @@ pub fn deform_by_sketch(
     let amp = candidates::relief(heights) * amount / peak;
     for (v, b) in heights.iter_mut().zip(&broad) {
         *v += amp * b;
+    }
+}
+
+/// Removes what the merge adds at scales far above a patch: the broad
+/// component (three box passes of radius 2·patch, about a Gaussian of
+/// σ = 2·patch) minus its mean. Each gradient-domain merge keeps its
+/// patch's slopes and only pins it to its neighbours along the seam, so
+/// small slope residues (after [`detrend`]) add up along the placement
+/// order into a random walk of height across the output: with many
+/// sources, half of a sketched circle came out a kilometre above the other
+/// half as one smooth snowy mass, and the λ inside it was lost in that
+/// tilt. Ridges and valleys are narrower than this scale and stay; the
+/// broad shape is the sketch's to give ([`deform_by_sketch`]).
+pub fn remove_drift(heights: &mut [f32], w: usize, h: usize, patch: usize) {
+    let mut broad = heights.to_vec();
+    for _ in 0..3 {
+        broad = box_blur(&broad, w, h, (2 * patch).max(1));
+    }
+    let mean = broad.iter().map(|&v| v as f64).sum::<f64>() / broad.len().max(1) as f64;
+    for (v, b) in heights.iter_mut().zip(&broad) {
+        *v -= b - mean as f32;
     }
 }
 
