@@ -158,7 +158,7 @@ impl Default for Params {
             max_source_nodes: 2500,
             best_per_source: 5,
             finalists: 5,
-            sketch_relief: 0.6,
+            sketch_relief: 1.0,
             weights: Weights::default(),
         }
     }
