@@ -84,7 +84,7 @@ pub fn seam(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Se
 /// The free region shrinks from the whole overlap to a strip a few pixels
 /// wide along the seam, which makes the full-resolution cut several times
 /// cheaper; the seam can still move by up to two pixels, where the fine
-/// detail decides it.
+/// detail decides it. `win.n` must be even.
 pub fn seam_banded(
     c: &Canvas,
     win: Window,
@@ -197,8 +197,10 @@ fn cut(
 /// (a block counts as filled only if all four pixels are, and as core if
 /// any is) and cut there; the cost is doubled so that it estimates the
 /// full-resolution cut (a seam crosses half as many edges at half the
-/// resolution). Four times fewer nodes make it about eight times cheaper
-/// than [`seam`].
+/// resolution). While the half-resolution window is at least 16 pixels,
+/// that cut is itself banded around the seam one level coarser (a
+/// coarse-to-fine banded graph cut down to an 8-pixel grid), so every level
+/// cuts only a strip along the seam.
 pub fn seam_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Seam {
     let n = win.n;
     let m = n / 2;
@@ -224,7 +226,13 @@ pub fn seam_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>
         }
     }
     let win = Window { x0: 0, y0: 0, n: m };
-    let mut s = seam(&small, win, &sp, core.map(|_| &sc[..]));
+    let sc = core.map(|_| &sc[..]);
+    let mut s = if m >= 16 && m % 2 == 0 {
+        let guide = seam_coarse(&small, win, &sp, sc);
+        seam_banded(&small, win, &sp, sc, &guide)
+    } else {
+        seam(&small, win, &sp, sc)
+    };
     s.cost *= 2;
     s
 }
