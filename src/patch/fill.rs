@@ -237,7 +237,6 @@ pub(crate) fn fill(
     uses: &mut BTreeMap<(usize, u8, u32), u32>,
     timings: &mut Timings,
     stats: &mut Stats,
-    solo: &rayon::ThreadPool,
     progress: &dyn Progress,
 ) {
     let params = &lib.params;
@@ -374,9 +373,7 @@ pub(crate) fn fill(
         let t3 = Instant::now();
         *uses.entry(s.key).or_insert(0) += 1;
         let before = uw.overlap;
-        if let Some(rep) =
-            solo.install(|| merge::apply(canvas, win, &s.patch, &seam.take_new, &opts))
-        {
+        if let Some(rep) = merge::apply(canvas, win, &s.patch, &seam.take_new, &opts) {
             stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
         }
         bl.update(canvas, win.x0, win.y0, win.x0 + n, win.y0 + n);

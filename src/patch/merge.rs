@@ -6,12 +6,13 @@
 //!    the new side (Tasse et al., after Milliron et al. 2002): the new
 //!    patch's gradients are bent to equal the old ones at the seam and the
 //!    correction fades out over `R` = patch/4;
-//! 3. a Poisson solve (the crate's solver via [`crate::blend::poisson`]) for
-//!    heights with those gradients, the old pixels as Dirichlet values.
+//! 3. a Poisson solve for heights with those gradients, the old pixels as
+//!    Dirichlet values (the crate's multigrid-preconditioned solver for
+//!    small grids, [`crate::poisson::solve_mg`], started from the patch).
 
 use super::graphcut::{Label, Seam, kwatra, min_cut};
-use crate::blend::poisson::solve_guided;
-use crate::poisson::{SolveOptions, SolveReport};
+use crate::blend::poisson::guided_rhs;
+use crate::poisson::{SolveOptions, SolveReport, solve_mg};
 
 /// The output being synthesized.
 #[derive(Debug, Clone, PartialEq)]
@@ -439,8 +440,18 @@ pub fn apply(
             }
         }
     }
-    let free: Vec<bool> = class.iter().map(|&k| k != 1).collect();
-    let report = solve_guided(gw, gh, &mut u, &free, &gxv, &gyv, opts).ok();
+    // Initial guess: the patch itself, continued into the free ring outside
+    // the window by its nearest pixel ([`solve_mg`] starts from `u`).
+    for g in 0..gw * gh {
+        if class[g] == 2 {
+            let x = (g % gw + gx0).clamp(win.x0, win.x0 + n - 1) - win.x0;
+            let y = (g / gw + gy0).clamp(win.y0, win.y0 + n - 1) - win.y0;
+            u[g] = patch[y * n + x];
+        }
+    }
+    let fixed: Vec<bool> = class.iter().map(|&k| k == 1).collect();
+    let rhs = guided_rhs(gw, gh, &gxv, &gyv);
+    let report = solve_mg(gw, gh, &mut u, &fixed, Some(&rhs), opts).ok();
     for gy in 0..gh {
         for gx in 0..gw {
             if in_win(gx, gy) && class[gy * gw + gx] == 0 {

@@ -80,8 +80,6 @@ pub enum PatchError {
         found: usize,
         expected: usize,
     },
-    #[error("cannot start a worker thread: {0}")]
-    Pool(String),
     #[error(transparent)]
     Other(#[from] crate::Error),
 }
@@ -657,8 +655,8 @@ pub(crate) fn select(
     // absolute level: otherwise separate components (Zhou's λ inside its
     // circle) start hundreds of metres apart and the fill between them
     // turns that into basins and plateaus the sketch never asked for.
-    let overlaps = (0..win.n * win.n)
-        .any(|i| c.filled[(win.y0 + i / win.n) * c.width + win.x0 + i % win.n]);
+    let overlaps =
+        (0..win.n * win.n).any(|i| c.filled[(win.y0 + i / win.n) * c.width + win.x0 + i % win.n]);
     let level = if overlaps {
         None
     } else {
@@ -692,16 +690,6 @@ pub(crate) fn select(
     let mut win_s = scored.swap_remove(best);
     win_s.patch = p;
     Some((win_s, seam))
-}
-
-/// A one-thread pool for the per-patch Poisson solves: a patch window is a
-/// few thousand unknowns, where rayon's fork-join costs more than the work
-/// (the solver's sums are chunked in a fixed order, so the bytes are the same).
-pub(crate) fn solo_pool() -> Result<rayon::ThreadPool, PatchError> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .map_err(|e| PatchError::Pool(e.to_string()))
 }
 
 pub(crate) fn solve_opts() -> SolveOptions {
@@ -750,7 +738,6 @@ pub fn synthesize(
     let mut uses: BTreeMap<(usize, u8, u32), u32> = BTreeMap::new();
     let r = n as f32 / 4.0;
     let opts = solve_opts();
-    let solo = solo_pool()?;
     progress.start("feature patches", users.len() as u64);
     for up in &users {
         let d = up.node.cps.len();
@@ -821,9 +808,7 @@ pub fn synthesize(
         if let Some((s, seam)) = chosen {
             let t3 = Instant::now();
             *uses.entry(s.key).or_insert(0) += 1;
-            if let Some(rep) =
-                solo.install(|| merge::apply(&mut canvas, win, &s.patch, &seam.take_new, &opts))
-            {
+            if let Some(rep) = merge::apply(&mut canvas, win, &s.patch, &seam.take_new, &opts) {
                 stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
             }
             stats.feature_patches += 1;
@@ -838,7 +823,6 @@ pub fn synthesize(
         &mut uses,
         &mut timings,
         &mut stats,
-        &solo,
         progress,
     );
     remove_drift(&mut canvas.heights, w, h, n);
