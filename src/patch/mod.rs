@@ -827,6 +827,19 @@ pub fn synthesize(
     );
     remove_drift(&mut canvas.heights, w, h, n);
     deform_by_sketch(&mut canvas.heights, &field, w, h, n, params.sketch_relief);
+    // The merge fixes heights only up to a constant: put the lowest point
+    // at the sources' typical lowest level (the median of their minima), so
+    // that the output is not partly below sea level for no reason (the
+    // renderer, like most tools, draws heights ≤ 0 as water).
+    let mut lows: Vec<f32> = lib
+        .sources
+        .iter()
+        .map(|s| s.heights.iter().copied().fold(f32::INFINITY, f32::min))
+        .collect();
+    lows.sort_by(f32::total_cmp);
+    let low = canvas.heights.iter().copied().fold(f32::INFINITY, f32::min);
+    let shift = lows[lows.len() / 2] - low;
+    canvas.heights.iter_mut().for_each(|v| *v += shift);
     let cell = median_cell(lib);
     let hf = Heightfield::from_vec(w, h, cell, canvas.heights).map_err(crate::Error::from)?;
     timings.total = t_all.elapsed();
