@@ -13,11 +13,19 @@
 //!    sketch's control points and adds bending energy, SSD against what is
 //!    already placed, noise-variance difference and a repetition penalty;
 //!    the best 5 of that get a graph-cut seam cost, and the cheapest wins;
-//! 4. [`merge`]: graph-cut seam ([`graphcut`]), Shepard-interpolated gradient
-//!    correction and a Poisson solve;
+//! 4. [`merge`]: graph-cut seam ([`graphcut`]; finalists ranked by a
+//!    half-resolution cut, the winner cut coarse to fine in bands),
+//!    Shepard-interpolated gradient correction and a multigrid-preconditioned
+//!    Poisson solve;
 //! 5. [`fill`]: the rest, by priority order, from non-feature candidates
-//!    under 6 transforms (integer SSD + noise on an 8× reduced grid, then the
-//!    same second round and merge).
+//!    under 6 transforms (integer SSD + noise on an 8× reduced grid through
+//!    an explicit-SIMD kernel, then the same second round and merge);
+//! 6. the broad drift of the merge is removed ([`remove_drift`]), the
+//!    sketch's broad shape added ([`deform_by_sketch`]) and the lowest point
+//!    put at the sources' typical lowest level.
+//!
+//! Sources are prepared once per [`Library`] and their features kept on
+//! disk between processes ([`cache`]).
 //!
 //! Everything is deterministic: no randomness; parallel loops write
 //! per-candidate results that are reduced in index order with ties broken
