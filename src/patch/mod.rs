@@ -343,13 +343,28 @@ pub fn sketch_field(sketch: &Sketch, w: usize, h: usize, patch: usize) -> Vec<f3
 
 fn box_blur(v: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
     let pass = |src: &[f32], w: usize, h: usize| -> Vec<f32> {
-        // Horizontal box of radius r with clamped ends, then transpose.
+        // Horizontal box of radius r with clamped ends, then transpose. Each
+        // row's prefix sums (f64, so the differences stay exact enough) make
+        // a box O(1) per pixel: the drift removal's radius of two patches
+        // summed 257 samples per pixel and pass otherwise.
         let mut out = vec![0.0f32; w * h];
+        let prefix: Vec<Vec<f64>> = src
+            .par_chunks(w)
+            .map(|row| {
+                let mut p = Vec::with_capacity(w + 1);
+                p.push(0.0f64);
+                let mut acc = 0.0f64;
+                for &v in row {
+                    acc += v as f64;
+                    p.push(acc);
+                }
+                p
+            })
+            .collect();
         out.par_chunks_mut(h).enumerate().for_each(|(x, col)| {
-            for (y, o) in col.iter_mut().enumerate() {
-                let (lo, hi) = (x.saturating_sub(r), (x + r).min(w - 1));
-                let s: f32 = src[y * w + lo..=y * w + hi].iter().sum();
-                *o = s / (hi - lo + 1) as f32;
+            let (lo, hi) = (x.saturating_sub(r), (x + r).min(w - 1));
+            for (o, p) in col.iter_mut().zip(&prefix) {
+                *o = ((p[hi + 1] - p[lo]) / (hi - lo + 1) as f64) as f32;
             }
         });
         out
