@@ -451,9 +451,10 @@ impl Level {
         }
     }
 
-    /// `Σ_n w_pn·v_n` at cell `i`.
-    fn off(&self, v: &[f64], i: usize) -> f64 {
-        let (x, y) = (i % self.w, i / self.w);
+    /// `Σ_n w_pn·v_n` at cell `i = y·w + x` (coordinates passed in: a
+    /// division per call would cost more than the sum).
+    #[inline]
+    fn off(&self, v: &[f64], i: usize, x: usize, y: usize) -> f64 {
         let mut s = 0.0;
         if x + 1 < self.w {
             s += self.east[i] * v[i + 1];
@@ -472,11 +473,38 @@ impl Level {
 
     /// One Gauss–Seidel sweep on `A x = b`, forward or backward.
     fn sweep(&self, x: &mut [f64], b: &[f64], forward: bool) {
-        let n = self.w * self.h;
-        for k in 0..n {
-            let i = if forward { k } else { n - 1 - k };
+        let (w, h) = (self.w, self.h);
+        let mut visit = |cx: usize, cy: usize| {
+            let i = cy * w + cx;
             if self.active[i] && self.diag[i] > 0.0 {
-                x[i] = (b[i] + self.off(x, i)) / self.diag[i];
+                x[i] = (b[i] + self.off(x, i, cx, cy)) / self.diag[i];
+            }
+        };
+        if forward {
+            for cy in 0..h {
+                for cx in 0..w {
+                    visit(cx, cy);
+                }
+            }
+        } else {
+            for cy in (0..h).rev() {
+                for cx in (0..w).rev() {
+                    visit(cx, cy);
+                }
+            }
+        }
+    }
+
+    /// `A v` on the active cells (0 elsewhere).
+    fn apply(&self, v: &[f64], out: &mut [f64]) {
+        for y in 0..self.h {
+            for x in 0..self.w {
+                let i = y * self.w + x;
+                out[i] = if self.active[i] {
+                    self.diag[i] * v[i] - self.off(v, i, x, y)
+                } else {
+                    0.0
+                };
             }
         }
     }
@@ -498,17 +526,24 @@ fn v_cycle(levels: &[Level], b: &[f64]) -> Vec<f64> {
     }
     lv.sweep(&mut x, b, true);
     let next = &levels[1];
+    let mut ax = vec![0.0; n];
+    lv.apply(&x, &mut ax);
     let mut bc = vec![0.0; next.w * next.h];
-    for i in 0..n {
-        if lv.active[i] {
-            let a = (i / lv.w / 2) * next.w + (i % lv.w) / 2;
-            bc[a] += b[i] - (lv.diag[i] * x[i] - lv.off(&x, i));
+    for y in 0..lv.h {
+        for xx in 0..lv.w {
+            let i = y * lv.w + xx;
+            if lv.active[i] {
+                bc[(y / 2) * next.w + xx / 2] += b[i] - ax[i];
+            }
         }
     }
     let xc = v_cycle(&levels[1..], &bc);
-    for i in 0..n {
-        if lv.active[i] {
-            x[i] += xc[(i / lv.w / 2) * next.w + (i % lv.w) / 2];
+    for y in 0..lv.h {
+        for xx in 0..lv.w {
+            let i = y * lv.w + xx;
+            if lv.active[i] {
+                x[i] += xc[(y / 2) * next.w + xx / 2];
+            }
         }
     }
     lv.sweep(&mut x, b, false);
@@ -594,15 +629,7 @@ pub fn solve_mg(
             .map(|((a, c), _)| a * c)
             .sum()
     };
-    let apply = |v: &[f64], out: &mut [f64]| {
-        for i in 0..n {
-            out[i] = if fixed[i] {
-                0.0
-            } else {
-                lv.diag[i] * v[i] - lv.off(v, i)
-            };
-        }
-    };
+    let apply = |v: &[f64], out: &mut [f64]| lv.apply(v, out);
     let unknowns = fixed.iter().filter(|&&f| !f).count();
     let bnorm = dot(&b, &b).sqrt().max(1.0);
     let mut ax = vec![0.0; n];
