@@ -82,7 +82,9 @@ fn synthesis_is_complete_converged_deterministic_and_follows_the_sketch() {
     // Sketched ridges stand above sketched valleys.
     let adh = patch::adherence(hf, &y_sketch(), 3.0).unwrap();
     assert!(adh > 0.1, "adherence {adh}");
-    // No seams: no step between neighbours far beyond the sources' own.
+    // No seams: no step between neighbours far beyond the sources' own, as
+    // the library uses them (rescaled to one relief: the hills' crop is
+    // scaled up to the mountains' relief, and its steps with it).
     let max_step = |d: &[f32], w: usize| {
         d.windows(2)
             .enumerate()
@@ -90,9 +92,10 @@ fn synthesis_is_complete_converged_deterministic_and_follows_the_sketch() {
             .map(|(_, p)| (p[1] - p[0]).abs())
             .fold(0.0f32, f32::max)
     };
-    let src_step = src
+    let src_step = lib
+        .sources
         .iter()
-        .map(|(_, h)| max_step(h.data(), 256))
+        .map(|s| max_step(&s.heights, s.width))
         .fold(0.0, f32::max);
     let out_step = max_step(hf.data(), 160);
     assert!(

@@ -41,7 +41,16 @@ pub fn solve_guided(
             });
         }
     }
-    let mut rhs = vec![0.0f32; n];
+    let rhs = guided_rhs(width, height, gx, gy);
+    let fixed: Vec<bool> = free.iter().map(|f| !f).collect();
+    Ok(solve(width, height, u, &fixed, Some(&rhs), opts)?)
+}
+
+/// The right-hand side `f` of the solve for guidance `gx`, `gy` (both of
+/// length `width · height`): at each pixel, the sum of the wanted
+/// differences to its in-grid neighbours, `Σ_n g(p→n)`.
+pub fn guided_rhs(width: usize, height: usize, gx: &[f32], gy: &[f32]) -> Vec<f32> {
+    let mut rhs = vec![0.0f32; width * height];
     for y in 0..height {
         for x in 0..width {
             let i = y * width + x;
@@ -61,8 +70,7 @@ pub fn solve_guided(
             rhs[i] = f;
         }
     }
-    let fixed: Vec<bool> = free.iter().map(|f| !f).collect();
-    Ok(solve(width, height, u, &fixed, Some(&rhs), opts)?)
+    rhs
 }
 
 /// Seamless cloning: inside `mask > 0.5` take the gradients of `src`, keep

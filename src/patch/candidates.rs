@@ -7,12 +7,13 @@
 //! Preparing is the expensive part (PPA on the whole DEM); it is done once
 //! per source and the value is kept by the caller — the [`super::Library`]
 //! caches it in memory for as many sketches as are synthesized with it
-//! (the bench and the CLI synthesize several sketches from one library).
-//! Seed 004 §5.4 stores the result on disk; ours is recomputed per process
-//! (about a quarter of a second per 800² source on 2 cores).
+//! (the bench and the CLI synthesize several sketches from one library),
+//! and, as seed 004 §5.4 does, the expensive part ([`Features`]) is kept
+//! on disk between processes by [`super::cache`] (about a second per 800²
+//! source on 2 cores to compute, milliseconds to read).
 
 use super::Params;
-use super::costs::{TURN, noise_levels};
+use super::costs::{TURN, centre_cells, noise_levels};
 use super::graph::{FeatureGraph, dist, point_at};
 use super::ppa::{self, PpaParams};
 use super::sketch::Kind;
@@ -145,6 +146,15 @@ pub const COARSE: usize = 8;
 /// Number of non-feature transforms.
 pub const FILL_TRANSFORMS: usize = 6;
 
+/// The part of a [`PreparedSource`] that is costly to compute and is
+/// cached on disk ([`super::cache`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Features {
+    pub ridges: Vec<FeatureNode>,
+    pub valleys: Vec<FeatureNode>,
+    pub fill: Vec<FillCand>,
+}
+
 /// One source DEM, prepared for synthesis.
 #[derive(Debug, Clone)]
 pub struct PreparedSource {
@@ -162,6 +172,10 @@ pub struct PreparedSource {
     pub coarse: Vec<i32>,
     pub coarse_w: usize,
     pub fill: Vec<FillCand>,
+    /// Per fill candidate, its `(patch/COARSE)²` reduced cells, contiguous,
+    /// centred and clamped ([`super::costs::centre_cells`]): what the
+    /// round-one kernel reads, so it streams instead of gathering rows.
+    pub fill_cells: Vec<i32>,
     /// The patch size this was prepared for.
     pub patch: usize,
 }
@@ -254,6 +268,29 @@ impl PreparedSource {
         params: &Params,
         scale: f32,
     ) -> crate::Result<Self> {
+        Self::build(name, hf, params, scale, None)
+    }
+
+    /// What [`super::cache`] stores: the expensive part of [`Self::prepare`]
+    /// (PPA on the whole DEM, candidate noise statistics).
+    pub fn features(&self) -> Features {
+        Features {
+            ridges: self.ridges.clone(),
+            valleys: self.valleys.clone(),
+            fill: self.fill.clone(),
+        }
+    }
+
+    /// [`Self::prepare`], taking the features from `cached` when given
+    /// (they must come from the same DEM, parameters and scale: the cache
+    /// key guarantees it) and deriving only the cheap rest.
+    pub fn build(
+        name: &str,
+        hf: &crate::Heightfield,
+        params: &Params,
+        scale: f32,
+        cached: Option<Features>,
+    ) -> crate::Result<Self> {
         let mut hf = hf.clone();
         if hf.nodata_count() > 0 {
             crate::fill::fill_nodata(&mut hf)?;
@@ -261,7 +298,64 @@ impl PreparedSource {
         let (w, h) = (hf.width(), hf.height());
         let patch = params.patch;
         let heights: Vec<f32> = hf.data().iter().map(|v| v * scale).collect();
-        let rel = relief(&heights).max(1.0);
+        let dm: Vec<i32> = heights.iter().map(|v| (v * 10.0).round() as i32).collect();
+        let cw = w / COARSE;
+        let ch = h / COARSE;
+        let coarse: Vec<i32> = (0..cw * ch)
+            .into_par_iter()
+            .map(|i| {
+                let (bx, by) = (i % cw, i / cw);
+                let mut s = 0i64;
+                for y in 0..COARSE {
+                    for x in 0..COARSE {
+                        s += dm[(COARSE * by + y) * w + COARSE * bx + x] as i64;
+                    }
+                }
+                s.div_euclid((COARSE * COARSE) as i64) as i32
+            })
+            .collect();
+        let Features {
+            ridges,
+            valleys,
+            fill,
+        } = match cached {
+            Some(f) => f,
+            None => Self::extract(&heights, &dm, w, h, params),
+        };
+        let m = patch / COARSE;
+        let fill_cells: Vec<i32> = fill
+            .par_iter()
+            .flat_map_iter(|fc| {
+                let (ox, oy) = (fc.x as usize / COARSE, fc.y as usize / COARSE);
+                let mut cells: Vec<i32> = (0..m * m)
+                    .map(|i| coarse[(oy + i / m) * cw + ox + i % m])
+                    .collect();
+                centre_cells(&mut cells, None);
+                cells
+            })
+            .collect();
+        Ok(PreparedSource {
+            name: name.to_string(),
+            width: w,
+            height: h,
+            cell_size: hf.cell_size(),
+            heights,
+            dm,
+            ridges,
+            valleys,
+            coarse,
+            coarse_w: cw,
+            fill,
+            fill_cells,
+            patch,
+        })
+    }
+
+    /// Feature nodes and non-feature candidates of scaled heights `heights`
+    /// (`dm` in decimetres).
+    fn extract(heights: &[f32], dm: &[i32], w: usize, h: usize, params: &Params) -> Features {
+        let patch = params.patch;
+        let rel = relief(heights).max(1.0);
         let ppa = ppa_params(patch, rel, params.source_dip);
         let margin = patch as f32 * 0.75;
         let min_prom = rel * params.source_min_prominence;
@@ -269,7 +363,7 @@ impl PreparedSource {
         let ((_, ridges), (_, valleys)) = rayon::join(
             || {
                 feature_nodes(
-                    &heights,
+                    heights,
                     w,
                     h,
                     patch,
@@ -292,22 +386,6 @@ impl PreparedSource {
                 )
             },
         );
-        let dm: Vec<i32> = heights.iter().map(|v| (v * 10.0).round() as i32).collect();
-        let cw = w / COARSE;
-        let ch = h / COARSE;
-        let coarse: Vec<i32> = (0..cw * ch)
-            .into_par_iter()
-            .map(|i| {
-                let (bx, by) = (i % cw, i / cw);
-                let mut s = 0i64;
-                for y in 0..COARSE {
-                    for x in 0..COARSE {
-                        s += dm[(COARSE * by + y) * w + COARSE * bx + x] as i64;
-                    }
-                }
-                s.div_euclid((COARSE * COARSE) as i64) as i32
-            })
-            .collect();
         let stride = (patch / 2).max(COARSE) & !(COARSE - 1);
         let mut pos = Vec::new();
         let mut y = 0;
@@ -338,20 +416,11 @@ impl PreparedSource {
                 })
             })
             .collect();
-        Ok(PreparedSource {
-            name: name.to_string(),
-            width: w,
-            height: h,
-            cell_size: hf.cell_size(),
-            heights,
-            dm,
+        Features {
             ridges,
             valleys,
-            coarse,
-            coarse_w: cw,
             fill,
-            patch,
-        })
+        }
     }
 
     /// Feature nodes of one kind.

@@ -10,13 +10,14 @@
 //! Candidates: every source's patches on a patch/2 grid under 6 transforms
 //! (four 90° rotations and two mirrors, which need no resampling). Round
 //! one is integer and data-parallel: DC-corrected SSD against the window's
-//! fully filled 8×8 cells on the 8× reduced grid, plus the noise-variance
-//! difference; the user window is permuted into each transform's frame
-//! once, so every candidate reads contiguous source rows. The best 5 per
+//! fully filled 8×8 cells on the 8× reduced grid ([`fill_ssd`], explicit
+//! SIMD), plus the noise-variance difference; the user window is permuted
+//! into each transform's frame once, and every candidate's cells are stored
+//! contiguously, so the kernel streams both. The best 5 per
 //! source go to round two and the graph-cut finalists ([`super::select`]).
 
 use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
-use super::costs::noise_cost;
+use super::costs::{centre_cells, fill_ssd, noise_cost};
 use super::merge::{self, Canvas, Window};
 use super::{Library, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window};
 use crate::progress::Progress;
@@ -101,73 +102,132 @@ fn rect<T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T>>(
     s[y1 * k + x1] + s[y0 * k + x0] - s[y0 * k + x1] - s[y1 * k + x0]
 }
 
-/// The next block to fill (highest priority, lowest index on ties).
-fn next_spot(bl: &Blocks, n: usize, g_ref: f64) -> Option<(usize, [f32; 2])> {
+/// Priorities of the unfilled blocks, kept between steps: a block's
+/// priority depends only on the blocks within `rb` of it, so after a patch
+/// only those around its window are re-evaluated (instead of all of them,
+/// which cost more than the candidate search at 1024²).
+struct Priorities {
+    rb: usize,
+    g_ref: f64,
+    n: usize,
+    prio: Vec<Option<(f64, [f32; 2])>>,
+}
+
+impl Priorities {
+    fn new(bl: &Blocks, n: usize, g_ref: f64) -> Priorities {
+        let mut p = Priorities {
+            rb: (n / B / 2).max(1),
+            g_ref,
+            n,
+            prio: vec![None; bl.bw * bl.bh],
+        };
+        p.refresh(bl, 0, 0, bl.bw, bl.bh);
+        p
+    }
+
+    /// Re-evaluates the blocks within `rb` of the block rectangle
+    /// `[x0, x1) × [y0, y1)` (whose counts changed).
+    fn refresh(&mut self, bl: &Blocks, x0: usize, y0: usize, x1: usize, y1: usize) {
+        let (bw, bh, rb) = (bl.bw, bl.bh, self.rb);
+        let cs = sat(
+            &bl.cnt.iter().map(|&c| c as u64).collect::<Vec<_>>(),
+            bw,
+            bh,
+        );
+        let hs = sat(&bl.hsum, bw, bh);
+        let (rx0, ry0) = (x0.saturating_sub(rb), y0.saturating_sub(rb));
+        let (rx1, ry1) = ((x1 + rb).min(bw), (y1 + rb).min(bh));
+        let rw = rx1 - rx0;
+        let (n, g_ref) = (self.n, self.g_ref);
+        let fresh: Vec<Option<(f64, [f32; 2])>> = (0..rw * (ry1 - ry0))
+            .into_par_iter()
+            .map(|k| {
+                let b = (ry0 + k / rw) * bw + rx0 + k % rw;
+                priority(bl, &cs, &hs, b, rb, n, g_ref)
+            })
+            .collect();
+        for (k, p) in fresh.into_iter().enumerate() {
+            self.prio[(ry0 + k / rw) * bw + rx0 + k % rw] = p;
+        }
+    }
+}
+
+/// Priority `C + D` of block `b` and its front normal, `None` when it is
+/// filled or nothing near it is (see the module docs).
+fn priority(
+    bl: &Blocks,
+    cs: &[u64],
+    hs: &[f64],
+    b: usize,
+    rb: usize,
+    n: usize,
+    g_ref: f64,
+) -> Option<(f64, [f32; 2])> {
     let (bw, bh) = (bl.bw, bl.bh);
-    let cs = sat(
-        &bl.cnt.iter().map(|&c| c as u64).collect::<Vec<_>>(),
-        bw,
-        bh,
-    );
-    let hs = sat(&bl.hsum, bw, bh);
-    let rb = (n / B / 2).max(1);
-    let any_filled = bl.cnt.iter().any(|&c| c > 0);
-    let pr: Vec<(f64, usize, [f32; 2])> = (0..bw * bh)
-        .into_par_iter()
-        .filter(|&b| bl.cnt[b] < bl.area[b])
-        .filter_map(|b| {
-            let (bx, by) = (b % bw, b / bw);
-            let (x0, y0) = (bx.saturating_sub(rb), by.saturating_sub(rb));
-            let (x1, y1) = ((bx + rb + 1).min(bw), (by + rb + 1).min(bh));
-            let filled = rect(&cs, bw, x0, y0, x1, y1);
-            if filled == 0 {
-                return None;
-            }
-            let conf = filled as f64 / (n * n) as f64;
-            // Front normal and height gradient from half-window differences.
-            let half = |ax0, ay0, ax1, ay1| {
-                let k = rect(&cs, bw, ax0, ay0, ax1, ay1) as f64;
-                let s = rect(&hs, bw, ax0, ay0, ax1, ay1);
-                (k, if k > 0.0 { Some(s / k) } else { None })
-            };
-            let (kl, ml) = half(x0, y0, bx, y1);
-            let (kr, mr) = half(bx + 1, y0, x1, y1);
-            let (kt, mt) = half(x0, y0, x1, by);
-            let (kd, md) = half(x0, by + 1, x1, y1);
-            let (nx, ny) = (kr - kl, kd - kt);
-            let nl = (nx * nx + ny * ny).sqrt();
-            let span = (rb * B) as f64;
-            let gx = match (ml, mr) {
-                (Some(a), Some(c)) => (c - a) / span,
-                _ => 0.0,
-            };
-            let gy = match (mt, md) {
-                (Some(a), Some(c)) => (c - a) / span,
-                _ => 0.0,
-            };
-            let data = if nl > 0.0 {
-                ((-gy * nx + gx * ny) / nl).abs() / g_ref
-            } else {
-                0.0
-            };
-            let dir = if nl > 0.0 {
-                [(nx / nl) as f32, (ny / nl) as f32]
-            } else {
-                [0.0, 0.0]
-            };
-            Some((conf + data.min(1.0), b, dir))
-        })
-        .collect();
-    if !any_filled {
+    if bl.cnt[b] >= bl.area[b] {
+        return None;
+    }
+    let (bx, by) = (b % bw, b / bw);
+    let (x0, y0) = (bx.saturating_sub(rb), by.saturating_sub(rb));
+    let (x1, y1) = ((bx + rb + 1).min(bw), (by + rb + 1).min(bh));
+    let filled = rect(cs, bw, x0, y0, x1, y1);
+    if filled == 0 {
+        return None;
+    }
+    let conf = filled as f64 / (n * n) as f64;
+    // Front normal and height gradient from half-window differences.
+    let half = |ax0, ay0, ax1, ay1| {
+        let k = rect(cs, bw, ax0, ay0, ax1, ay1) as f64;
+        let s = rect(hs, bw, ax0, ay0, ax1, ay1);
+        (k, if k > 0.0 { Some(s / k) } else { None })
+    };
+    let (kl, ml) = half(x0, y0, bx, y1);
+    let (kr, mr) = half(bx + 1, y0, x1, y1);
+    let (kt, mt) = half(x0, y0, x1, by);
+    let (kd, md) = half(x0, by + 1, x1, y1);
+    let (nx, ny) = (kr - kl, kd - kt);
+    let nl = (nx * nx + ny * ny).sqrt();
+    let span = (rb * B) as f64;
+    let gx = match (ml, mr) {
+        (Some(a), Some(c)) => (c - a) / span,
+        _ => 0.0,
+    };
+    let gy = match (mt, md) {
+        (Some(a), Some(c)) => (c - a) / span,
+        _ => 0.0,
+    };
+    let data = if nl > 0.0 {
+        ((-gy * nx + gx * ny) / nl).abs() / g_ref
+    } else {
+        0.0
+    };
+    let dir = if nl > 0.0 {
+        [(nx / nl) as f32, (ny / nl) as f32]
+    } else {
+        [0.0, 0.0]
+    };
+    Some((conf + data.min(1.0), dir))
+}
+
+/// The next block to fill (highest priority, lowest index on ties).
+fn next_spot(bl: &Blocks, pr: &Priorities) -> Option<(usize, [f32; 2])> {
+    let (bw, bh) = (bl.bw, bl.bh);
+    if !bl.cnt.iter().any(|&c| c > 0) {
         // Nothing placed yet (a sketch without features): start in the middle.
         return (0..bw * bh)
             .find(|&b| b == (bh / 2) * bw + bw / 2 && bl.cnt[b] < bl.area[b])
             .or_else(|| (0..bw * bh).find(|&b| bl.cnt[b] < bl.area[b]))
             .map(|b| (b, [0.0, 0.0]));
     }
-    pr.into_iter()
-        .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)))
-        .map(|(_, b, d)| (b, d))
+    let mut best: Option<(f64, usize, [f32; 2])> = None;
+    for (b, p) in pr.prio.iter().enumerate() {
+        if let Some((v, d)) = *p
+            && best.is_none_or(|(bv, _, _)| v > bv)
+        {
+            best = Some((v, b, d));
+        }
+    }
+    best.map(|(_, b, d)| (b, d))
 }
 
 /// Fills every hole of the canvas.
@@ -177,7 +237,6 @@ pub(crate) fn fill(
     uses: &mut BTreeMap<(usize, u8, u32), u32>,
     timings: &mut Timings,
     stats: &mut Stats,
-    solo: &rayon::ThreadPool,
     progress: &dyn Progress,
 ) {
     let params = &lib.params;
@@ -203,10 +262,11 @@ pub(crate) fn fill(
     } else {
         1.0
     };
+    let mut pr = Priorities::new(&bl, n, g_ref.max(1e-6));
     progress.start("filling", total_unfilled);
     loop {
         let t1 = Instant::now();
-        let Some((b, dir)) = next_spot(&bl, n, g_ref.max(1e-6)) else {
+        let Some((b, dir)) = next_spot(&bl, &pr) else {
             break;
         };
         let (bx, by) = (b % bl.bw, b / bl.bw);
@@ -223,7 +283,9 @@ pub(crate) fn fill(
             h,
         );
         let uw = user_window(canvas, win);
-        // User cells on the reduced grid.
+        // User cells on the reduced grid, centred and clamped like the
+        // candidates' ([`centre_cells`]), then permuted into each
+        // transform's source frame with an all-bits mask of valid cells.
         let mut uc = vec![0i32; m * m];
         let mut uv = vec![false; m * m];
         for cy in 0..m {
@@ -241,60 +303,33 @@ pub(crate) fn fill(
                 uv[cy * m + cx] = all;
             }
         }
-        // Permute into each transform's source frame.
-        let perms: Vec<(Vec<i32>, Vec<bool>)> = (0..FILL_TRANSFORMS)
+        let count = centre_cells(&mut uc, Some(&uv));
+        let perms: Vec<(Vec<i32>, Vec<i32>)> = (0..FILL_TRANSFORMS)
             .map(|v| {
                 let mut a = vec![0i32; m * m];
-                let mut ok = vec![false; m * m];
+                let mut mask = vec![0i32; m * m];
                 for cy in 0..m {
                     for cx in 0..m {
                         let (sx, sy) = fill_map(v, cx, cy, m);
                         a[sy * m + sx] = uc[cy * m + cx];
-                        ok[sy * m + sx] = uv[cy * m + cx];
+                        mask[sy * m + sx] = -(uv[cy * m + cx] as i32);
                     }
                 }
-                (a, ok)
+                (a, mask)
             })
             .collect();
-        let any_cell = uv.iter().any(|&v| v);
         let mut best: Vec<(usize, u32, u8)> = Vec::new();
         for (si, src) in lib.sources.iter().enumerate() {
-            let cw = src.coarse_w;
             let mut scored: Vec<(u64, u32, u8)> = src
                 .fill
                 .par_iter()
+                .zip(src.fill_cells.par_chunks(m * m))
                 .enumerate()
-                .map(|(k, fc)| {
-                    let (ox, oy) = (fc.x as usize / COARSE, fc.y as usize / COARSE);
+                .map(|(k, (fc, cells))| {
                     let nc = noise_cost(&uw.noise, &fc.noise) * params.weights.fill_noise;
                     let mut b = (u64::MAX, 0u8);
-                    for (v, (a, ok)) in perms.iter().enumerate() {
-                        let ssd = if any_cell {
-                            let mut cand = [0i32; 64];
-                            let mut total = (0i64, 0i64, 0i64);
-                            for row in 0..m {
-                                let srow =
-                                    &src.coarse[(oy + row) * cw + ox..(oy + row) * cw + ox + m];
-                                cand[..m].copy_from_slice(srow);
-                                let (s, s2, c) = row_sums(
-                                    &a[row * m..(row + 1) * m],
-                                    &cand[..m],
-                                    &ok[row * m..(row + 1) * m],
-                                );
-                                total.0 += s;
-                                total.1 += s2;
-                                total.2 += c;
-                            }
-                            let (s, s2, c) = total;
-                            if c > 0 {
-                                ((c * s2 - s * s) / (c * c)) as u64
-                            } else {
-                                0
-                            }
-                        } else {
-                            0
-                        };
-                        let cost = ssd.saturating_add(nc);
+                    for (v, (a, mask)) in perms.iter().enumerate() {
+                        let cost = fill_ssd(a, mask, cells, count).saturating_add(nc);
                         if cost < b.0 {
                             b = (cost, v as u8);
                         }
@@ -326,7 +361,7 @@ pub(crate) fn fill(
                 super::detrend(&mut patch, n);
                 let key = (si, 2u8, k);
                 let u = uses.get(&key).copied().unwrap_or(0);
-                let cost = round2_cost(&uw, &patch, &params.weights, u);
+                let cost = round2_cost(&uw, &patch, &params.weights, &lib.noise_ref, u);
                 Scored { cost, patch, key }
             })
             .collect();
@@ -338,12 +373,17 @@ pub(crate) fn fill(
         let t3 = Instant::now();
         *uses.entry(s.key).or_insert(0) += 1;
         let before = uw.overlap;
-        if let Some(rep) =
-            solo.install(|| merge::apply(canvas, win, &s.patch, &seam.take_new, &opts))
-        {
+        if let Some(rep) = merge::apply(canvas, win, &s.patch, &seam.take_new, &opts) {
             stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
         }
         bl.update(canvas, win.x0, win.y0, win.x0 + n, win.y0 + n);
+        pr.refresh(
+            &bl,
+            win.x0 / B,
+            win.y0 / B,
+            (win.x0 + n).div_ceil(B),
+            (win.y0 + n).div_ceil(B),
+        );
         let after = (0..n * n)
             .filter(|&i| canvas.filled[(win.y0 + i / n) * w + win.x0 + i % n])
             .count();
@@ -352,18 +392,4 @@ pub(crate) fn fill(
         timings.fill_merge += t3.elapsed();
     }
     progress.finish();
-}
-
-/// `(Σd, Σd², count)` of `d = a − b` over valid samples of one row. Plain
-/// fixed-length integer loops, which the compiler vectorises.
-#[inline]
-fn row_sums(a: &[i32], b: &[i32], ok: &[bool]) -> (i64, i64, i64) {
-    let (mut s, mut s2, mut c) = (0i64, 0i64, 0i64);
-    for ((&x, &y), &v) in a.iter().zip(b).zip(ok) {
-        let d = ((x - y) * v as i32) as i64;
-        s += d;
-        s2 += d * d;
-        c += v as i64;
-    }
-    (s, s2, c)
 }

@@ -6,12 +6,13 @@
 //!    the new side (Tasse et al., after Milliron et al. 2002): the new
 //!    patch's gradients are bent to equal the old ones at the seam and the
 //!    correction fades out over `R` = patch/4;
-//! 3. a Poisson solve (the crate's solver via [`crate::blend::poisson`]) for
-//!    heights with those gradients, the old pixels as Dirichlet values.
+//! 3. a Poisson solve for heights with those gradients, the old pixels as
+//!    Dirichlet values (the crate's multigrid-preconditioned solver for
+//!    small grids, [`crate::poisson::solve_mg`], started from the patch).
 
 use super::graphcut::{Label, Seam, kwatra, min_cut};
-use crate::blend::poisson::solve_guided;
-use crate::poisson::{SolveOptions, SolveReport};
+use crate::blend::poisson::guided_rhs;
+use crate::poisson::{SolveOptions, SolveReport, solve_mg};
 
 /// The output being synthesized.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,8 +75,48 @@ pub fn offset(c: &Canvas, win: Window, patch: &[f32]) -> f32 {
 /// The seam between the canvas and `patch` (already offset) in `win`;
 /// `core` marks pixels that must come from the patch.
 pub fn seam(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Seam {
+    cut(c, win, patch, core, None)
+}
+
+/// [`seam`] restricted to a band around the seam `coarse` found at half
+/// resolution ([`seam_coarse`]): a free pixel more than one coarse block
+/// (two pixels) from where the coarse labels change takes its block's
+/// label; only the band is cut (banded graph cut, Lombaert et al. 2005).
+/// The free region shrinks from the whole overlap to a strip a few pixels
+/// wide along the seam, which makes the full-resolution cut several times
+/// cheaper; the seam can still move by up to two pixels, where the fine
+/// detail decides it. `win.n` must be even.
+pub fn seam_banded(
+    c: &Canvas,
+    win: Window,
+    patch: &[f32],
+    core: Option<&[bool]>,
+    coarse: &Seam,
+) -> Seam {
+    cut(c, win, patch, core, Some(&coarse.take_new))
+}
+
+fn cut(
+    c: &Canvas,
+    win: Window,
+    patch: &[f32],
+    core: Option<&[bool]>,
+    coarse: Option<&[bool]>,
+) -> Seam {
     let n = win.n;
     let idx = |x: usize, y: usize| (win.y0 + y) * c.width + win.x0 + x;
+    // Coarse blocks whose 3×3 neighbourhood holds both labels.
+    let m = n / 2;
+    let near_seam: Option<Vec<bool>> = coarse.map(|t| {
+        (0..m * m)
+            .map(|k| {
+                let (bx, by) = (k % m, k / m);
+                let (x0, y0) = (bx.saturating_sub(1), by.saturating_sub(1));
+                let (x1, y1) = ((bx + 1).min(m - 1), (by + 1).min(m - 1));
+                (y0..=y1).any(|y| (x0..=x1).any(|x| t[y * m + x] != t[k]))
+            })
+            .collect()
+    });
     let mut labels = vec![Label::Free; n * n];
     let mut any_overlap = false;
     for y in 0..n {
@@ -89,7 +130,17 @@ pub fn seam(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Se
                 Label::Old
             } else {
                 any_overlap = true;
-                Label::Free
+                let b = (y / 2) * m + x / 2;
+                match (coarse, &near_seam) {
+                    (Some(t), Some(near)) if !near[b] => {
+                        if t[b] {
+                            Label::New
+                        } else {
+                            Label::Old
+                        }
+                    }
+                    _ => Label::Free,
+                }
             };
         }
     }
@@ -99,46 +150,59 @@ pub fn seam(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Se
             take_new: vec![true; n * n],
         };
     }
+    // Heights in integer decimetres, rounded once per pixel.
     let dm = |v: f32| (v * 10.0).round() as i64;
-    let a = |x: usize, y: usize| dm(c.heights[idx(x, y)]);
-    let f = |x: usize, y: usize| c.filled[idx(x, y)];
-    let b = |x: usize, y: usize| dm(patch[y * n + x]);
-    let edge = |(sx, sy): (usize, usize), (tx, ty): (usize, usize)| -> i64 {
-        let (fs, ft) = (f(sx, sy), f(tx, ty));
-        let gb = 2 * (b(tx, ty) - b(sx, sy)).abs();
-        match (fs, ft) {
+    let mut a = vec![0i64; n * n];
+    let mut f = vec![false; n * n];
+    for y in 0..n {
+        for x in 0..n {
+            let i = idx(x, y);
+            a[y * n + x] = dm(c.heights[i]);
+            f[y * n + x] = c.filled[i];
+        }
+    }
+    let b: Vec<i64> = patch.iter().map(|&v| dm(v)).collect();
+    let edge = |s: usize, t: usize| -> i64 {
+        let gb = 2 * (b[t] - b[s]).abs();
+        match (f[s], f[t]) {
             (true, true) => {
-                let ga = 2 * (a(tx, ty) - a(sx, sy)).abs();
-                kwatra(a(sx, sy) - b(sx, sy), a(tx, ty) - b(tx, ty), ga + gb)
+                let ga = 2 * (a[t] - a[s]).abs();
+                kwatra(a[s] - b[s], a[t] - b[t], ga + gb)
             }
-            (true, false) => kwatra(2 * (a(sx, sy) - b(sx, sy)), 0, gb),
-            (false, true) => kwatra(2 * (a(tx, ty) - b(tx, ty)), 0, gb),
+            (true, false) => kwatra(2 * (a[s] - b[s]), 0, gb),
+            (false, true) => kwatra(2 * (a[t] - b[t]), 0, gb),
             (false, false) => 0,
         }
     };
     let mut ch = vec![0i64; n * n];
     let mut cv = vec![0i64; n * n];
+    // Edges between two pixels of the same fixed label are never cut: their
+    // cost is not needed (and this skips most of a banded window).
+    let fixed_same = |k: usize, l: usize| labels[k] != Label::Free && labels[k] == labels[l];
     for y in 0..n {
         for x in 0..n {
-            if x + 1 < n {
-                ch[y * n + x] = edge((x, y), (x + 1, y));
+            let k = y * n + x;
+            if x + 1 < n && !fixed_same(k, k + 1) {
+                ch[k] = edge(k, k + 1);
             }
-            if y + 1 < n {
-                cv[y * n + x] = edge((x, y), (x, y + 1));
+            if y + 1 < n && !fixed_same(k, k + n) {
+                cv[k] = edge(k, k + n);
             }
         }
     }
     min_cut(n, n, &labels, &ch, &cv)
 }
 
-/// The seam cost at half resolution, for ranking finalists: the window and
-/// the patch are averaged over 2×2 blocks (a block counts as filled only if
-/// all four pixels are, and as core if any is) and cut there; the cost is
-/// doubled so that it estimates the full-resolution cut (a seam crosses
-/// half as many edges at half the resolution). Four times fewer nodes make
-/// it about eight times cheaper than [`seam`]; the winner is then cut at
-/// full resolution.
-pub fn seam_cost_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> i64 {
+/// The seam at half resolution, for ranking finalists and as the guide of
+/// [`seam_banded`]: the window and the patch are averaged over 2×2 blocks
+/// (a block counts as filled only if all four pixels are, and as core if
+/// any is) and cut there; the cost is doubled so that it estimates the
+/// full-resolution cut (a seam crosses half as many edges at half the
+/// resolution). While the half-resolution window is at least 16 pixels,
+/// that cut is itself banded around the seam one level coarser (a
+/// coarse-to-fine banded graph cut down to an 8-pixel grid), so every level
+/// cuts only a strip along the seam.
+pub fn seam_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>) -> Seam {
     let n = win.n;
     let m = n / 2;
     let mut small = Canvas::new(m, m);
@@ -163,7 +227,15 @@ pub fn seam_cost_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[b
         }
     }
     let win = Window { x0: 0, y0: 0, n: m };
-    2 * seam(&small, win, &sp, core.map(|_| &sc[..])).cost
+    let sc = core.map(|_| &sc[..]);
+    let mut s = if m >= 16 && m % 2 == 0 {
+        let guide = seam_coarse(&small, win, &sp, sc);
+        seam_banded(&small, win, &sp, sc, &guide)
+    } else {
+        seam(&small, win, &sp, sc)
+    };
+    s.cost *= 2;
+    s
 }
 
 /// Merges `patch` (already offset) into the canvas at `win`, taking the
@@ -267,13 +339,22 @@ pub fn apply(
     let stride = seam_pts.len().div_ceil(96).max(1);
     let seam_pts: Vec<_> = seam_pts.into_iter().step_by(stride).collect();
     let radius = (n as f32 / 4.0).max(2.0);
+    // Points at `d ≥ radius` have weight exactly 0 and, when all are that
+    // far, the fade is 0 too: skipping them before the square root gives the
+    // same bits at a fraction of the cost (this loop runs for every new
+    // pixel against every kept seam point).
+    let r2 = radius * radius;
     let corr = |gx: usize, gy: usize| -> (f32, f32) {
         if seam_pts.is_empty() {
             return (0.0, 0.0);
         }
         let (mut sx, mut sy, mut sw, mut dmin) = (0.0f32, 0.0f32, 0.0f32, f32::INFINITY);
         for &(px, py, cx, cy) in &seam_pts {
-            let d = ((px - gx as f32).powi(2) + (py - gy as f32).powi(2)).sqrt();
+            let d2 = (px - gx as f32).powi(2) + (py - gy as f32).powi(2);
+            if d2 >= r2 {
+                continue;
+            }
+            let d = d2.sqrt();
             dmin = dmin.min(d);
             if d < 1e-3 {
                 return (cx, cy);
@@ -359,8 +440,18 @@ pub fn apply(
             }
         }
     }
-    let free: Vec<bool> = class.iter().map(|&k| k != 1).collect();
-    let report = solve_guided(gw, gh, &mut u, &free, &gxv, &gyv, opts).ok();
+    // Initial guess: the patch itself, continued into the free ring outside
+    // the window by its nearest pixel ([`solve_mg`] starts from `u`).
+    for g in 0..gw * gh {
+        if class[g] == 2 {
+            let x = (g % gw + gx0).clamp(win.x0, win.x0 + n - 1) - win.x0;
+            let y = (g / gw + gy0).clamp(win.y0, win.y0 + n - 1) - win.y0;
+            u[g] = patch[y * n + x];
+        }
+    }
+    let fixed: Vec<bool> = class.iter().map(|&k| k == 1).collect();
+    let rhs = guided_rhs(gw, gh, &gxv, &gyv);
+    let report = solve_mg(gw, gh, &mut u, &fixed, Some(&rhs), opts).ok();
     for gy in 0..gh {
         for gx in 0..gw {
             if in_win(gx, gy) && class[gy * gw + gx] == 0 {

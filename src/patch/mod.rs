@@ -13,16 +13,25 @@
 //!    sketch's control points and adds bending energy, SSD against what is
 //!    already placed, noise-variance difference and a repetition penalty;
 //!    the best 5 of that get a graph-cut seam cost, and the cheapest wins;
-//! 4. [`merge`]: graph-cut seam ([`graphcut`]), Shepard-interpolated gradient
-//!    correction and a Poisson solve;
+//! 4. [`merge`]: graph-cut seam ([`graphcut`]; finalists ranked by a
+//!    half-resolution cut, the winner cut coarse to fine in bands),
+//!    Shepard-interpolated gradient correction and a multigrid-preconditioned
+//!    Poisson solve;
 //! 5. [`fill`]: the rest, by priority order, from non-feature candidates
-//!    under 6 transforms (integer SSD + noise on an 8× reduced grid, then the
-//!    same second round and merge).
+//!    under 6 transforms (integer SSD + noise on an 8× reduced grid through
+//!    an explicit-SIMD kernel, then the same second round and merge);
+//! 6. the broad drift of the merge is removed ([`remove_drift`]), the
+//!    sketch's broad shape added ([`deform_by_sketch`]) and the lowest point
+//!    put at the sources' typical lowest level.
+//!
+//! Sources are prepared once per [`Library`] and their features kept on
+//! disk between processes ([`cache`]).
 //!
 //! Everything is deterministic: no randomness; parallel loops write
 //! per-candidate results that are reduced in index order with ties broken
 //! by index, so the bytes do not depend on the thread count.
 
+pub mod cache;
 pub mod candidates;
 pub mod costs;
 pub mod fill;
@@ -79,8 +88,6 @@ pub enum PatchError {
         found: usize,
         expected: usize,
     },
-    #[error("cannot start a worker thread: {0}")]
-    Pool(String),
     #[error(transparent)]
     Other(#[from] crate::Error),
 }
@@ -97,6 +104,16 @@ pub struct Weights {
     pub noise: f64,
     pub cut: f64,
     pub repeat: f64,
+    /// Weight of the detail cost: `Σ_l ln((σ_c,l + 1 m) / (σ_ref,l + 1 m))²`
+    /// between a candidate's wavelet noise levels and the library's
+    /// typical ones ([`Library::noise_ref`]). Not in the seeds: with many
+    /// sources of different character (plains next to alpine ranges), the
+    /// relief-normalised profile costs cannot tell a faint ridge of a plain
+    /// from a real one, and whole sketched features came out as smooth,
+    /// detail-free bands (or single rough masses); this keeps every patch
+    /// near the library's typical roughness. With one source it only
+    /// prefers that source's typical patches.
+    pub detail: f64,
     /// Weight of the noise cost against the SSD in the integer first round
     /// of hole filling.
     pub fill_noise: u64,
@@ -111,6 +128,7 @@ impl Default for Weights {
             noise: 0.5,
             cut: 0.5,
             repeat: 0.5,
+            detail: 1.0,
             fill_noise: 4,
         }
     }
@@ -146,7 +164,7 @@ impl Default for Params {
             max_source_nodes: 2500,
             best_per_source: 5,
             finalists: 5,
-            sketch_relief: 0.6,
+            sketch_relief: 1.0,
             weights: Weights::default(),
         }
     }
@@ -166,6 +184,10 @@ impl Params {
 pub struct Library {
     pub sources: Vec<PreparedSource>,
     pub params: Params,
+    /// The library's typical roughness: per wavelet level, the median
+    /// noise statistic ([`costs::noise_levels`], decimetres) of every
+    /// source's non-feature candidates; see [`Weights::detail`].
+    pub noise_ref: [u32; 3],
 }
 
 impl Library {
@@ -175,6 +197,28 @@ impl Library {
         params: &Params,
         progress: &dyn Progress,
     ) -> Result<Library, PatchError> {
+        Ok(Self::prepare_in(sources, params, None, progress)?.0)
+    }
+
+    /// [`Self::prepare`] through the disk cache in `dir` ([`cache`]): each
+    /// source's features are read from there when an intact entry for the
+    /// same DEM, parameters and code exists, and computed and stored
+    /// otherwise. Returns the library and how many sources were read.
+    pub fn prepare_cached(
+        sources: &[(String, Heightfield)],
+        params: &Params,
+        dir: &std::path::Path,
+        progress: &dyn Progress,
+    ) -> Result<(Library, usize), PatchError> {
+        Self::prepare_in(sources, params, Some(dir), progress)
+    }
+
+    fn prepare_in(
+        sources: &[(String, Heightfield)],
+        params: &Params,
+        dir: Option<&std::path::Path>,
+        progress: &dyn Progress,
+    ) -> Result<(Library, usize), PatchError> {
         params.check()?;
         if sources.is_empty() {
             return Err(PatchError::NoSources);
@@ -204,15 +248,37 @@ impl Library {
         let target = sorted[sorted.len() / 2];
         progress.start("preparing sources", sources.len() as u64);
         let mut out = Vec::with_capacity(sources.len());
+        let mut hits = 0;
         for ((name, hf), rel) in sources.iter().zip(&reliefs) {
-            out.push(PreparedSource::prepare(name, hf, params, target / rel)?);
+            let scale = target / rel;
+            out.push(match dir {
+                Some(d) => {
+                    let (s, o) = cache::prepare(d, name, hf, params, scale)?;
+                    hits += (o == cache::Outcome::Hit) as usize;
+                    s
+                }
+                None => PreparedSource::prepare(name, hf, params, scale)?,
+            });
             progress.advance(1);
         }
         progress.finish();
-        Ok(Library {
-            sources: out,
-            params: *params,
-        })
+        let mut noise_ref = [0u32; 3];
+        for (l, r) in noise_ref.iter_mut().enumerate() {
+            let mut v: Vec<u32> = out
+                .iter()
+                .flat_map(|s| s.fill.iter().map(move |c| c.noise[l]))
+                .collect();
+            v.sort_unstable();
+            *r = v.get(v.len() / 2).copied().unwrap_or(0);
+        }
+        Ok((
+            Library {
+                sources: out,
+                params: *params,
+                noise_ref,
+            },
+            hits,
+        ))
     }
 }
 
@@ -277,13 +343,28 @@ pub fn sketch_field(sketch: &Sketch, w: usize, h: usize, patch: usize) -> Vec<f3
 
 fn box_blur(v: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
     let pass = |src: &[f32], w: usize, h: usize| -> Vec<f32> {
-        // Horizontal box of radius r with clamped ends, then transpose.
+        // Horizontal box of radius r with clamped ends, then transpose. Each
+        // row's prefix sums (f64, so the differences stay exact enough) make
+        // a box O(1) per pixel: the drift removal's radius of two patches
+        // summed 257 samples per pixel and pass otherwise.
         let mut out = vec![0.0f32; w * h];
+        let prefix: Vec<Vec<f64>> = src
+            .par_chunks(w)
+            .map(|row| {
+                let mut p = Vec::with_capacity(w + 1);
+                p.push(0.0f64);
+                let mut acc = 0.0f64;
+                for &v in row {
+                    acc += v as f64;
+                    p.push(acc);
+                }
+                p
+            })
+            .collect();
         out.par_chunks_mut(h).enumerate().for_each(|(x, col)| {
-            for (y, o) in col.iter_mut().enumerate() {
-                let (lo, hi) = (x.saturating_sub(r), (x + r).min(w - 1));
-                let s: f32 = src[y * w + lo..=y * w + hi].iter().sum();
-                *o = s / (hi - lo + 1) as f32;
+            let (lo, hi) = (x.saturating_sub(r), (x + r).min(w - 1));
+            for (o, p) in col.iter_mut().zip(&prefix) {
+                *o = ((p[hi + 1] - p[lo]) / (hi - lo + 1) as f64) as f32;
             }
         });
         out
@@ -529,17 +610,31 @@ pub(crate) fn user_window(c: &Canvas, win: Window) -> UserWindow {
 
 /// Round-two cost of a sampled candidate patch against the canvas window:
 /// `w_ssd · SSD_dc / (σ²_user + σ²_cand + 1 m²) + w_noise · Σ(σu − σc)² /
-/// (Σσu² + Σσc² + 1 m²) + w_repeat · uses` (SSD and noise only where
-/// something is placed; variances over the overlap). Normalising the SSD by
+/// (Σσu² + Σσc² + 1 m²) + w_repeat · uses + w_detail · detail` (SSD and
+/// noise only where something is placed; variances over the overlap;
+/// detail as at [`Weights::detail`]). Normalising the SSD by
 /// both variances (not the user's alone) keeps a smooth neighbourhood from
 /// admitting only smooth patches, which otherwise chains into long
 /// featureless bands.
-pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses: u32) -> f64 {
-    let mut cost = weights.repeat * uses as f64;
+pub(crate) fn round2_cost(
+    u: &UserWindow,
+    patch: &[f32],
+    weights: &Weights,
+    noise_ref: &[u32; 3],
+    uses: u32,
+) -> f64 {
+    let pdm: Vec<i32> = patch.iter().map(|v| (v * 10.0).round() as i32).collect();
+    let all = vec![true; patch.len()];
+    let cn = noise_levels(u.dm.len().isqrt(), &pdm, &all);
+    let detail: f64 = cn
+        .iter()
+        .zip(noise_ref)
+        .map(|(&c, &r)| ((c as f64 + 10.0) / (r as f64 + 10.0)).ln().powi(2))
+        .sum();
+    let mut cost = weights.repeat * uses as f64 + weights.detail * detail;
     if u.overlap == 0 {
         return cost;
     }
-    let pdm: Vec<i32> = patch.iter().map(|v| (v * 10.0).round() as i32).collect();
     let (ssd, _) = costs::ssd_dc(&u.dm, &pdm, &u.valid);
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for (&v, &ok) in patch.iter().zip(&u.valid) {
@@ -551,8 +646,6 @@ pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses
     let k = u.overlap as f64;
     let var_c = (s2 / k - (s / k).powi(2)).max(0.0);
     cost += weights.ssd * (ssd as f64 / 100.0) / (u.var_m2 + var_c + 1.0);
-    let all = vec![true; patch.len()];
-    let cn = noise_levels(u.dm.len().isqrt(), &pdm, &all);
     let num = costs::noise_cost(&u.noise, &cn) as f64;
     let den: f64 = u
         .noise
@@ -566,9 +659,10 @@ pub(crate) fn round2_cost(u: &UserWindow, patch: &[f32], weights: &Weights, uses
 
 /// Picks the winner among scored candidates: sort by cost (ties by key),
 /// add the graph-cut cost for the best `finalists` (estimated at half
-/// resolution, [`merge::seam_cost_coarse`]), take the minimum, and cut the
-/// winner at full resolution. Returns the winning patch (offset to the
-/// overlap) and its seam.
+/// resolution, [`merge::seam_coarse`]), take the minimum (ties by rank),
+/// and cut the winner at full resolution in a band around its half-
+/// resolution seam ([`merge::seam_banded`]). Returns the winning patch
+/// (offset to the overlap) and its seam.
 pub(crate) fn select(
     c: &Canvas,
     win: Window,
@@ -579,31 +673,46 @@ pub(crate) fn select(
     scored.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.key.cmp(&b.key)));
     scored.truncate(params.finalists.max(1));
     let n = win.n as f64;
-    let results: Vec<(f64, Vec<f32>)> = scored
+    // A patch that overlaps nothing (the first of a sketch component) is
+    // put at the mean level of what is placed so far, not at its source's
+    // absolute level: otherwise separate components (Zhou's λ inside its
+    // circle) start hundreds of metres apart and the fill between them
+    // turns that into basins and plateaus the sketch never asked for.
+    let overlaps =
+        (0..win.n * win.n).any(|i| c.filled[(win.y0 + i / win.n) * c.width + win.x0 + i % win.n]);
+    let level = if overlaps {
+        None
+    } else {
+        let (s, k) = c
+            .heights
+            .iter()
+            .zip(&c.filled)
+            .filter(|(_, f)| **f)
+            .fold((0.0f64, 0usize), |(s, k), (&v, _)| (s + v as f64, k + 1));
+        (k > 0).then(|| s / k as f64)
+    };
+    let results: Vec<(f64, Vec<f32>, graphcut::Seam)> = scored
         .par_iter()
         .map(|s| {
-            let off = merge::offset(c, win, &s.patch);
+            let off = match level {
+                Some(l) => {
+                    let m = s.patch.iter().map(|&v| v as f64).sum::<f64>() / s.patch.len() as f64;
+                    (l - m) as f32
+                }
+                None => merge::offset(c, win, &s.patch),
+            };
             let p: Vec<f32> = s.patch.iter().map(|v| v + off).collect();
-            let cut = merge::seam_cost_coarse(c, win, &p, core) as f64 / 256.0 / n;
-            (s.cost + params.weights.cut * cut, p)
+            let coarse = merge::seam_coarse(c, win, &p, core);
+            let cut = coarse.cost as f64 / 256.0 / n;
+            (s.cost + params.weights.cut * cut, p, coarse)
         })
         .collect();
     let best = (0..results.len()).min_by(|&a, &b| results[a].0.total_cmp(&results[b].0))?;
-    let (_, p) = results.into_iter().nth(best)?;
-    let seam = merge::seam(c, win, &p, core);
+    let (_, p, coarse) = results.into_iter().nth(best)?;
+    let seam = merge::seam_banded(c, win, &p, core, &coarse);
     let mut win_s = scored.swap_remove(best);
     win_s.patch = p;
     Some((win_s, seam))
-}
-
-/// A one-thread pool for the per-patch Poisson solves: a patch window is a
-/// few thousand unknowns, where rayon's fork-join costs more than the work
-/// (the solver's sums are chunked in a fixed order, so the bytes are the same).
-pub(crate) fn solo_pool() -> Result<rayon::ThreadPool, PatchError> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .map_err(|e| PatchError::Pool(e.to_string()))
 }
 
 pub(crate) fn solve_opts() -> SolveOptions {
@@ -652,7 +761,6 @@ pub fn synthesize(
     let mut uses: BTreeMap<(usize, u8, u32), u32> = BTreeMap::new();
     let r = n as f32 / 4.0;
     let opts = solve_opts();
-    let solo = solo_pool()?;
     progress.start("feature patches", users.len() as u64);
     for up in &users {
         let d = up.node.cps.len();
@@ -708,7 +816,7 @@ pub fn synthesize(
                 let feat = c1 as f64 / (d * (ALONG + ACROSS)) as f64 / (UNIT as f64 * UNIT as f64);
                 let cost = params.weights.feature * feat
                     + params.weights.deform * deform
-                    + round2_cost(&uw, &patch, &params.weights, u);
+                    + round2_cost(&uw, &patch, &params.weights, &lib.noise_ref, u);
                 Some(Scored { cost, patch, key })
             })
             .collect();
@@ -723,9 +831,7 @@ pub fn synthesize(
         if let Some((s, seam)) = chosen {
             let t3 = Instant::now();
             *uses.entry(s.key).or_insert(0) += 1;
-            if let Some(rep) =
-                solo.install(|| merge::apply(&mut canvas, win, &s.patch, &seam.take_new, &opts))
-            {
+            if let Some(rep) = merge::apply(&mut canvas, win, &s.patch, &seam.take_new, &opts) {
                 stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
             }
             stats.feature_patches += 1;
@@ -740,10 +846,23 @@ pub fn synthesize(
         &mut uses,
         &mut timings,
         &mut stats,
-        &solo,
         progress,
     );
+    remove_drift(&mut canvas.heights, w, h, n);
     deform_by_sketch(&mut canvas.heights, &field, w, h, n, params.sketch_relief);
+    // The merge fixes heights only up to a constant: put the lowest point
+    // at the sources' typical lowest level (the median of their minima), so
+    // that the output is not partly below sea level for no reason (the
+    // renderer, like most tools, draws heights ≤ 0 as water).
+    let mut lows: Vec<f32> = lib
+        .sources
+        .iter()
+        .map(|s| s.heights.iter().copied().fold(f32::INFINITY, f32::min))
+        .collect();
+    lows.sort_by(f32::total_cmp);
+    let low = canvas.heights.iter().copied().fold(f32::INFINITY, f32::min);
+    let shift = lows[lows.len() / 2] - low;
+    canvas.heights.iter_mut().for_each(|v| *v += shift);
     let cell = median_cell(lib);
     let hf = Heightfield::from_vec(w, h, cell, canvas.heights).map_err(crate::Error::from)?;
     timings.total = t_all.elapsed();
@@ -787,6 +906,27 @@ pub fn deform_by_sketch(
     let amp = candidates::relief(heights) * amount / peak;
     for (v, b) in heights.iter_mut().zip(&broad) {
         *v += amp * b;
+    }
+}
+
+/// Removes what the merge adds at scales far above a patch: the broad
+/// component (three box passes of radius 2·patch, about a Gaussian of
+/// σ = 2·patch) minus its mean. Each gradient-domain merge keeps its
+/// patch's slopes and only pins it to its neighbours along the seam, so
+/// small slope residues (after [`detrend`]) add up along the placement
+/// order into a random walk of height across the output: with many
+/// sources, half of a sketched circle came out a kilometre above the other
+/// half as one smooth snowy mass, and the λ inside it was lost in that
+/// tilt. Ridges and valleys are narrower than this scale and stay; the
+/// broad shape is the sketch's to give ([`deform_by_sketch`]).
+pub fn remove_drift(heights: &mut [f32], w: usize, h: usize, patch: usize) {
+    let mut broad = heights.to_vec();
+    for _ in 0..3 {
+        broad = box_blur(&broad, w, h, (2 * patch).max(1));
+    }
+    let mean = broad.iter().map(|&v| v as f64).sum::<f64>() / broad.len().max(1) as f64;
+    for (v, b) in heights.iter_mut().zip(&broad) {
+        *v -= b - mean as f32;
     }
 }
 

@@ -40,6 +40,14 @@ pub struct Args {
     /// Also write a shaded-relief preview PNG.
     #[arg(long)]
     preview: Option<PathBuf>,
+    /// Where prepared source features are cached [default:
+    /// $TERRASYNTH_CACHE_DIR, else $XDG_CACHE_HOME/terrasynth, else
+    /// ~/.cache/terrasynth].
+    #[arg(long, value_name = "DIR")]
+    cache_dir: Option<PathBuf>,
+    /// Prepare every source from scratch and cache nothing.
+    #[arg(long, conflicts_with = "cache_dir")]
+    no_cache: bool,
     #[command(flatten)]
     read: Input,
 }
@@ -62,7 +70,15 @@ pub fn run(a: Args) -> CliResult {
     };
     let bar = Bar::new();
     let t_prep = std::time::Instant::now();
-    let lib = Library::prepare(&sources, &params, &bar)?;
+    let (lib, hits) = if a.no_cache {
+        (Library::prepare(&sources, &params, &bar)?, 0)
+    } else {
+        let dir = a
+            .cache_dir
+            .clone()
+            .unwrap_or_else(terrasynth::database::default::cache_dir);
+        Library::prepare_cached(&sources, &params, &dir, &bar)?
+    };
     let prep_ms = t_prep.elapsed().as_secs_f64() * 1e3;
     let result = patch::synthesize(&lib, &sketch, w, h, &bar)?;
     io::write(&result.heightfield, &a.output, &WriteOptions::default())?;
@@ -78,7 +94,8 @@ pub fn run(a: Args) -> CliResult {
         s.fill_patches
     );
     eprintln!(
-        "ms: source preparation {prep_ms:.0}; sketch {:.0}, feature round1 {:.0} round2 {:.0} merge {:.0}, fill round1 {:.0} round2 {:.0} merge {:.0}, total {:.0}",
+        "ms: source preparation {prep_ms:.0} ({hits} of {} from the cache); sketch {:.0}, feature round1 {:.0} round2 {:.0} merge {:.0}, fill round1 {:.0} round2 {:.0} merge {:.0}, total {:.0}",
+        lib.sources.len(),
         ms(t.sketch),
         ms(t.feature_round1),
         ms(t.feature_round2),
