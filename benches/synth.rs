@@ -1,7 +1,8 @@
 //! Synthesis on the embedded default database: each stage on its own at
 //! 1024² (`upsample_jitter/cpu/1024`, `correct/cpu/1024` — one subpass of
 //! level 0 on a real state, `reconstruct/cpu/1024`) and end to end
-//! (`synth/cpu/512`, `synth/cpu/1024`). The CLI's `terrasynth bench` gives
+//! (`synth/cpu/512`, `synth/cpu/1024`; with `--features gpu` and an
+//! adapter also `synth/gpu/256..1024`). The CLI's `terrasynth bench` gives
 //! the same end-to-end numbers per level.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -70,6 +71,22 @@ fn bench(c: &mut Criterion) {
         g.bench_function(format!("cpu/{n}"), |b| {
             b.iter(|| synth.synthesize(n, n, black_box(1)).unwrap())
         });
+    }
+    // The same loop on the GPU backend (`--features gpu`): on a real GPU,
+    // or lavapipe where there is none (slow: a cross-check device, not a
+    // fast one).
+    #[cfg(feature = "gpu")]
+    match terrasynth::backend::gpu::Context::new() {
+        Ok(ctx) => {
+            let mut gpu = Synthesizer::new(&db, Params::default()).unwrap();
+            gpu.use_gpu(ctx).unwrap();
+            for n in [256, 512, 1024] {
+                g.bench_function(format!("gpu/{n}"), |b| {
+                    b.iter(|| gpu.synthesize(n, n, black_box(1)).unwrap())
+                });
+            }
+        }
+        Err(e) => eprintln!("synth/gpu skipped: {e}"),
     }
     g.finish();
 }

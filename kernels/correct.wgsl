@@ -2,7 +2,7 @@
 // mirror of src/synth/stages/correct/scalar.rs (`correct_pixel_guided`),
 // function for function, one invocation per pixel of the parity class
 // (p.px, p.py). Each control is on when its flag is set; without flags the
-// control bindings are placeholders and never read. See the Rust module docs of
+// guide binding is a placeholder and never read. See the Rust module docs of
 // src/synth/stages/correct.rs for the arithmetic (N_S kept ×3, h by floor
 // division, residuals clamped to ±CLAMP so a κ = 2 score fits a u32, ties
 // keep the earlier candidate).
@@ -19,7 +19,8 @@ struct CorrectParams {
     // Types of the database (length of `seed_counts`).
     type_count: u32,
     pad0: u32,
-    // Only pixels in [x0, x1) × [y0, y1) are corrected (Guide::window).
+    // Only pixels in [x0, x1) × [y0, y1) are corrected (Guide::window); with
+    // F_COHERENCE the others take the previous result.
     x0: u32,
     y0: u32,
     x1: u32,
@@ -39,19 +40,24 @@ const F_COHERENCE: u32 = 4u;
 // C₂ per texel, packed x | y << 16.
 @group(0) @binding(5) var<storage, read> similar: array<u32>;
 
-// Type id per atlas texel, four u8 per word (Level::types' bytes).
-@group(0) @binding(6) var<storage, read> types: array<u32>;
-// Seed texels per type, SEEDS_PER_TYPE slots each, packed x | y << 16.
-@group(0) @binding(7) var<storage, read> seeds: array<u32>;
-@group(0) @binding(8) var<storage, read> seed_counts: array<u32>;
-// blend::Target per pixel: (height, tol).
-@group(0) @binding(9) var<storage, read> targets: array<vec2<i32>>;
-// R^i per pixel.
-@group(0) @binding(10) var<storage, read> allowed_set: array<u32>;
-// The previous frame's S, V and W^i (widened to u32) per pixel.
-@group(0) @binding(11) var<storage, read> prev_s: array<vec2<i32>>;
-@group(0) @binding(12) var<storage, read> prev_v: array<i32>;
-@group(0) @binding(13) var<storage, read> weights: array<u32>;
+// The level's type tables in one buffer (gpu::Level::type_data): seed
+// counts per type (type_count words), then SEEDS_PER_TYPE seed texels per
+// type (packed x | y << 16), then the type id per atlas texel (four u8 per
+// word). One binding instead of three keeps the kernel within WebGPU's
+// default of 8 storage buffers per stage.
+@group(0) @binding(6) var<storage, read> type_data: array<u32>;
+
+// Control inputs per pixel (kernels::GuideCell): the blend::Target
+// (height, tol), R^i, W^i, and the previous frame's S and V.
+struct GuideCell {
+    blend_target: vec2<i32>,
+    allowed: u32,
+    weight: u32,
+    prev_s: vec2<i32>,
+    prev_v: i32,
+    pad0: i32,
+}
+@group(0) @binding(7) var<storage, read> guide: array<GuideCell>;
 
 // correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT;
 // types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; blend::MAX_ERROR.
@@ -183,7 +189,8 @@ fn neighbour(x: i32, y: i32) -> Neighbour {
 // Type id of atlas texel q (Level::types).
 fn texel_type(q: vec2<i32>) -> u32 {
     let i = atlas_index(q.x, q.y);
-    return (types[i >> 2u] >> ((i & 3u) * 8u)) & 0xFFu;
+    let at = p.type_count * (1u + SEEDS_PER_TYPE);
+    return (type_data[at + (i >> 2u)] >> ((i & 3u) * 8u)) & 0xFFu;
 }
 
 // `mask >> t & 1 == 1` as Rust computes it in release builds (the shift
@@ -314,7 +321,16 @@ fn nudge(v: i32, h_c: i32, goal: vec2<i32>) -> i32 {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ux = 2u * gid.x + p.px;
     let uy = 2u * gid.y + p.py;
-    if (ux >= p.width || uy >= p.height || ux < p.x0 || uy < p.y0 || ux >= p.x1 || uy >= p.y1) {
+    if (ux >= p.width || uy >= p.height) {
+        return;
+    }
+    if (ux < p.x0 || uy < p.y0 || ux >= p.x1 || uy >= p.y1) {
+        // Outside the window: the previous frame's result (correct::keep_outside).
+        if ((p.flags & F_COHERENCE) != 0u) {
+            let k = uy * p.width + ux;
+            state_s[k] = guide[k].prev_s;
+            state_v[k] = guide[k].prev_v;
+        }
         return;
     }
     let x = i32(ux);
@@ -339,13 +355,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var best = Best(0xFFFFFFFFu, vec2<i32>(0), 0, false, vec2<i32>(0));
     var allowed = ALL_TYPES;
     if ((p.flags & F_ALLOWED) != 0u) {
-        allowed = allowed_set[i];
+        allowed = guide[i].allowed;
     }
     if ((p.flags & F_COHERENCE) != 0u) {
-        let s = prev_s[i];
-        let v = prev_v[i];
+        let s = guide[i].prev_s;
+        let v = guide[i].prev_v;
         let q = vec2<i32>(round_fixed(s.x), round_fixed(s.y));
-        let w = weights[i];
+        let w = guide[i].weight;
         // A previous result of a type no longer allowed is no candidate,
         // unless frozen (freezing dominates).
         if (allowed == ALL_TYPES || w == 0u || has_type(allowed, texel_type(q))) {
@@ -363,7 +379,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (!candidates(ns, x, y, allowed, &best)) {
         var seeded = false;
         for (var t = 0u; t < p.type_count; t++) {
-            let count = seed_counts[t];
+            let count = type_data[t];
             if (!has_type(allowed, t) || count == 0u) {
                 continue;
             }
@@ -371,7 +387,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             for (var k = 0u; k < SEEDS_PER_ALLOWED_TYPE; k++) {
                 let salt = t * SEEDS_PER_ALLOWED_TYPE + k;
                 let hash = hash4(SEED_SALT | p.level, salt, ux, uy);
-                let c = seeds[t * SEEDS_PER_TYPE + below(hash, count)];
+                let c = type_data[p.type_count + t * SEEDS_PER_TYPE + below(hash, count)];
                 let q = vec2<i32>(i32(c & 0xFFFFu), i32(c >> 16u));
                 let r = score(ns, q.x, q.y, 1u);
                 if (r.score < best.score) {
@@ -387,7 +403,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var v = best.h;
     if (best.has_q && (p.flags & F_TARGETS) != 0u) {
         let h_c = texel(best.q.x, best.q.y).x - MODE1_BIAS + v;
-        v = nudge(v, h_c, targets[i]);
+        v = nudge(v, h_c, guide[i].blend_target);
     }
     state_s[i] = best.s;
     state_v[i] = v;

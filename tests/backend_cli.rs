@@ -81,6 +81,10 @@ fn backends_write_the_same_bytes_and_auto_falls_back_with_a_notice() {
             "auto found no GPU but gpu ran: {auto_notes:?}"
         );
     } else {
+        assert!(
+            !cfg!(feature = "gpu") || std::env::var_os("TERRASYNTH_REQUIRE_GPU").is_none(),
+            "TERRASYNTH_REQUIRE_GPU is set but --backend gpu failed: {err}"
+        );
         assert!(err.starts_with("error: "), "{err}");
         if cfg!(feature = "gpu") {
             assert!(err.contains("no usable GPU adapter"), "{err}");
@@ -113,4 +117,54 @@ fn bench_reports_the_backend_and_its_clock() {
         assert_eq!(s["clock"], "wall clock");
     }
     assert!(s["stages"]["correct"].as_f64().unwrap() > 0.0);
+}
+
+/// Runs `edit` over the example scene and its edit; returns the frames'
+/// heightfield bytes, or None when the run failed.
+fn edit(dir: &Path, backend: &str) -> (Output, Option<Vec<u8>>) {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes");
+    let out_dir = dir.join(backend);
+    let out = terrasynth(&[
+        "edit",
+        scenes.join("canyonlands.json").to_str().unwrap(),
+        scenes.join("canyonlands_edit1.json").to_str().unwrap(),
+        "--out-dir",
+        out_dir.to_str().unwrap(),
+        "--ext",
+        "r32",
+        "--backend",
+        backend,
+    ]);
+    let frames = (0..2)
+        .map(|k| std::fs::read(out_dir.join(format!("frame_{k:03}.r32"))).ok())
+        .collect::<Option<Vec<_>>>()
+        .map(|f| f.concat());
+    (out, frames)
+}
+
+/// A controlled editing session (curves, points, paint, freeze, paste, a
+/// coherent second frame) writes the same frames on every backend.
+#[test]
+fn edit_sessions_write_the_same_frames_on_every_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    let (cpu, cpu_frames) = edit(dir.path(), "cpu");
+    assert!(cpu.status.success(), "{cpu:?}");
+    let cpu_frames = cpu_frames.unwrap();
+    let (gpu, gpu_frames) = edit(dir.path(), "gpu");
+    let err = String::from_utf8_lossy(&gpu.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    if gpu.status.success() {
+        assert!(
+            gpu_frames.unwrap() == cpu_frames,
+            "gpu frames must match cpu"
+        );
+    } else {
+        assert!(
+            std::env::var_os("TERRASYNTH_REQUIRE_GPU").is_none(),
+            "TERRASYNTH_REQUIRE_GPU is set but the GPU session failed: {err}"
+        );
+        eprintln!("no GPU: only the CPU session ran ({})", err.trim());
+        assert!(err.starts_with("error: "), "{err}");
+        assert!(gpu_frames.is_none(), "no frames on failure");
+    }
 }

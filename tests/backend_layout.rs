@@ -4,7 +4,7 @@
 
 use std::mem::{offset_of, size_of};
 use terrasynth::backend::kernels::{
-    self, CorrectUniform, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
+    self, CorrectUniform, GuideCell, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
     UpsampleUniform,
 };
 use terrasynth::render::shade::ShadeParams;
@@ -92,6 +92,31 @@ macro_rules! rust_layout {
     };
 }
 
+/// Every kernel binds at most WebGPU's default number of storage buffers
+/// per shader stage (8), so any adapter that wgpu accepts can run it, not
+/// only those whose drivers raise the limit (lavapipe, desktop Vulkan).
+#[test]
+fn kernels_fit_the_default_storage_buffer_limit() {
+    let limit = WEBGPU_DEFAULT_STORAGE_BUFFERS;
+    for k in kernels::ALL {
+        let m = module(k);
+        let n = m
+            .global_variables
+            .iter()
+            .filter(|(_, v)| matches!(v.space, naga::AddressSpace::Storage { .. }))
+            .count();
+        assert!(
+            n <= limit,
+            "{} binds {n} storage buffers: the default limit is {limit}",
+            k.name
+        );
+    }
+}
+
+/// `wgpu::Limits::default().max_storage_buffers_per_shader_stage`, the
+/// WebGPU default (wgpu is no dependency of the tests without `gpu`).
+const WEBGPU_DEFAULT_STORAGE_BUFFERS: usize = 8;
+
 #[test]
 fn every_kernel_parses_and_validates() {
     for k in kernels::ALL {
@@ -139,6 +164,17 @@ fn parameter_structs_match_their_wgsl_declarations() {
             y0,
             x1,
             y1
+        })
+    );
+    assert_eq!(
+        wgsl_struct(&module(kernels::CORRECT), "GuideCell"),
+        rust_layout!(GuideCell {
+            blend_target,
+            allowed,
+            weight,
+            prev_s,
+            prev_v,
+            pad0
         })
     );
     assert_eq!(

@@ -9,7 +9,7 @@
 use proptest::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 use terrasynth::Heightfield;
 use terrasynth::backend::gpu::Context;
 use terrasynth::render::{
@@ -17,17 +17,12 @@ use terrasynth::render::{
     shade::{self, flags},
 };
 
+mod common;
+
 const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
 
 fn ctx() -> Option<Arc<Context>> {
-    static CTX: OnceLock<Result<Arc<Context>, String>> = OnceLock::new();
-    match CTX.get_or_init(|| Context::new().map_err(|e| e.to_string())) {
-        Ok(c) => Some(c.clone()),
-        Err(e) => {
-            eprintln!("skipping the GPU cross-check: {e}");
-            None
-        }
-    }
+    common::gpu::context()
 }
 
 /// Renders on both backends; returns the flags used, for coverage checks.

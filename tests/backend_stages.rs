@@ -24,16 +24,9 @@ use terrasynth::synth::{Params, Synthesizer};
 mod common;
 use common::dem::{self, DEM};
 
-/// The shared device, or `None` (with the reason printed once per test).
+/// The shared device, or `None` without an adapter (see `common::gpu`).
 fn ctx() -> Option<Arc<Context>> {
-    static CTX: OnceLock<Result<Arc<Context>, String>> = OnceLock::new();
-    match CTX.get_or_init(|| Context::new().map_err(|e| e.to_string())) {
-        Ok(c) => Some(c.clone()),
-        Err(e) => {
-            eprintln!("skipping the GPU cross-check: {e}");
-            None
-        }
-    }
+    common::gpu::context()
 }
 
 fn default_db() -> &'static Database {

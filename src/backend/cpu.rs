@@ -22,6 +22,7 @@ impl Backend for Cpu<'_, '_> {
     type State = State;
     type Types = Raster<u32>;
     type Weights = Raster<u8>;
+    type Guide<'g> = correct::Guide<'g>;
 
     fn name(&self) -> &'static str {
         "cpu"
@@ -42,6 +43,20 @@ impl Backend for Cpu<'_, '_> {
 
     fn correct(&self, st: &State, level: usize, p: &CorrectParams) {
         correct::correct(&self.atlas[level], st, p);
+    }
+
+    fn upload_guide<'g>(
+        &self,
+        g: &correct::Guide<'g>,
+        width: usize,
+        height: usize,
+    ) -> Result<correct::Guide<'g>, BackendError> {
+        super::check_guide(g, width, height)?;
+        Ok(*g)
+    }
+
+    fn correct_guided(&self, st: &State, level: usize, p: &CorrectParams, g: &correct::Guide<'_>) {
+        correct::correct_guided(&self.atlas[level], st, p, g);
     }
 
     fn reconstruct(&self, st: &State) -> Result<Vec<i32>, BackendError> {

@@ -108,6 +108,24 @@ pub struct CorrectUniform {
     pub y1: u32,
 }
 
+/// `GuideCell` of `kernels/correct.wgsl`: one pixel's control inputs of
+/// `correct`, all in one buffer so the kernel needs few bindings. Parts
+/// whose flag is off are zero and never read.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct GuideCell {
+    /// `blend::Target` (height, tol).
+    pub blend_target: [i32; 2],
+    /// R^i (`correct::Guide::allowed`).
+    pub allowed: u32,
+    /// W^i in quarters, widened.
+    pub weight: u32,
+    /// The previous frame's S (`Coord::pack`'s bytes) and V.
+    pub prev_s: [i32; 2],
+    pub prev_v: i32,
+    pub pad0: i32,
+}
+
 /// `CorrectUniform::flags`: geometric targets, type sets, coherence.
 pub const CORRECT_TARGETS: u32 = 1;
 pub const CORRECT_ALLOWED: u32 = 2;

@@ -15,7 +15,7 @@ pub mod gpu;
 pub mod kernels;
 
 use crate::synth::fixed::Coord;
-use crate::synth::stages::correct::CorrectParams;
+use crate::synth::stages::correct::{self, CorrectParams};
 use crate::synth::stages::upsample_jitter::UpsampleParams;
 use crate::synth::state::State;
 use std::time::Duration;
@@ -44,17 +44,13 @@ pub struct StageTime {
 /// [`Backend::finish`] waits for them, and every call that returns host
 /// data waits implicitly.
 ///
-/// Database data is bound at construction and addressed by level index, so
+/// Database data is bound at construction and addressed by level index;
 /// per-level inputs of later stages (the user-control rasters of
-/// `synth::control`: targets, allowed types, coherence weights) fit the
-/// same way: uploaded once per level as a backend-side associated type,
-/// passed to `correct` next to the state (so far `gpu::Gpu::upload_guide`
-/// and `gpu::Gpu::correct_guided`, cross-checked against
-/// `correct::correct_guided`; the synthesizer's controlled loop,
-/// `Synthesizer::run_with`, still runs on the CPU). The pyramids of two of
+/// `synth::control`: targets, allowed types, previous results, coherence
+/// weights) are uploaded as a backend-side [`Backend::Guide`] and passed to
+/// [`Backend::correct_guided`] next to the state. The pyramids of two of
 /// them are stages of their own ([`Backend::reduce_types`],
-/// [`Backend::reduce_weights`]), so a backend builds every level's raster
-/// from level 0's where it keeps them.
+/// [`Backend::reduce_weights`]).
 pub trait Backend {
     /// One level's coordinates S and offsets V, where this backend keeps them.
     type State;
@@ -64,6 +60,9 @@ pub trait Backend {
     /// One level's coherence weights W^i (quarters, u8 on the host), where
     /// this backend keeps them.
     type Weights;
+    /// One pass's control inputs of `correct` at one level (a
+    /// `correct::Guide`), where this backend reads them.
+    type Guide<'g>;
 
     /// `"cpu"` or `"gpu"`, for reports.
     fn name(&self) -> &'static str;
@@ -81,6 +80,24 @@ pub trait Backend {
     );
     /// One subpass of stage `correct` at database level `level`, in place.
     fn correct(&self, st: &Self::State, level: usize, p: &CorrectParams);
+    /// Moves the control inputs of one pass over a `width × height` level
+    /// to the backend (the CPU borrows them as they are).
+    fn upload_guide<'g>(
+        &self,
+        g: &correct::Guide<'g>,
+        width: usize,
+        height: usize,
+    ) -> Result<Self::Guide<'g>, BackendError>;
+    /// One subpass of stage `correct` under control inputs (paper §5), in
+    /// place; with a guide of `correct::Guide::NONE` the same bytes as
+    /// [`Backend::correct`].
+    fn correct_guided(
+        &self,
+        st: &Self::State,
+        level: usize,
+        p: &CorrectParams,
+        g: &Self::Guide<'_>,
+    );
     /// Stage `reconstruct` of a level-0 state: fixed-point heights (see
     /// `synth::stages::reconstruct`), row-major.
     fn reconstruct(&self, st: &Self::State) -> Result<Vec<i32>, BackendError>;
@@ -176,6 +193,27 @@ pub fn check_raster(
             width,
             height,
         });
+    }
+    Ok(())
+}
+
+/// Rejects a guide whose rasters are not `width × height` (every backend
+/// checks before `correct_guided` indexes them by pixel).
+pub fn check_guide(
+    g: &correct::Guide<'_>,
+    width: usize,
+    height: usize,
+) -> Result<(), BackendError> {
+    if let Some(t) = g.targets {
+        check_raster("targets", t.len(), width, height)?;
+    }
+    if let Some(a) = g.allowed {
+        check_raster("type sets", a.len(), width, height)?;
+    }
+    if let Some(c) = g.coherence {
+        check_raster("previous coordinates", c.coords.len(), width, height)?;
+        check_raster("previous offsets", c.offsets.len(), width, height)?;
+        check_raster("coherence weights", c.weights.len(), width, height)?;
     }
     Ok(())
 }

@@ -7,6 +7,11 @@
 //! metres. Every stage is integer arithmetic and every random choice a hash,
 //! so the output bytes depend only on the database, the parameters and the
 //! seed — never on the thread count.
+//!
+//! One loop ([`Synthesizer::run`] and, under user control,
+//! [`Synthesizer::run_with`]) drives whichever [`Backend`] was chosen, so
+//! plain synthesis, scenes and editing sessions run on the CPU or the GPU
+//! with the same bytes.
 
 pub mod atlas;
 pub mod control;
@@ -21,7 +26,7 @@ use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
 use control::Target;
 use fixed::{Coord, FRAC_BITS};
-use stages::correct::{self, Coherence, CorrectParams, Guide, SUBPASSES};
+use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
@@ -198,38 +203,30 @@ fn widen(b: [usize; 4], by: usize, w: usize, h: usize) -> [usize; 4] {
     ]
 }
 
-/// Bounds of the pixels whose S or V differ from `r`; None if none do.
-fn changed_bounds(st: &State, r: &PassResult) -> Option<[usize; 4]> {
-    let w = st.width;
+/// Bounds of the pixels whose S or V (row-major, `width` wide) differ from
+/// `r`; None if none do.
+fn changed_bounds(
+    coords: &[Coord],
+    offsets: &[i32],
+    width: usize,
+    r: &PassResult,
+) -> Option<[usize; 4]> {
     let mut b: Option<[usize; 4]> = None;
-    for y in 0..st.height {
-        for x in 0..w {
-            let i = y * w + x;
-            if st.s(i) != r.coords[i] || st.v(i) != r.offsets[i] {
-                b = union(b, Some([x, y, x + 1, y + 1]));
-            }
+    for (i, (c, v)) in coords.iter().zip(offsets).enumerate() {
+        if *c != r.coords[i] || *v != r.offsets[i] {
+            let (x, y) = (i % width, i / width);
+            b = union(b, Some([x, y, x + 1, y + 1]));
         }
     }
     b
 }
 
-/// After a windowed subpass: the subpass's pixels outside the window take
-/// the previous frame's result of this pass (what they would compute).
-fn keep_outside(st: &State, r: &PassResult, [x0, y0, x1, y1]: [usize; 4], p: CorrectParams) {
-    use rayon::prelude::*;
-    let w = st.width;
-    (p.py as usize..st.height)
-        .into_par_iter()
-        .step_by(2)
-        .for_each(|y| {
-            let inside_row = (y0..y1).contains(&y);
-            for x in (p.px as usize..w).step_by(2) {
-                if !(inside_row && (x0..x1).contains(&x)) {
-                    let i = y * w + x;
-                    st.set(i, r.coords[i], r.offsets[i]);
-                }
-            }
-        });
+/// The control side of one run: per-level guides, the previous frame, and
+/// whether to record this one.
+struct Control<'a> {
+    guides: &'a Guides,
+    prev: Option<&'a Frames>,
+    record: bool,
 }
 
 /// Synthesizes terrain from one database, on the CPU unless
@@ -365,31 +362,73 @@ impl<'db> Synthesizer<'db> {
     /// Synthesizes and returns timings (and levels, if kept), on the
     /// backend chosen by [`Synthesizer::use_backend`].
     pub fn run(&self, width: usize, height: usize, seed: u32) -> Result<Synthesis, SynthError> {
-        #[cfg(feature = "gpu")]
-        if let Some(g) = &self.gpu {
-            return self.run_on(g, width, height, seed);
-        }
-        self.run_on(&self.cpu(), width, height, seed)
+        Ok(self.dispatch(width, height, seed, None)?.0)
     }
 
-    /// The synthesis loop on any backend: the same stage calls in the same
-    /// order, so every backend yields the same bytes. Stage timings are wall
-    /// clock up to [`Backend::finish`], i.e. including the device's work.
-    pub fn run_on<B: Backend>(
+    /// Synthesis under control inputs (paper §5), on the backend chosen by
+    /// [`Synthesizer::use_backend`]. `prev` is the previous frame's per-pass
+    /// results (the coherence candidates, and what pixels outside a level's
+    /// window keep); with `record`, this frame's are returned for the next
+    /// one.
+    pub fn run_with(
+        &self,
+        width: usize,
+        height: usize,
+        seed: u32,
+        guides: &Guides,
+        prev: Option<&Frames>,
+        record: bool,
+    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
+        let control = Control {
+            guides,
+            prev,
+            record,
+        };
+        self.dispatch(width, height, seed, Some(&control))
+    }
+
+    /// [`Synthesizer::drive`] on the chosen backend.
+    fn dispatch(
+        &self,
+        width: usize,
+        height: usize,
+        seed: u32,
+        control: Option<&Control<'_>>,
+    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return self.drive(g, width, height, seed, control);
+        }
+        self.drive(&self.cpu(), width, height, seed, control)
+    }
+
+    /// The synthesis loop, one for every backend and for plain and
+    /// controlled synthesis: the same stage calls in the same order, so
+    /// every backend yields the same bytes. Stage timings are wall clock up
+    /// to [`Backend::finish`], i.e. including the device's work, unless the
+    /// backend has a device clock.
+    fn drive<B: Backend>(
         &self,
         b: &B,
         width: usize,
         height: usize,
         seed: u32,
-    ) -> Result<Synthesis, SynthError> {
+        control: Option<&Control<'_>>,
+    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         let t0 = Instant::now();
         let (top, l, mut timings) = self.plan(width, height)?;
         let mut kept = Vec::new();
+        let mut frames = control.filter(|c| c.record).map(|_| Frames {
+            levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
+        });
         // Without a device clock, the loop waits after each stage so that
         // wall clock measures it; with one, stages queue back to back.
         let device_clock = b.has_device_clock();
         b.device_times()?; // forget times of earlier calls
         let mut state = b.upload(self.initial(width, height, top, seed))?;
+        // Bounds of the pixels of the level above that differ from the
+        // previous frame (restricted re-synthesis only).
+        let mut changed_parent: Option<[usize; 4]> = None;
         for level in (0..=top).rev() {
             let (w, h) = level_size(width, height, level);
             if level < top {
@@ -404,9 +443,23 @@ impl<'db> Synthesizer<'db> {
             }
             if level <= l {
                 let t = Instant::now();
-                for _pass in 0..self.params.passes {
-                    for &(px, py) in &SUBPASSES {
-                        b.correct(&state, level, &CorrectParams { px, py });
+                match control {
+                    None => {
+                        for _pass in 0..self.params.passes {
+                            for &(px, py) in &SUBPASSES {
+                                b.correct(&state, level, &CorrectParams { px, py });
+                            }
+                        }
+                    }
+                    Some(c) => {
+                        changed_parent = self.correct_level(
+                            b,
+                            &state,
+                            (level, w, h),
+                            c,
+                            changed_parent,
+                            frames.as_mut(),
+                        )?;
                     }
                 }
                 if !device_clock {
@@ -446,113 +499,6 @@ impl<'db> Synthesizer<'db> {
                 }
             }
         }
-        Ok(Synthesis {
-            heightfield,
-            levels: kept,
-            timings,
-        })
-    }
-
-    /// Synthesis under control inputs (paper §5), on the CPU (the GPU
-    /// backend runs unconstrained synthesis only, so far). `prev` is the previous
-    /// frame's per-pass results (the coherence candidates, and what pixels
-    /// outside a level's window keep); with `record`, this frame's are
-    /// returned for the next one.
-    pub fn run_with(
-        &self,
-        width: usize,
-        height: usize,
-        seed: u32,
-        guides: &Guides,
-        prev: Option<&Frames>,
-        record: bool,
-    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
-        let t0 = Instant::now();
-        let (top, l, mut timings) = self.plan(width, height)?;
-        let cpu = self.cpu();
-        let mut kept = Vec::new();
-        let mut frames = record.then(|| Frames {
-            levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
-        });
-        let mut state = self.initial(width, height, top, seed);
-        // Bounds of the pixels of the level above that differ from the
-        // previous frame (restricted re-synthesis only).
-        let mut changed_parent: Option<[usize; 4]> = None;
-        for level in (0..=top).rev() {
-            if level < top {
-                let t = Instant::now();
-                let (w, h) = level_size(width, height, level);
-                let child = State::new(w, h);
-                cpu.upsample_jitter(&state, &child, level, &self.upsample_params(seed, level));
-                state = child;
-                timings.levels[level].upsample = t.elapsed();
-            }
-            if level <= l {
-                let t = Instant::now();
-                let lg = guides.levels.get(level);
-                let before = prev.and_then(|f| f.levels.get(level));
-                let window = match (guides.restrict, before) {
-                    (true, Some(b)) if !b.is_empty() => {
-                        let seeds = union(lg.and_then(|g| g.dirty), changed_parent.map(double));
-                        let grow =
-                            REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
-                        Some(seeds.map_or([0; 4], |b| widen(b, grow, state.width, state.height)))
-                    }
-                    _ => None,
-                };
-                for pass in 0..self.params.passes as usize {
-                    let last = before.and_then(|b| b.get(pass));
-                    let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
-                        (Some(r), Some(weights)) => Some(Coherence {
-                            coords: &r.coords,
-                            offsets: &r.offsets,
-                            weights,
-                        }),
-                        _ => None,
-                    };
-                    let guide = Guide {
-                        level: level as u32,
-                        targets: lg.and_then(|g| g.targets.as_deref()),
-                        allowed: lg.and_then(|g| g.allowed.as_deref()),
-                        coherence,
-                        window,
-                    };
-                    for &(px, py) in &SUBPASSES {
-                        let p = CorrectParams { px, py };
-                        correct::correct_guided(&self.atlas[level], &state, &p, &guide);
-                        if let (Some(win), Some(r)) = (window, last) {
-                            keep_outside(&state, r, win, p);
-                        }
-                    }
-                    if let Some(f) = frames.as_mut() {
-                        f.levels[level].push(PassResult {
-                            coords: state.coords(),
-                            offsets: state.offsets(),
-                        });
-                    }
-                }
-                changed_parent = match (window, before.and_then(|b| b.last())) {
-                    (Some(_), Some(r)) => changed_bounds(&state, r),
-                    _ => Some([0, 0, state.width, state.height]),
-                };
-                timings.levels[level].correct = t.elapsed();
-            }
-            if self.params.keep_levels {
-                kept.push(LevelMaps {
-                    level,
-                    width: state.width,
-                    height: state.height,
-                    coords: state.coords(),
-                    offsets: state.offsets(),
-                });
-            }
-        }
-        kept.reverse();
-        let t = Instant::now();
-        let fixed = cpu.reconstruct(&state)?;
-        let heightfield = self.to_metres(&fixed, state.width, width, height)?;
-        timings.reconstruct = t.elapsed();
-        timings.total = t0.elapsed();
         Ok((
             Synthesis {
                 heightfield,
@@ -561,6 +507,72 @@ impl<'db> Synthesizer<'db> {
             },
             frames,
         ))
+    }
+
+    /// The correction passes of one `w × h` level under control: each
+    /// pass's guide uploaded to the backend, its result recorded into
+    /// `frames`. With [`Guides::restrict`] and a previous frame, only the
+    /// window that can differ is corrected (the stage gives the rest the
+    /// previous result). Returns the bounds of the pixels that differ from
+    /// the previous frame's, for the level below.
+    fn correct_level<B: Backend>(
+        &self,
+        b: &B,
+        state: &B::State,
+        (level, w, h): (usize, usize, usize),
+        c: &Control<'_>,
+        changed_parent: Option<[usize; 4]>,
+        mut frames: Option<&mut Frames>,
+    ) -> Result<Option<[usize; 4]>, SynthError> {
+        let lg = c.guides.levels.get(level);
+        let before = c.prev.and_then(|f| f.levels.get(level));
+        let window = match (c.guides.restrict, before) {
+            (true, Some(b)) if !b.is_empty() => {
+                let seeds = union(lg.and_then(|g| g.dirty), changed_parent.map(double));
+                let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
+                Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
+            }
+            _ => None,
+        };
+        let mut last_result = None;
+        for pass in 0..self.params.passes as usize {
+            let last = before.and_then(|b| b.get(pass));
+            let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
+                (Some(r), Some(weights)) => Some(Coherence {
+                    coords: &r.coords,
+                    offsets: &r.offsets,
+                    weights,
+                }),
+                _ => None,
+            };
+            let guide = Guide {
+                level: level as u32,
+                targets: lg.and_then(|g| g.targets.as_deref()),
+                allowed: lg.and_then(|g| g.allowed.as_deref()),
+                coherence,
+                window,
+            };
+            let g = b.upload_guide(&guide, w, h)?;
+            for &(px, py) in &SUBPASSES {
+                b.correct_guided(state, level, &CorrectParams { px, py }, &g);
+            }
+            let is_last = pass + 1 == self.params.passes as usize;
+            if frames.is_some() || (is_last && window.is_some()) {
+                let (coords, offsets) = b.download(state)?;
+                let r = PassResult { coords, offsets };
+                match frames.as_deref_mut() {
+                    Some(f) => f.levels[level].push(r),
+                    None => last_result = Some(r),
+                }
+            }
+        }
+        let current = last_result
+            .as_ref()
+            .or_else(|| frames.and_then(|f| f.levels[level].last()));
+        Ok(match (window, before.and_then(|b| b.last()), current) {
+            (Some(_), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r),
+            _ => Some([0, 0, w, h]),
+        })
     }
 
     /// The database this synthesizer draws from.

@@ -165,6 +165,13 @@ impl<'db> Session<'db> {
         &self.synth
     }
 
+    /// The synthesizer, e.g. to move the session's stages to the GPU
+    /// ([`Synthesizer::use_backend`]): every frame runs on its backend, with
+    /// the same bytes on each.
+    pub fn synthesizer_mut(&mut self) -> &mut Synthesizer<'db> {
+        &mut self.synth
+    }
+
     /// The last frame's heights.
     pub fn heightfield(&self) -> Option<&Heightfield> {
         self.last.as_ref()

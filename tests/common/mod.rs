@@ -2,6 +2,8 @@
 #![allow(dead_code)]
 
 pub mod dem;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 
 use terrasynth::Heightfield;
 use terrasynth::io::Format;

@@ -13,10 +13,10 @@
 //! submissions, so one subpass sees the previous one's writes.
 
 use super::kernels::{
-    self, CorrectUniform, Kernel, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
-    UpsampleUniform,
+    self, CorrectUniform, GuideCell, Kernel, ReconstructUniform, ReduceTypesUniform,
+    ReduceWeightsUniform, UpsampleUniform,
 };
-use super::{Backend, BackendError, Stage, StageTime, check_raster};
+use super::{Backend, BackendError, Stage, StageTime, check_guide, check_raster};
 use crate::render::shade::{ShadeBuffers, ShadeParams};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::fixed::Coord;
@@ -377,22 +377,20 @@ struct Level {
     columns: wgpu::Buffer,
     appearance: wgpu::Buffer,
     similar: wgpu::Buffer,
-    /// Type id per texel (u8, four per word).
-    types: wgpu::Buffer,
-    seeds: wgpu::Buffer,
-    seed_counts: wgpu::Buffer,
+    /// Seed counts, seeds and texel types in one buffer (see
+    /// `kernels/correct.wgsl`'s `type_data`).
+    type_data: wgpu::Buffer,
     type_count: u32,
 }
 
-/// The control inputs of `correct` at one level on the device
-/// ([`Gpu::upload_guide`]); `None` where a control is off.
+/// The control inputs of `correct` for one pass of one level on the device
+/// ([`Backend::upload_guide`]): which controls are on, and one
+/// [`GuideCell`] per pixel when any is.
 pub struct GpuGuide {
     level: u32,
     window: Option<[usize; 4]>,
-    targets: Option<wgpu::Buffer>,
-    allowed: Option<wgpu::Buffer>,
-    /// Previous S, V and W^i.
-    coherence: Option<[wgpu::Buffer; 3]>,
+    flags: u32,
+    cells: Option<wgpu::Buffer>,
 }
 
 /// The GPU backend bound to one database: its atlas levels and level-0
@@ -405,13 +403,22 @@ pub struct Gpu {
     placeholder: wgpu::Buffer,
 }
 
-/// `v`, or one zero word when empty (a binding needs a buffer).
-fn some_words(v: &[u8]) -> Vec<u8> {
-    if v.is_empty() {
-        vec![0; 16]
-    } else {
-        v.to_vec()
+/// A level's type tables as `correct.wgsl` reads them: seed counts, seeds,
+/// then the texel types packed four per word (little-endian, like the
+/// bytes); one zero word at least (a binding needs a buffer).
+fn type_data(seed_counts: &[u32], seeds: &[u32], types: &[u8]) -> Vec<u32> {
+    let mut d = Vec::with_capacity(seed_counts.len() + seeds.len() + types.len() / 4 + 1);
+    d.extend_from_slice(seed_counts);
+    d.extend_from_slice(seeds);
+    d.extend(types.chunks(4).map(|c| {
+        let mut w = [0u8; 4];
+        w[..c.len()].copy_from_slice(c);
+        u32::from_le_bytes(w)
+    }));
+    if d.is_empty() {
+        d.push(0);
     }
+    d
 }
 
 /// One level's state on the device: S as `vec2<i32>` (the bytes of
@@ -439,19 +446,20 @@ impl Gpu {
                     appearance: ctx
                         .storage("appearance", bytemuck::cast_slice(a.level.appearance))?,
                     similar: ctx.storage("similarity", bytemuck::cast_slice(a.level.similar))?,
-                    types: ctx.storage("texel types", &some_words(a.level.types))?,
-                    seeds: ctx
-                        .storage("seeds", &some_words(bytemuck::cast_slice(a.level.seeds)))?,
-                    seed_counts: ctx.storage(
-                        "seed counts",
-                        &some_words(bytemuck::cast_slice(&a.seed_counts)),
+                    type_data: ctx.storage(
+                        "type tables",
+                        bytemuck::cast_slice(&type_data(
+                            &a.seed_counts,
+                            a.level.seeds,
+                            a.level.types,
+                        )),
                     )?,
                     type_count: a.seed_counts.len() as u32,
                 })
             })
             .collect::<Result<_, BackendError>>()?;
         let heights = ctx.storage("heights", bytemuck::cast_slice(heights))?;
-        let placeholder = ctx.storage("placeholder", &[0; 16])?;
+        let placeholder = ctx.storage("placeholder", bytemuck::bytes_of(&GuideCell::default()))?;
         Ok(Gpu {
             ctx,
             levels,
@@ -462,114 +470,6 @@ impl Gpu {
 
     pub fn context(&self) -> &Arc<Context> {
         &self.ctx
-    }
-
-    /// Moves the control inputs of a `width × height` level to the device.
-    pub fn upload_guide(
-        &self,
-        g: &Guide<'_>,
-        width: usize,
-        height: usize,
-    ) -> Result<GpuGuide, BackendError> {
-        let targets = g
-            .targets
-            .map(|t| {
-                check_raster("targets", t.len(), width, height)?;
-                let cells: Vec<[i32; 2]> = t.iter().map(|t| [t.height, t.tol]).collect();
-                self.ctx.storage("targets", bytemuck::cast_slice(&cells))
-            })
-            .transpose()?;
-        let allowed = g
-            .allowed
-            .map(|a| {
-                self.upload_raster("type sets", a, width, height)
-                    .map(|r| r.buf)
-            })
-            .transpose()?;
-        let coherence = g
-            .coherence
-            .map(|c| {
-                check_raster("previous coordinates", c.coords.len(), width, height)?;
-                check_raster("previous offsets", c.offsets.len(), width, height)?;
-                let s: Vec<u64> = c.coords.iter().map(|c| c.pack()).collect();
-                let w: Vec<u32> = c.weights.iter().map(|&w| w as u32).collect();
-                check_raster("coherence weights", w.len(), width, height)?;
-                Ok::<_, BackendError>([
-                    self.ctx.storage("previous S", bytemuck::cast_slice(&s))?,
-                    self.ctx
-                        .storage("previous V", bytemuck::cast_slice(c.offsets))?,
-                    self.ctx
-                        .storage("coherence weights", bytemuck::cast_slice(&w))?,
-                ])
-            })
-            .transpose()?;
-        Ok(GpuGuide {
-            level: g.level,
-            window: g.window,
-            targets,
-            allowed,
-            coherence,
-        })
-    }
-
-    /// One subpass of stage `correct` under control inputs (the mirror of
-    /// `correct::correct_guided`).
-    pub fn correct_guided(&self, st: &GpuState, level: usize, p: &CorrectParams, g: &GpuGuide) {
-        let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, st.width, st.height]);
-        let mut u = CorrectUniform {
-            width: st.width as u32,
-            height: st.height as u32,
-            px: p.px,
-            py: p.py,
-            level: g.level,
-            type_count: self.levels[level].type_count,
-            x0: x0 as u32,
-            y0: y0 as u32,
-            x1: x1.min(st.width) as u32,
-            y1: y1.min(st.height) as u32,
-            ..Default::default()
-        };
-        let none = &self.placeholder;
-        if g.targets.is_some() {
-            u.flags |= kernels::CORRECT_TARGETS;
-        }
-        if g.allowed.is_some() {
-            u.flags |= kernels::CORRECT_ALLOWED;
-        }
-        if g.coherence.is_some() {
-            u.flags |= kernels::CORRECT_COHERENCE;
-        }
-        let [prev_s, prev_v, weights] = match &g.coherence {
-            Some([s, v, w]) => [s, v, w],
-            None => [none, none, none],
-        };
-        let l = &self.levels[level];
-        // Pixels of the parity class per axis: ⌈(n − parity) / 2⌉.
-        let class = |n: usize, parity: u32| (n - parity as usize).div_ceil(2);
-        self.ctx.dispatch(
-            Some((Stage::Correct, level)),
-            &self.ctx.correct,
-            bytemuck::bytes_of(&u),
-            &[
-                &st.s,
-                &st.v,
-                &l.columns,
-                &l.appearance,
-                &l.similar,
-                &l.types,
-                &l.seeds,
-                &l.seed_counts,
-                g.targets.as_ref().unwrap_or(none),
-                g.allowed.as_ref().unwrap_or(none),
-                prev_s,
-                prev_v,
-                weights,
-            ],
-            (
-                groups(class(st.width, p.px)),
-                groups(class(st.height, p.py)),
-            ),
-        );
     }
 }
 
@@ -629,6 +529,7 @@ impl Backend for Gpu {
     type State = GpuState;
     type Types = GpuRaster;
     type Weights = GpuRaster;
+    type Guide<'g> = GpuGuide;
 
     fn name(&self) -> &'static str {
         "gpu"
@@ -704,11 +605,97 @@ impl Backend for Gpu {
         let none = GpuGuide {
             level: level as u32,
             window: None,
-            targets: None,
-            allowed: None,
-            coherence: None,
+            flags: 0,
+            cells: None,
         };
         self.correct_guided(st, level, p, &none);
+    }
+
+    fn upload_guide(
+        &self,
+        g: &Guide<'_>,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuGuide, BackendError> {
+        check_guide(g, width, height)?;
+        let mut flags = 0;
+        for (on, flag) in [
+            (g.targets.is_some(), kernels::CORRECT_TARGETS),
+            (g.allowed.is_some(), kernels::CORRECT_ALLOWED),
+            (g.coherence.is_some(), kernels::CORRECT_COHERENCE),
+        ] {
+            if on {
+                flags |= flag;
+            }
+        }
+        let cells = (flags != 0)
+            .then(|| {
+                let cells: Vec<GuideCell> = (0..width * height)
+                    .map(|i| {
+                        let mut c = GuideCell::default();
+                        if let Some(t) = g.targets {
+                            c.blend_target = [t[i].height, t[i].tol];
+                        }
+                        if let Some(a) = g.allowed {
+                            c.allowed = a[i];
+                        }
+                        if let Some(co) = g.coherence {
+                            c.weight = co.weights[i] as u32;
+                            c.prev_s = bytemuck::cast(co.coords[i].pack());
+                            c.prev_v = co.offsets[i];
+                        }
+                        c
+                    })
+                    .collect();
+                self.ctx
+                    .storage("control inputs", bytemuck::cast_slice(&cells))
+            })
+            .transpose()?;
+        Ok(GpuGuide {
+            level: g.level,
+            window: g.window,
+            flags,
+            cells,
+        })
+    }
+
+    fn correct_guided(&self, st: &GpuState, level: usize, p: &CorrectParams, g: &GpuGuide) {
+        let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, st.width, st.height]);
+        let mut u = CorrectUniform {
+            width: st.width as u32,
+            height: st.height as u32,
+            px: p.px,
+            py: p.py,
+            level: g.level,
+            type_count: self.levels[level].type_count,
+            x0: x0 as u32,
+            y0: y0 as u32,
+            x1: x1.min(st.width) as u32,
+            y1: y1.min(st.height) as u32,
+            ..Default::default()
+        };
+        u.flags = g.flags;
+        let l = &self.levels[level];
+        // Pixels of the parity class per axis: ⌈(n − parity) / 2⌉.
+        let class = |n: usize, parity: u32| (n - parity as usize).div_ceil(2);
+        self.ctx.dispatch(
+            Some((Stage::Correct, level)),
+            &self.ctx.correct,
+            bytemuck::bytes_of(&u),
+            &[
+                &st.s,
+                &st.v,
+                &l.columns,
+                &l.appearance,
+                &l.similar,
+                &l.type_data,
+                g.cells.as_ref().unwrap_or(&self.placeholder),
+            ],
+            (
+                groups(class(st.width, p.px)),
+                groups(class(st.height, p.py)),
+            ),
+        );
     }
 
     fn reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {

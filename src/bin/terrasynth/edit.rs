@@ -2,7 +2,7 @@
 //! editing session (coherent re-synthesis between frames).
 
 use crate::CliResult;
-use crate::args::load_database;
+use crate::args::{BackendArg, load_database, select_backend};
 use std::path::{Path, PathBuf};
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::scene::{Scene, SceneEdits, overlay};
@@ -28,6 +28,10 @@ pub struct Args {
     /// Re-synthesize every frame from scratch (no coherence), for comparison.
     #[arg(long)]
     no_coherence: bool,
+    /// Where the stages run: cpu, gpu (`--features gpu` builds) or auto.
+    /// Same frames, byte for byte, on each.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 /// `synth --scene`: one scene, one output.
@@ -36,6 +40,7 @@ pub fn synth_scene(
     output: &Path,
     preview: Option<&Path>,
     overlay: bool,
+    backend: BackendArg,
 ) -> CliResult {
     let scene = Scene::read(scene)?;
     let db = load_database(scene.database.as_deref())?;
@@ -48,6 +53,7 @@ pub fn synth_scene(
         scene.height,
         scene.seed,
     )?;
+    select_backend(session.synthesizer_mut(), backend)?;
     let frame = session.apply(first)?;
     io::write(&frame.heightfield, output, &WriteOptions::default())?;
     let s = frame.heightfield.stats().expect("synthesis has no nodata");
@@ -94,6 +100,7 @@ pub fn run(a: Args) -> CliResult {
         base.seed,
     )?;
     session.coherence = !a.no_coherence;
+    select_backend(session.synthesizer_mut(), a.backend)?;
     let mut report = Vec::new();
     let files: Vec<PathBuf> = std::iter::once(a.base.clone())
         .chain(a.edits.iter().cloned())

@@ -53,7 +53,13 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     if let Some(scene) = &a.scene {
-        return crate::edit::synth_scene(scene, &a.output, a.preview.as_deref(), !a.no_overlay);
+        return crate::edit::synth_scene(
+            scene,
+            &a.output,
+            a.preview.as_deref(),
+            !a.no_overlay,
+            a.backend,
+        );
     }
     let db = load_database(a.db.as_deref())?;
     let params = Params {

@@ -92,8 +92,10 @@ pub struct Guide<'a> {
     /// Coherence: the previous frame's result of this level and pass, one
     /// more candidate per pixel with its cost × W/4.
     pub coherence: Option<Coherence<'a>>,
-    /// Only pixels inside `[x0, y0, x1, y1)` are corrected (the rest are
-    /// known to keep their previous result, see `synth::session`).
+    /// Only pixels inside `[x0, y0, x1, y1)` are corrected. The rest are
+    /// known to reproduce the previous frame's result (see
+    /// `synth::Guides::restrict`): with [`Guide::coherence`] they take it
+    /// (its S and V as they are), without it they keep their state.
     pub window: Option<[usize; 4]>,
 }
 
@@ -147,6 +149,7 @@ pub fn correct(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams) {
 /// through the scalar path (seeding is rare and lives there); geometric and
 /// coherence controls run in both paths with the same integer arithmetic.
 pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: &Guide<'_>) {
+    keep_outside(st, p, g);
     let (w, h) = (st.width, st.height);
     let [wx0, wy0, wx1, wy1] = g.window.unwrap_or([0, 0, w, h]);
     let px = p.px as usize;
@@ -176,5 +179,29 @@ pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: 
             (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
                 .step_by(2)
                 .for_each(scalar_at);
+        });
+}
+
+/// The subpass's pixels outside [`Guide::window`] take the previous frame's
+/// result of this pass (what a full subpass would compute there), so a
+/// windowed subpass leaves the same state as a full one. Part of the stage
+/// rather than of its caller so that every backend does it where the state
+/// lives (the WGSL kernel's invocations outside the window do the same).
+pub fn keep_outside(st: &State, p: &CorrectParams, g: &Guide<'_>) {
+    let (Some([x0, y0, x1, y1]), Some(c)) = (g.window, g.coherence) else {
+        return;
+    };
+    let w = st.width;
+    (p.py as usize..st.height)
+        .into_par_iter()
+        .step_by(2)
+        .for_each(|y| {
+            let inside_row = (y0..y1).contains(&y);
+            for x in (p.px as usize..w).step_by(2) {
+                if !(inside_row && (x0..x1).contains(&x)) {
+                    let i = y * w + x;
+                    st.set(i, c.coords[i], c.offsets[i]);
+                }
+            }
         });
 }

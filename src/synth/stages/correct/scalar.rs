@@ -280,6 +280,7 @@ pub fn correct(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams) {
 
 /// [`correct`] with control inputs (the oracle of `super::correct_guided`).
 pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: &Guide<'_>) {
+    super::keep_outside(st, p, g);
     let (w, h) = (st.width, st.height);
     let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, w, h]);
     (p.py as usize..y1.min(h))
