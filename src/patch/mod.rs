@@ -657,8 +657,8 @@ pub(crate) fn select(
     // absolute level: otherwise separate components (Zhou's λ inside its
     // circle) start hundreds of metres apart and the fill between them
     // turns that into basins and plateaus the sketch never asked for.
-    let overlaps = (0..win.n * win.n)
-        .any(|i| c.filled[(win.y0 + i / win.n) * c.width + win.x0 + i % win.n]);
+    let overlaps =
+        (0..win.n * win.n).any(|i| c.filled[(win.y0 + i / win.n) * c.width + win.x0 + i % win.n]);
     let level = if overlaps {
         None
     } else {
