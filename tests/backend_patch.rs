@@ -135,3 +135,55 @@ fn fill_ssd_matches_on_shared_dem_sources() {
         "pyrenees candidates vs a thuringia window",
     );
 }
+
+/// End to end: a Y-branch sketch built from two shared-DEM crops, with
+/// stage `fill_ssd` on each backend, writes the same heights.
+#[test]
+fn sketch_synthesis_matches_end_to_end() {
+    use terrasynth::backend::Choice;
+    use terrasynth::patch::fill_cost::FillCost;
+    use terrasynth::patch::sketch::Sketch;
+    use terrasynth::patch::{self, Library, Params};
+    use terrasynth::progress::Silent;
+    if common::gpu::context().is_none() {
+        return;
+    }
+    let mut src = Vec::new();
+    for name in ["pyrenees_andorra", "thuringia_hills"] {
+        let Ok(hf) = terrasynth::io::read(
+            &Path::new(DEM).join(format!("{name}.png")),
+            &Default::default(),
+        ) else {
+            eprintln!("skipping: the shared DEMs are not in {DEM}");
+            return;
+        };
+        src.push((name.to_string(), hf.crop(200, 200, 256, 256).unwrap()));
+    }
+    let params = Params {
+        patch: 32,
+        ..Params::default()
+    };
+    let lib = Library::prepare(&src, &params, &Silent).unwrap();
+    let sketch = Sketch::from_json(
+        br#"{"width": 160, "height": 160, "strokes": [
+        {"kind": "ridge", "width": 8, "points": [[80, 90], [30, 20]]},
+        {"kind": "ridge", "width": 8, "points": [[80, 90], [130, 20]]},
+        {"kind": "valley", "width": 8, "points": [[20, 80], [45, 150]]}]}"#,
+        Path::new("y.json"),
+    )
+    .unwrap();
+    let run = |choice| {
+        let (cost, notice) = FillCost::choose(choice, &lib).unwrap();
+        assert!(notice.is_none(), "{notice:?}");
+        let s = patch::synthesize_with(&lib, &sketch, 160, 160, &cost, &Silent).unwrap();
+        (cost.name(), s)
+    };
+    let (cpu_name, cpu) = run(Choice::Cpu);
+    let (gpu_name, gpu) = run(Choice::Gpu);
+    assert_eq!((cpu_name, gpu_name), ("cpu", "gpu"));
+    assert!(gpu.stats.fill_patches > 0, "the fill stage must have run");
+    let (a, b) = (cpu.heightfield.data(), gpu.heightfield.data());
+    if let Some(i) = (0..a.len()).find(|&i| a[i].to_bits() != b[i].to_bits()) {
+        panic!("pixel {i}: GPU {} vs CPU {}", b[i], a[i]);
+    }
+}

@@ -27,6 +27,7 @@ pub mod cache;
 pub mod candidates;
 pub mod costs;
 pub mod fill;
+pub mod fill_cost;
 pub mod graph;
 pub mod graphcut;
 pub mod merge;
@@ -80,6 +81,8 @@ pub enum PatchError {
         found: usize,
         expected: usize,
     },
+    #[error(transparent)]
+    Backend(#[from] crate::backend::BackendError),
     #[error("cannot start a worker thread: {0}")]
     Pool(String),
     #[error(transparent)]
@@ -719,6 +722,19 @@ pub fn synthesize(
     h: usize,
     progress: &dyn Progress,
 ) -> Result<Synthesis, PatchError> {
+    synthesize_with(lib, sketch, w, h, &fill_cost::FillCost::Cpu, progress)
+}
+
+/// [`synthesize`] with stage `fill_ssd` on the backend `cost` (same bytes
+/// on each; see [`fill_cost`]).
+pub fn synthesize_with(
+    lib: &Library,
+    sketch: &Sketch,
+    w: usize,
+    h: usize,
+    cost: &fill_cost::FillCost,
+    progress: &dyn Progress,
+) -> Result<Synthesis, PatchError> {
     let params = &lib.params;
     params.check()?;
     let n = params.patch;
@@ -836,11 +852,11 @@ pub fn synthesize(
         lib,
         &mut canvas,
         &mut uses,
-        &mut timings,
-        &mut stats,
+        (&mut timings, &mut stats),
         &solo,
+        cost,
         progress,
-    );
+    )?;
     remove_drift(&mut canvas.heights, w, h, n);
     deform_by_sketch(&mut canvas.heights, &field, w, h, n, params.sketch_relief);
     let cell = median_cell(lib);
