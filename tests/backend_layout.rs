@@ -4,8 +4,8 @@
 
 use std::mem::{offset_of, size_of};
 use terrasynth::backend::kernels::{
-    self, CorrectUniform, GuideCell, ReconstructUniform, ReduceTypesUniform, ReduceWeightsUniform,
-    UpsampleUniform,
+    self, CorrectUniform, FillSsdUniform, GuideCell, ReconstructUniform, ReduceTypesUniform,
+    ReduceWeightsUniform, UpsampleUniform,
 };
 use terrasynth::render::shade::ShadeParams;
 use terrasynth::synth::atlas::Column;
@@ -164,6 +164,15 @@ fn parameter_structs_match_their_wgsl_declarations() {
             y0,
             x1,
             y1
+        })
+    );
+    assert_eq!(
+        wgsl_struct(&module(kernels::FILL_SSD), "FillSsdParams"),
+        rust_layout!(FillSsdUniform {
+            cells,
+            candidates,
+            transforms,
+            pad0
         })
     );
     assert_eq!(

@@ -50,14 +50,19 @@ pub const REDUCE_WEIGHTS: Kernel = kernel!("reduce_weights");
 /// `render::shade::ShadeParams` itself, already `#[repr(C)]` and Pod.
 pub const SHADE: Kernel = kernel!("shade");
 
+/// The patch engine's data-parallel cost stage (`patch::costs`, round one
+/// of hole filling).
+pub const FILL_SSD: Kernel = kernel!("fill_ssd");
+
 /// Every kernel, for tests that check them all.
-pub const ALL: [Kernel; 6] = [
+pub const ALL: [Kernel; 7] = [
     UPSAMPLE_JITTER,
     CORRECT,
     REDUCE_TYPES,
     REDUCE_WEIGHTS,
     RECONSTRUCT,
     SHADE,
+    FILL_SSD,
 ];
 
 /// Workgroup side of every kernel (`@workgroup_size(8, 8)`).
@@ -166,4 +171,14 @@ pub struct ReduceWeightsUniform {
     pub height: u32,
     pub child_width: u32,
     pub child_height: u32,
+}
+
+/// `FillSsdParams` of `kernels/fill_ssd.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct FillSsdUniform {
+    pub cells: u32,
+    pub candidates: u32,
+    pub transforms: u32,
+    pub pad0: u32,
 }

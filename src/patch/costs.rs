@@ -337,8 +337,11 @@ pub fn fill_ssd_scalar(user: &[i32], mask: &[i32], cand: &[i32], k: i64) -> u64 
     dc_ssd(s, s2, k)
 }
 
+/// The DC-corrected SSD `(k·s2 − s²) / k²` (floor; 0 when `k = 0`) from
+/// the sums `s = Σd`, `s2 = Σd²` over `k` cells: the last step of
+/// [`fill_ssd`], shared by the GPU path, whose kernel returns the sums.
 #[inline]
-fn dc_ssd(s: i64, s2: i64, k: i64) -> u64 {
+pub fn dc_ssd(s: i64, s2: i64, k: i64) -> u64 {
     if k > 0 {
         ((k * s2 - s * s) / (k * k)) as u64
     } else {
@@ -375,4 +378,26 @@ pub fn fill_ssd(user: &[i32], mask: &[i32], cand: &[i32], k: i64) -> u64 {
         s2 += d * d;
     }
     dc_ssd(s, s2, k)
+}
+
+/// Round one of hole filling for one source: [`fill_ssd`] of every
+/// candidate (`cells.len() / user.len() * transforms` of them, each
+/// `user[v].len()` cells, contiguous in `cells`) under every transform `v`
+/// (`user[v]`, `mask[v]`), candidate-major: entry `k · transforms + v`.
+/// Data-parallel over candidates; `backend::gpu::fill_ssd` computes the
+/// same table on the GPU.
+pub fn fill_ssd_table(user: &[Vec<i32>], mask: &[Vec<i32>], cells: &[i32], k: i64) -> Vec<u64> {
+    use rayon::prelude::*;
+    let per = user.first().map_or(0, Vec::len);
+    if per == 0 {
+        return Vec::new();
+    }
+    cells
+        .par_chunks(per)
+        .flat_map_iter(|c| {
+            user.iter()
+                .zip(mask)
+                .map(move |(u, m)| fill_ssd(u, m, c, k))
+        })
+        .collect()
 }

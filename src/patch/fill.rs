@@ -10,16 +10,19 @@
 //! Candidates: every source's patches on a patch/2 grid under 6 transforms
 //! (four 90° rotations and two mirrors, which need no resampling). Round
 //! one is integer and data-parallel: DC-corrected SSD against the window's
-//! fully filled 8×8 cells on the 8× reduced grid ([`fill_ssd`], explicit
-//! SIMD), plus the noise-variance difference; the user window is permuted
+//! fully filled 8×8 cells on the 8× reduced grid (stage `fill_ssd`, explicit
+//! SIMD or the GPU: [`super::fill_cost`]), plus the noise-variance difference; the user window is permuted
 //! into each transform's frame once, and every candidate's cells are stored
 //! contiguously, so the kernel streams both. The best 5 per
 //! source go to round two and the graph-cut finalists ([`super::select`]).
 
 use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
-use super::costs::{centre_cells, fill_ssd, noise_cost};
+use super::costs::{centre_cells, noise_cost};
+use super::fill_cost::FillCost;
 use super::merge::{self, Canvas, Window};
-use super::{Library, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window};
+use super::{
+    Library, PatchError, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window,
+};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -235,10 +238,10 @@ pub(crate) fn fill(
     lib: &Library,
     canvas: &mut Canvas,
     uses: &mut BTreeMap<(usize, u8, u32), u32>,
-    timings: &mut Timings,
-    stats: &mut Stats,
+    (timings, stats): (&mut Timings, &mut Stats),
+    cost: &FillCost,
     progress: &dyn Progress,
-) {
+) -> Result<(), PatchError> {
     let params = &lib.params;
     let n = params.patch;
     let m = n / COARSE;
@@ -304,32 +307,33 @@ pub(crate) fn fill(
             }
         }
         let count = centre_cells(&mut uc, Some(&uv));
-        let perms: Vec<(Vec<i32>, Vec<i32>)> = (0..FILL_TRANSFORMS)
-            .map(|v| {
-                let mut a = vec![0i32; m * m];
-                let mut mask = vec![0i32; m * m];
-                for cy in 0..m {
-                    for cx in 0..m {
-                        let (sx, sy) = fill_map(v, cx, cy, m);
-                        a[sy * m + sx] = uc[cy * m + cx];
-                        mask[sy * m + sx] = -(uv[cy * m + cx] as i32);
-                    }
+        let (mut users, mut masks) = (Vec::new(), Vec::new());
+        for v in 0..FILL_TRANSFORMS {
+            let mut a = vec![0i32; m * m];
+            let mut mask = vec![0i32; m * m];
+            for cy in 0..m {
+                for cx in 0..m {
+                    let (sx, sy) = fill_map(v, cx, cy, m);
+                    a[sy * m + sx] = uc[cy * m + cx];
+                    mask[sy * m + sx] = -(uv[cy * m + cx] as i32);
                 }
-                (a, mask)
-            })
-            .collect();
+            }
+            users.push(a);
+            masks.push(mask);
+        }
         let mut best: Vec<(usize, u32, u8)> = Vec::new();
         for (si, src) in lib.sources.iter().enumerate() {
+            let table = cost.table(lib, si, &users, &masks, count)?;
             let mut scored: Vec<(u64, u32, u8)> = src
                 .fill
                 .par_iter()
-                .zip(src.fill_cells.par_chunks(m * m))
+                .zip(table.par_chunks(FILL_TRANSFORMS))
                 .enumerate()
-                .map(|(k, (fc, cells))| {
+                .map(|(k, (fc, ssd))| {
                     let nc = noise_cost(&uw.noise, &fc.noise) * params.weights.fill_noise;
                     let mut b = (u64::MAX, 0u8);
-                    for (v, (a, mask)) in perms.iter().enumerate() {
-                        let cost = fill_ssd(a, mask, cells, count).saturating_add(nc);
+                    for (v, &d) in ssd.iter().enumerate() {
+                        let cost = d.saturating_add(nc);
                         if cost < b.0 {
                             b = (cost, v as u8);
                         }
@@ -392,4 +396,5 @@ pub(crate) fn fill(
         timings.fill_merge += t3.elapsed();
     }
     progress.finish();
+    Ok(())
 }

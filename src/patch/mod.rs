@@ -35,6 +35,7 @@ pub mod cache;
 pub mod candidates;
 pub mod costs;
 pub mod fill;
+pub mod fill_cost;
 pub mod graph;
 pub mod graphcut;
 pub mod merge;
@@ -88,6 +89,8 @@ pub enum PatchError {
         found: usize,
         expected: usize,
     },
+    #[error(transparent)]
+    Backend(#[from] crate::backend::BackendError),
     #[error(transparent)]
     Other(#[from] crate::Error),
 }
@@ -730,6 +733,19 @@ pub fn synthesize(
     h: usize,
     progress: &dyn Progress,
 ) -> Result<Synthesis, PatchError> {
+    synthesize_with(lib, sketch, w, h, &fill_cost::FillCost::Cpu, progress)
+}
+
+/// [`synthesize`] with stage `fill_ssd` on the backend `cost` (same bytes
+/// on each; see [`fill_cost`]).
+pub fn synthesize_with(
+    lib: &Library,
+    sketch: &Sketch,
+    w: usize,
+    h: usize,
+    cost: &fill_cost::FillCost,
+    progress: &dyn Progress,
+) -> Result<Synthesis, PatchError> {
     let params = &lib.params;
     params.check()?;
     let n = params.patch;
@@ -844,10 +860,10 @@ pub fn synthesize(
         lib,
         &mut canvas,
         &mut uses,
-        &mut timings,
-        &mut stats,
+        (&mut timings, &mut stats),
+        cost,
         progress,
-    );
+    )?;
     remove_drift(&mut canvas.heights, w, h, n);
     deform_by_sketch(&mut canvas.heights, &field, w, h, n, params.sketch_relief);
     // The merge fixes heights only up to a constant: put the lowest point

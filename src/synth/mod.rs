@@ -141,7 +141,7 @@ pub struct Guides {
 /// One level's control rasters (level-sized, row-major).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LevelGuide {
-    /// Geometric targets (levels ≥ 2).
+    /// Geometric targets (every level: see `control::blend`).
     pub targets: Option<Vec<Target>>,
     /// Type target sets R^i (levels ≥ 2).
     pub allowed: Option<Vec<u32>>,

@@ -11,6 +11,10 @@
 //! Each stage call records one command buffer and submits it; the queue
 //! runs them in order, and wgpu orders storage-buffer accesses across
 //! submissions, so one subpass sees the previous one's writes.
+//!
+//! The patch engine's data-parallel cost stage lives in [`fill_ssd`].
+
+pub mod fill_ssd;
 
 use super::kernels::{
     self, CorrectUniform, GuideCell, Kernel, ReconstructUniform, ReduceTypesUniform,
@@ -41,6 +45,7 @@ pub struct Context {
     reduce_weights: wgpu::ComputePipeline,
     reconstruct: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
+    fill_ssd: wgpu::ComputePipeline,
     /// Timestamp queries, where the adapter has them.
     profile: Option<Mutex<Profile>>,
 }
@@ -113,6 +118,7 @@ impl Context {
         let reduce_weights = pipeline(kernels::REDUCE_WEIGHTS);
         let reconstruct = pipeline(kernels::RECONSTRUCT);
         let shade = pipeline(kernels::SHADE);
+        let fill_ssd = pipeline(kernels::FILL_SSD);
         if let Some(e) = scope.pop().await {
             return Err(BackendError::Gpu(e.to_string()));
         }
@@ -139,6 +145,7 @@ impl Context {
             reduce_weights,
             reconstruct,
             shade,
+            fill_ssd,
         }))
     }
 

@@ -83,18 +83,23 @@ pub enum BackendArg {
     Auto,
 }
 
+impl From<BackendArg> for terrasynth::backend::Choice {
+    fn from(a: BackendArg) -> Self {
+        use terrasynth::backend::Choice;
+        match a {
+            BackendArg::Cpu => Choice::Cpu,
+            BackendArg::Gpu => Choice::Gpu,
+            BackendArg::Auto => Choice::Auto,
+        }
+    }
+}
+
 /// Moves `synth` to the requested backend, printing Auto's fallback notice.
 pub fn select_backend(
     synth: &mut terrasynth::synth::Synthesizer<'_>,
     arg: BackendArg,
 ) -> Result<(), terrasynth::synth::SynthError> {
-    use terrasynth::backend::Choice;
-    let choice = match arg {
-        BackendArg::Cpu => Choice::Cpu,
-        BackendArg::Gpu => Choice::Gpu,
-        BackendArg::Auto => Choice::Auto,
-    };
-    if let Some(notice) = synth.use_backend(choice)? {
+    if let Some(notice) = synth.use_backend(arg.into())? {
         eprintln!("note: {notice}");
     }
     Ok(())

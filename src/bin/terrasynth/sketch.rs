@@ -2,11 +2,11 @@
 //! patches of real DEMs (seeds 001, 004).
 
 use crate::CliResult;
-use crate::args::{Input, parse_size};
+use crate::args::{BackendArg, Input, parse_size};
 use crate::progress::Bar;
 use std::path::PathBuf;
 use terrasynth::io::{self, WriteOptions};
-use terrasynth::patch::{self, Library, Params, sketch::Sketch};
+use terrasynth::patch::{self, Library, Params, fill_cost::FillCost, sketch::Sketch};
 use terrasynth::render::{self, RenderOptions};
 
 const ABOUT: &str = "\
@@ -48,6 +48,10 @@ pub struct Args {
     /// Prepare every source from scratch and cache nothing.
     #[arg(long, conflicts_with = "cache_dir")]
     no_cache: bool,
+    /// Where the data-parallel cost stage (`fill_ssd`) runs: cpu, gpu
+    /// (`--features gpu` builds) or auto. Same output bytes on each.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
     #[command(flatten)]
     read: Input,
 }
@@ -80,15 +84,20 @@ pub fn run(a: Args) -> CliResult {
         Library::prepare_cached(&sources, &params, &dir, &bar)?
     };
     let prep_ms = t_prep.elapsed().as_secs_f64() * 1e3;
-    let result = patch::synthesize(&lib, &sketch, w, h, &bar)?;
+    let (cost, notice) = FillCost::choose(a.backend.into(), &lib)?;
+    if let Some(n) = notice {
+        eprintln!("note: {n}");
+    }
+    let result = patch::synthesize_with(&lib, &sketch, w, h, &cost, &bar)?;
     io::write(&result.heightfield, &a.output, &WriteOptions::default())?;
     let t = &result.timings;
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let s = &result.stats;
     eprintln!(
-        "wrote {} ({w} x {h}) from {} source(s): {} user patches, {} feature + {} fill patches",
+        "wrote {} ({w} x {h}) from {} source(s), fill costs on the {}: {} user patches, {} feature + {} fill patches",
         a.output.display(),
         lib.sources.len(),
+        cost.name(),
         s.user_patches,
         s.feature_patches,
         s.fill_patches

@@ -1,0 +1,92 @@
+//! Where round one of hole filling runs — stage `fill_ssd`, the patch
+//! engine's data-parallel cost (DESIGN §7): on the CPU
+//! ([`super::costs::fill_ssd_table`], rayon over candidates, `wide` SIMD
+//! over cells) or, with the `gpu` feature, as `kernels/fill_ssd.wgsl`, with
+//! every source's candidate cells uploaded once per synthesis. Both give
+//! the same table, so the same terrain bytes.
+
+use super::costs::fill_ssd_table;
+use super::{Library, PatchError};
+use crate::backend::Choice;
+
+/// The backend of stage `fill_ssd`.
+pub enum FillCost {
+    /// rayon + SIMD, the reference.
+    Cpu,
+    /// The WGSL kernel; one device buffer per source.
+    #[cfg(feature = "gpu")]
+    Gpu {
+        ctx: std::sync::Arc<crate::backend::gpu::Context>,
+        sources: Vec<crate::backend::gpu::fill_ssd::FillSource>,
+    },
+}
+
+impl FillCost {
+    /// The backend `choice` names for `lib`, and a one-line notice when
+    /// [`Choice::Auto`] found no GPU and stays on the CPU.
+    pub fn choose(choice: Choice, lib: &Library) -> Result<(FillCost, Option<String>), PatchError> {
+        #[cfg(feature = "gpu")]
+        {
+            use crate::backend::gpu::Context;
+            let ctx = match choice {
+                Choice::Cpu => return Ok((FillCost::Cpu, None)),
+                Choice::Gpu => Context::new()?,
+                Choice::Auto => match Context::new() {
+                    Ok(ctx) => ctx,
+                    Err(e) => return Ok((FillCost::Cpu, Some(format!("{e}; using the CPU")))),
+                },
+            };
+            let m = lib.params.patch / super::candidates::COARSE;
+            let sources = lib
+                .sources
+                .iter()
+                .map(|s| ctx.upload_fill_source(&s.fill_cells, m * m))
+                .collect::<Result<_, _>>()?;
+            Ok((FillCost::Gpu { ctx, sources }, None))
+        }
+        #[cfg(not(feature = "gpu"))]
+        {
+            let _ = lib;
+            use crate::backend::BackendError;
+            match choice {
+                Choice::Cpu => Ok((FillCost::Cpu, None)),
+                Choice::Gpu => Err(BackendError::NotCompiled.into()),
+                Choice::Auto => Ok((
+                    FillCost::Cpu,
+                    Some(format!("{}; using the CPU", BackendError::NotCompiled)),
+                )),
+            }
+        }
+    }
+
+    /// `"cpu"` or `"gpu"`, for reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            FillCost::Cpu => "cpu",
+            #[cfg(feature = "gpu")]
+            FillCost::Gpu { .. } => "gpu",
+        }
+    }
+
+    /// Source `si`'s round-one table against one window (see
+    /// [`fill_ssd_table`]): entry `k · transforms + v`.
+    pub(crate) fn table(
+        &self,
+        lib: &Library,
+        si: usize,
+        user: &[Vec<i32>],
+        mask: &[Vec<i32>],
+        count: i64,
+    ) -> Result<Vec<u64>, PatchError> {
+        match self {
+            FillCost::Cpu => Ok(fill_ssd_table(
+                user,
+                mask,
+                &lib.sources[si].fill_cells,
+                count,
+            )),
+            #[cfg(feature = "gpu")]
+            FillCost::Gpu { ctx, sources } => Ok(ctx.fill_ssd(&sources[si], user, mask, count)?),
+        }
+    }
+}
