@@ -79,6 +79,41 @@ pub struct SolveReport {
 
 const CHUNK: usize = 4096;
 
+/// The checks both solvers make before touching anything: every slice
+/// `width × height` long, fixed values and `f` finite, at least one fixed
+/// pixel (otherwise the solution is defined only up to a constant).
+fn check_inputs(
+    width: usize,
+    height: usize,
+    u: &[f32],
+    fixed: &[bool],
+    rhs: Option<&[f32]>,
+) -> Result<(), PoissonError> {
+    let n = width * height;
+    for len in [u.len(), fixed.len(), rhs.map_or(n, |r| r.len())] {
+        if len != n {
+            return Err(PoissonError::Length {
+                width,
+                height,
+                found: len,
+            });
+        }
+    }
+    for i in 0..n {
+        let bad_fixed = fixed[i] && !u[i].is_finite();
+        if bad_fixed || rhs.is_some_and(|r| !r[i].is_finite()) {
+            return Err(PoissonError::NotFinite {
+                x: i % width,
+                y: i / width,
+            });
+        }
+    }
+    if !fixed.iter().any(|&f| f) {
+        return Err(PoissonError::NothingFixed);
+    }
+    Ok(())
+}
+
 /// Solves in place. `u` holds the boundary values at fixed pixels (read) and
 /// the initial guess at free pixels (ignored: the cascadic start replaces it);
 /// on return the free pixels hold the solution. `rhs` is `f` (zero if `None`).
@@ -90,31 +125,8 @@ pub fn solve(
     rhs: Option<&[f32]>,
     opts: &SolveOptions,
 ) -> Result<SolveReport, PoissonError> {
+    check_inputs(width, height, u, fixed, rhs)?;
     let n = width * height;
-    for len in [u.len(), fixed.len(), rhs.map_or(n, |r| r.len())] {
-        if len != n {
-            return Err(PoissonError::Length {
-                width,
-                height,
-                found: len,
-            });
-        }
-    }
-    let mut any_fixed = false;
-    for i in 0..n {
-        let bad_fixed = fixed[i] && !u[i].is_finite();
-        let bad_rhs = rhs.is_some_and(|r| !r[i].is_finite());
-        if bad_fixed || bad_rhs {
-            return Err(PoissonError::NotFinite {
-                x: i % width,
-                y: i / width,
-            });
-        }
-        any_fixed |= fixed[i];
-    }
-    if !any_fixed {
-        return Err(PoissonError::NothingFixed);
-    }
     let unknowns = fixed.iter().filter(|&&f| !f).count();
     if unknowns == 0 {
         return Ok(SolveReport {
@@ -567,28 +579,8 @@ pub fn solve_mg(
     rhs: Option<&[f32]>,
     opts: &SolveOptions,
 ) -> Result<SolveReport, PoissonError> {
+    check_inputs(width, height, u, fixed, rhs)?;
     let n = width * height;
-    for len in [u.len(), fixed.len(), rhs.map_or(n, |r| r.len())] {
-        if len != n {
-            return Err(PoissonError::Length {
-                width,
-                height,
-                found: len,
-            });
-        }
-    }
-    for i in 0..n {
-        let bad_fixed = fixed[i] && !u[i].is_finite();
-        if bad_fixed || rhs.is_some_and(|r| !r[i].is_finite()) {
-            return Err(PoissonError::NotFinite {
-                x: i % width,
-                y: i / width,
-            });
-        }
-    }
-    if !fixed.iter().any(|&f| f) {
-        return Err(PoissonError::NothingFixed);
-    }
     let mut levels = vec![Level::finest(width, height, fixed)];
     while let Some(l) = levels.last()
         && l.w.max(l.h) > 4

@@ -7,31 +7,17 @@
 
 use proptest::prelude::*;
 use std::path::Path;
-use terrasynth::patch::candidates::{COARSE, FILL_TRANSFORMS, PreparedSource, fill_map};
+use terrasynth::patch::candidates::{COARSE, PreparedSource};
 use terrasynth::patch::costs::{FILL_CLAMP, centre_cells, fill_ssd_scalar, fill_ssd_table};
+use terrasynth::patch::fill::user_cells;
 
 mod common;
 use common::dem::DEM;
 
-/// The user's `m × m` cells (centred over `valid`) permuted into every
-/// transform's frame, with all-bits masks, as `patch::fill` builds them.
+/// The user's `m × m` cells permuted into every transform's frame, as
+/// `patch::fill` builds them.
 fn perms(cells: &[i32], valid: &[bool], m: usize) -> (Vec<Vec<i32>>, Vec<Vec<i32>>, i64) {
-    let mut c = cells.to_vec();
-    let count = centre_cells(&mut c, Some(valid));
-    let (mut user, mut mask) = (Vec::new(), Vec::new());
-    for v in 0..FILL_TRANSFORMS {
-        let (mut a, mut k) = (vec![0i32; m * m], vec![0i32; m * m]);
-        for cy in 0..m {
-            for cx in 0..m {
-                let (sx, sy) = fill_map(v, cx, cy, m);
-                a[sy * m + sx] = c[cy * m + cx];
-                k[sy * m + sx] = -(valid[cy * m + cx] as i32);
-            }
-        }
-        user.push(a);
-        mask.push(k);
-    }
-    (user, mask, count)
+    user_cells(&mut cells.to_vec(), valid, m)
 }
 
 /// The table on both backends (and the scalar oracle for every entry).

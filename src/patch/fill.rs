@@ -306,21 +306,7 @@ pub(crate) fn fill(
                 uv[cy * m + cx] = all;
             }
         }
-        let count = centre_cells(&mut uc, Some(&uv));
-        let (mut users, mut masks) = (Vec::new(), Vec::new());
-        for v in 0..FILL_TRANSFORMS {
-            let mut a = vec![0i32; m * m];
-            let mut mask = vec![0i32; m * m];
-            for cy in 0..m {
-                for cx in 0..m {
-                    let (sx, sy) = fill_map(v, cx, cy, m);
-                    a[sy * m + sx] = uc[cy * m + cx];
-                    mask[sy * m + sx] = -(uv[cy * m + cx] as i32);
-                }
-            }
-            users.push(a);
-            masks.push(mask);
-        }
+        let (users, masks, count) = user_cells(&mut uc, &uv, m);
         let mut best: Vec<(usize, u32, u8)> = Vec::new();
         for (si, src) in lib.sources.iter().enumerate() {
             let table = cost.table(lib, si, &users, &masks, count)?;
@@ -397,4 +383,28 @@ pub(crate) fn fill(
     }
     progress.finish();
     Ok(())
+}
+
+/// The user window's `m × m` reduced cells `uc` (valid where `uv`) as
+/// round one reads them: centred and clamped like the candidates'
+/// ([`centre_cells`]), then permuted into each transform's source frame,
+/// with an all-bits mask (−1) of valid cells. Returns the per-transform
+/// cells, masks and the number of valid cells.
+pub fn user_cells(uc: &mut [i32], uv: &[bool], m: usize) -> (Vec<Vec<i32>>, Vec<Vec<i32>>, i64) {
+    let count = centre_cells(uc, Some(uv));
+    let (mut users, mut masks) = (Vec::new(), Vec::new());
+    for v in 0..FILL_TRANSFORMS {
+        let mut a = vec![0i32; m * m];
+        let mut mask = vec![0i32; m * m];
+        for cy in 0..m {
+            for cx in 0..m {
+                let (sx, sy) = fill_map(v, cx, cy, m);
+                a[sy * m + sx] = uc[cy * m + cx];
+                mask[sy * m + sx] = -(uv[cy * m + cx] as i32);
+            }
+        }
+        users.push(a);
+        masks.push(mask);
+    }
+    (users, masks, count)
 }
