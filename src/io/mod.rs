@@ -25,6 +25,7 @@
 
 mod asc;
 mod atomic;
+pub mod coords_map;
 mod error;
 mod exr;
 mod hgt;
@@ -38,6 +39,7 @@ mod tiff;
 pub mod type_mask;
 
 pub use atomic::write_atomic;
+pub use coords_map::CoordsMap;
 pub use error::{FormatError, IoError};
 pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
 pub use hgt::ARC_SECOND_M;

@@ -17,6 +17,7 @@ pub mod atlas;
 pub mod control;
 pub mod fixed;
 pub mod session;
+pub mod source_map;
 pub mod stages;
 pub mod state;
 

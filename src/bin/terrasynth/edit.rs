@@ -41,6 +41,7 @@ pub fn synth_scene(
     preview: Option<&Path>,
     overlay: bool,
     backend: BackendArg,
+    coords: (Option<&Path>, Option<&Path>),
 ) -> CliResult {
     let scene = Scene::read(scene)?;
     let db = load_database(scene.database.as_deref())?;
@@ -74,6 +75,16 @@ pub fn synth_scene(
         let img = overlay::preview(&frame.heightfield, &scene, &edits, db.type_names(), overlay)?;
         terrasynth::render::write_png(p, &img)?;
         eprintln!("wrote {}", p.display());
+    }
+    if coords.0.is_some() || coords.1.is_some() {
+        // The last pass of level 0 is what reconstruction read.
+        let l0 = session
+            .frames()
+            .and_then(|f| f.levels.first())
+            .and_then(|l| l.last())
+            .ok_or("no level-0 coordinates: the scene runs 0 correction passes")?;
+        let stride = terrasynth::synth::state::level_size(scene.width, scene.height, 0).0;
+        crate::synth::write_coords(&l0.coords, stride, (scene.width, scene.height), &db, coords)?;
     }
     Ok(())
 }

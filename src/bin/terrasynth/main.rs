@@ -5,11 +5,13 @@ mod bench;
 mod convert;
 mod db;
 mod edit;
+mod eval;
 mod generate;
 mod info;
 mod progress;
 mod render;
 mod sketch;
+mod suite;
 mod synth;
 
 use clap::{Parser, Subcommand};
@@ -48,6 +50,10 @@ enum Command {
     Generate(generate::Args),
     /// Turn a ridge/valley sketch into terrain made of real DEM patches.
     Sketch(sketch::Args),
+    /// Measure how real a synthesis is against a real DEM (descriptor
+    /// distances, realism ratio, type usage), or run the realism protocol
+    /// over a folder of DEMs (--suite).
+    Eval(eval::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -65,6 +71,7 @@ fn main() -> ExitCode {
         Command::Edit(a) => edit::run(a),
         Command::Generate(a) => generate::run(a),
         Command::Sketch(a) => sketch::run(a),
+        Command::Eval(a) => eval::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
