@@ -25,22 +25,23 @@ const SINK: u32 = u32::MAX;
 /// D8 drainage area in cells (the cell itself included) of every cell: each
 /// cell sends everything it collects to the neighbour of steepest descent
 /// (drop over distance, diagonals at √2), or nowhere when no neighbour is
-/// lower (a pit or a flat). Cells on the edge consider only the neighbours
-/// inside the grid.
+/// lower (a pit or a flat). Cells on the edge are outlets: they collect
+/// but pass nothing on, as if the terrain went on beyond them (otherwise
+/// every edge would become a channel running along the border, collecting a
+/// quarter of a cone at each corner).
 pub fn d8_area(hf: &Heightfield) -> Vec<u32> {
     let (w, h) = (hf.width(), hf.height());
     let data = hf.data();
     let mut receiver = vec![SINK; w * h];
     receiver.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, r) in row.iter_mut().enumerate() {
+        if y == 0 || y == h - 1 {
+            return;
+        }
+        for (x, r) in row.iter_mut().enumerate().take(w - 1).skip(1) {
             let c = data[y * w + x] as f64;
             let mut best = 0.0;
             for &(dx, dy, dist) in &NEIGHBOURS {
-                let (nx, ny) = (x as isize + dx, y as isize + dy);
-                if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                    continue;
-                }
-                let k = ny as usize * w + nx as usize;
+                let k = ((y as isize + dy) * w as isize + x as isize + dx) as usize;
                 let drop = (c - data[k] as f64) / dist;
                 if drop > best {
                     best = drop;

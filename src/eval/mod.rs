@@ -158,14 +158,17 @@ pub fn help_text() -> String {
             Kind::Distribution => "distribution",
             Kind::Scalar => "scalar",
         };
-        s += &format!("  {:<12} {kind:<12} {}\n", d.id, d.doc);
+        s += &format!("  {} ({kind}):\n      {}\n", d.id, d.doc);
     }
-    s += "Also reported (not in the ratio): relief = 1st-99th percentile height range (m), \
-          median slope (deg), pits.\n\
-          Distances: distributions by the Wasserstein-1 distance of 199 quantiles over the pooled \
-          10-90 % range; scalars by |a-b|/(|a|+|b|). Realism ratio: the mean over descriptors of \
-          d(synthesis, reference) / max(d(reference left half, right half), 0.05); \
-          1.0 = as different as the real terrain is from itself.\n";
+    s += &format!(
+        "Also reported, not in the ratio: relief (1st-99th percentile height range, m) and the \
+         median slope (deg).\n\
+         Distances: distributions by the Wasserstein-1 distance of 199 quantiles over the pooled \
+         10-90 % range; scalars by |a-b|/(|a|+|b|). Realism ratio: the mean over descriptors of \
+         d(synthesis, reference) / max(d(reference left half, right half), {}); 1.0 = as \
+         different as the real terrain is from itself.\n",
+        compare::FLOOR
+    );
     s
 }
 
