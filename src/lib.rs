@@ -13,6 +13,7 @@ pub mod blend;
 pub mod database;
 pub mod error;
 pub mod fill;
+pub mod georef;
 pub mod hash;
 pub mod heightfield;
 pub mod io;

@@ -62,6 +62,7 @@ pub(super) fn quantize16(
         width: Some(hf.width()),
         height: Some(hf.height()),
         nodata_value: has_nodata.then_some(0.0),
+        georef: hf.georef().cloned(),
     };
     Ok(Quantized {
         codes,

@@ -128,6 +128,7 @@ pub(super) fn encode32(hf: &Heightfield) -> Result<Encoded, FormatError> {
         width: Some(hf.width()),
         height: Some(hf.height()),
         nodata_value: None,
+        georef: hf.georef().cloned(),
     };
     let (min, max) = hf
         .stats()

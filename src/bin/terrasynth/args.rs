@@ -13,21 +13,37 @@ pub struct Input {
     /// Dimensions WxH of headerless raw input (R16/R32) without a sidecar.
     #[arg(long = "in-size", value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
-    /// Override the input's cell size, in metres.
+    /// Cell size in metres. A georeferenced input (GeoTIFF, SRTM tile, ASC
+    /// with .prj) is resampled to square cells of this size; any other
+    /// input's cell size is overridden. Geographic inputs are resampled to
+    /// square cells of their north-south spacing without it.
     #[arg(long = "cell-size")]
     pub cell_size: Option<f64>,
+    /// Band of a multi-band GeoTIFF, 1-based (as gdal_translate -b).
+    #[arg(long)]
+    pub band: Option<usize>,
 }
 
 impl Input {
     pub fn read(&self, path: &Path) -> Result<terrasynth::Heightfield, io::IoError> {
-        io::read(
+        self.load(path).map(|l| l.heightfield)
+    }
+
+    /// Reads with what the reader decided, printing its notices.
+    pub fn load(&self, path: &Path) -> Result<io::Loaded, io::IoError> {
+        let loaded = io::load(
             path,
             &ReadOptions {
                 format: self.format,
                 size: self.size,
                 cell_size: self.cell_size,
+                band: self.band,
             },
-        )
+        )?;
+        for n in &loaded.grid.notes {
+            eprintln!("note: {}: {n}", path.display());
+        }
+        Ok(loaded)
     }
 }
 
