@@ -29,6 +29,7 @@
 
 mod asc;
 mod atomic;
+pub mod engine;
 mod error;
 mod exr;
 mod geotiff;
@@ -186,6 +187,9 @@ pub struct WriteOptions {
     /// Files the command read (inputs, scene files): no output, sidecar or
     /// `.prj` may replace one of them.
     pub inputs: Vec<PathBuf>,
+    /// PNG16 / R16: store rows south to north (Unity's order, see
+    /// [`engine`]); the sidecar records it so terrasynth reads them back.
+    pub south_up: bool,
 }
 
 /// Decodes a heightfield from bytes. `sidecar` is the JSON sidecar's bytes for
@@ -305,11 +309,11 @@ pub fn encode(
     opts: &WriteOptions,
 ) -> Result<Encoded, FormatError> {
     match format {
-        Format::Png16 => png::encode16(hf, opts.height_range),
+        Format::Png16 => png::encode16(hf, opts.height_range, opts.south_up),
         Format::Exr => exr::encode(hf),
         Format::Tiff => tiff::encode(hf),
         Format::Asc => asc::encode(hf),
-        Format::R16 => raw::encode16(hf, opts.height_range),
+        Format::R16 => raw::encode16(hf, opts.height_range, opts.south_up),
         Format::R32 => raw::encode32(hf),
         Format::Ter => ter::encode(hf),
         Format::Png8 | Format::Hgt => Err(FormatError::Unwritable(format!(

@@ -70,6 +70,9 @@ pub struct Sidecar {
     pub nodata_value: Option<f64>,
     /// Where the grid lies, when known.
     pub georef: Option<Georef>,
+    /// Rows are stored south to north (`"row_order": "south_to_north"`,
+    /// written for Unity); default north to south.
+    pub south_up: bool,
 }
 
 impl Sidecar {
@@ -113,6 +116,16 @@ impl Sidecar {
             width: dimension(top, "width")?,
             height: dimension(top, "height")?,
             nodata_value: number(top, "nodata_value", "")?,
+            south_up: match top.get("row_order") {
+                None | Some(Value::Null) => false,
+                Some(Value::String(s)) if s == "south_to_north" => true,
+                Some(Value::String(s)) if s == "north_to_south" => false,
+                Some(other) => {
+                    return Err(bad(format!(
+                        "row_order is {other}: expected \"north_to_south\" or \"south_to_north\""
+                    )));
+                }
+            },
             georef: match top.get("georeference") {
                 Some(Value::Object(g)) if g.contains_key("geotransform") => Some(georef(g)?),
                 _ => None,
@@ -154,6 +167,9 @@ impl Sidecar {
         });
         if let Some(n) = self.nodata_value {
             v["nodata_value"] = json!(n);
+        }
+        if self.south_up {
+            v["row_order"] = json!("south_to_north");
         }
         if let Some(g) = &self.georef {
             let c = g.crs.as_ref();
@@ -331,6 +347,7 @@ mod tests {
             height: Some(900),
             nodata_value: None,
             georef: None,
+            south_up: false,
         };
         assert_eq!(Sidecar::parse(&s.to_json(-17.0, 1206.0)).unwrap(), s);
         let mut crs = Crs::epsg(4326, Units::Degrees);
@@ -349,6 +366,7 @@ mod tests {
         assert_eq!(Sidecar::parse(&s.to_json(-17.0, 1206.0)).unwrap(), s);
         let local = Sidecar {
             georef: Some(Georef::local(900, 92.55)),
+            south_up: true,
             ..s
         };
         assert_eq!(

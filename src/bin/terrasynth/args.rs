@@ -120,3 +120,74 @@ pub fn select_backend(
     }
     Ok(())
 }
+
+/// `--for`: a game engine's heightmap conventions.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum EngineArg {
+    /// Unity Terrain: 16-bit RAW (.raw), 2^n+1 square, rows south to north.
+    Unity,
+    /// Unreal Landscape: 16-bit PNG or .r16 of a recommended size.
+    Unreal,
+}
+
+/// Writes an output heightfield: never over one of `inputs`, with the
+/// engine's conventions and import settings when `engine` is given, and
+/// the writer's notices printed.
+pub fn write_output(
+    hf: &terrasynth::Heightfield,
+    path: &Path,
+    format: Option<Format>,
+    engine: Option<EngineArg>,
+    inputs: &[&Path],
+) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    use terrasynth::io::engine::{self, Engine};
+    let mut opts = io::WriteOptions {
+        format,
+        inputs: inputs.iter().map(|p| p.to_path_buf()).collect(),
+        ..Default::default()
+    };
+    let mut prepared = None;
+    let hf = match engine {
+        None => hf,
+        Some(e) => {
+            let e = match e {
+                EngineArg::Unity => Engine::Unity,
+                EngineArg::Unreal => Engine::Unreal,
+            };
+            let ext = path
+                .extension()
+                .and_then(|x| x.to_str())
+                .unwrap_or("")
+                .to_ascii_lowercase();
+            if format.is_some() || !e.accepts(&ext) {
+                return Err(format!(
+                    "--for {} writes {}; name the output accordingly (e.g. terrain.{})",
+                    e.name(),
+                    if e == Engine::Unity {
+                        "a 16-bit .raw"
+                    } else {
+                        "a 16-bit .png or .r16"
+                    },
+                    if e == Engine::Unity { "raw" } else { "png" }
+                )
+                .into());
+            }
+            let p = prepared.insert(engine::prepare(hf, e)?);
+            for n in &p.notes {
+                eprintln!("note: {n}");
+            }
+            opts.south_up = p.south_up;
+            &p.heightfield
+        }
+    };
+    for n in io::write_noted(hf, path, &opts)? {
+        eprintln!("note: {n}");
+    }
+    if let Some(p) = &prepared {
+        eprintln!("import settings for {}:", path.display());
+        for s in &p.settings {
+            eprintln!("  {s}");
+        }
+    }
+    Ok(())
+}
