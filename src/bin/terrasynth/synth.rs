@@ -59,10 +59,11 @@ pub struct Args {
 pub fn check_outputs(outputs: &[Option<&Path>], inputs: &[&Path]) -> Result<(), io::IoError> {
     for out in outputs.iter().flatten() {
         let mut files = vec![out.to_path_buf()];
-        // Data files may bring a sidecar and a .prj with them.
-        if io::Format::from_path(out).is_some() {
-            files.push(io::sidecar_path(out));
-            files.push(io::prj_path(out));
+        // Data files may bring a sidecar or a .prj with them.
+        match io::Format::from_path(out) {
+            Some(f) if f.uses_sidecar() => files.push(io::sidecar_path(out)),
+            Some(io::Format::Asc) => files.push(io::prj_path(out)),
+            _ => {}
         }
         for f in files {
             if let Some(input) = inputs.iter().find(|i| io::same_file(i, &f)) {
