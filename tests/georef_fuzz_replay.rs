@@ -2,22 +2,8 @@
 //! tile name, then a `.prj`), every prefix of each and single-bit flips,
 //! exactly as the target runs them: a CRS or a typed error, never a panic.
 
-use terrasynth::io::{Companions, Format, ReadOptions, ground, load_bytes, wkt};
-
-const GRID: &[u8] =
-    b"ncols 3\nnrows 2\nxllcorner 1\nyllcorner 41\ndx 0.001\ndy 0.0008\n1 2 3\n4 5 6\n";
-
 fn run(data: &[u8]) -> Option<terrasynth::Heightfield> {
-    let split = data.iter().position(|&b| b == b'\n').unwrap_or(data.len());
-    let name = String::from_utf8_lossy(&data[..split]);
-    let _ = ground::hgt_georef(&name, 1201);
-    let prj = data.get(split + 1..).unwrap_or_default();
-    let _ = wkt::parse(prj);
-    let companions = Companions {
-        prj: Some(prj),
-        ..Default::default()
-    };
-    load_bytes(GRID, Format::Asc, &companions, &ReadOptions::default())
+    terrasynth::io::ground::fuzz_georef(data)
         .ok()
         .map(|l| l.heightfield)
 }

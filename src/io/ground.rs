@@ -147,6 +147,24 @@ pub fn hgt_georef(name: &str, side: usize) -> Option<Georef> {
     })
 }
 
+/// What the `georef` fuzz target (and its replay test) runs on one input:
+/// an SRTM tile name on the first line, a `.prj` WKT after it, parsed
+/// alone and as the companion of a small geographic ESRI grid.
+#[doc(hidden)]
+pub fn fuzz_georef(data: &[u8]) -> Result<super::Loaded, FormatError> {
+    const GRID: &[u8] =
+        b"ncols 3\nnrows 2\nxllcorner 1\nyllcorner 41\ndx 0.001\ndy 0.0008\n1 2 3\n4 5 6\n";
+    let split = data.iter().position(|&b| b == b'\n').unwrap_or(data.len());
+    let _ = hgt_georef(&String::from_utf8_lossy(&data[..split]), 1201);
+    let prj = data.get(split + 1..).unwrap_or_default();
+    let _ = super::wkt::parse(prj);
+    let companions = super::Companions {
+        prj: Some(prj),
+        ..Default::default()
+    };
+    super::load_bytes(GRID, super::Format::Asc, &companions, &Default::default())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
