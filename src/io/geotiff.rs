@@ -340,12 +340,14 @@ pub(super) fn tags(g: &Georef) -> Tags {
             }
         }
         Some(c) if c.wkt.is_some() => {
-            text(
-                &mut keys,
-                KEY_CITATION,
-                &format!("{ESRI_PE}{}", c.wkt.as_deref().unwrap_or_default()),
-            );
-            if !geographic {
+            // GDAL reads a CRS without EPSG code from an ESRI PE string in
+            // the PCS (or geographic) citation of a user-defined CRS.
+            let pe = format!("{ESRI_PE}{}", compact(c.wkt.as_deref().unwrap_or_default()));
+            if geographic {
+                text(&mut keys, KEY_GEOG_CITATION, &pe);
+                keys.push((KEY_GEOGRAPHIC_TYPE, 0, 1, USER_DEFINED));
+            } else {
+                text(&mut keys, KEY_PCS_CITATION, &pe);
                 keys.push((KEY_PROJECTED_TYPE, 0, 1, USER_DEFINED));
             }
         }
@@ -401,6 +403,21 @@ pub(super) fn tags(g: &Georef) -> Tags {
         keys: dir,
         ascii,
     }
+}
+
+/// WKT without the line breaks and indentation outside quoted names.
+fn compact(wkt: &str) -> String {
+    let mut out = String::with_capacity(wkt.len());
+    let mut quoted = false;
+    for ch in wkt.chars() {
+        if ch == '"' {
+            quoted = !quoted;
+        }
+        if quoted || !ch.is_whitespace() {
+            out.push(ch);
+        }
+    }
+    out
 }
 
 /// Per-band value mapping from GDAL's metadata XML.

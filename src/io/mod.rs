@@ -433,7 +433,20 @@ pub fn write_noted(
         }
         _ => None,
     };
+    // A CRS known only by its WKT: GDAL does not rebuild one from GeoKeys
+    // alone, so it also goes into GDAL's PAM sidecar (`<file>.aux.xml`),
+    // which GDAL and QGIS read with the TIFF.
+    let pam = match (format, hf.georef().and_then(|g| g.crs.as_ref())) {
+        (Format::Tiff, Some(c)) if c.epsg.is_none() && c.wkt.is_some() => Some(format!(
+            "<PAMDataset>\n  <SRS>{}</SRS>\n</PAMDataset>\n",
+            xml_escape(c.wkt.as_deref().unwrap_or_default())
+        )),
+        _ => None,
+    };
     let mut targets = vec![path.to_path_buf()];
+    if pam.is_some() {
+        targets.push(pam_path(path));
+    }
     if enc.sidecar.is_some() {
         targets.push(sidecar_path(path));
     }
@@ -456,8 +469,25 @@ pub fn write_noted(
     if let Some(w) = &prj {
         write_atomic(&prj_path(path), w.as_bytes())?;
     }
+    if let Some(x) = &pam {
+        write_atomic(&pam_path(path), x.as_bytes())?;
+    }
     write_atomic(path, &enc.bytes)?;
     Ok(notes)
+}
+
+/// GDAL's PAM sidecar of a data file (`<file>.aux.xml`).
+pub fn pam_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".aux.xml");
+    PathBuf::from(name)
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
 /// Whether two paths name the same file (or would: an output that does not
