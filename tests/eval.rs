@@ -9,6 +9,7 @@ use common::dem;
 use std::sync::OnceLock;
 use terrasynth::Heightfield;
 use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
+use terrasynth::eval::drainage::{Edges, d8_area};
 use terrasynth::eval::{self, Reference, Value, describe, id};
 use terrasynth::io::CoordsMap;
 use terrasynth::io::coords_map::{NO_EXEMPLAR, Source};
@@ -87,14 +88,17 @@ fn a_funnel_drains_into_one_cell_and_a_cone_spreads_its_flow() {
     let n = 63;
     let r = |x: usize, y: usize| ((x as f64 - 31.0).powi(2) + (y as f64 - 31.0).powi(2)).sqrt();
     let funnel = Heightfield::from_fn(n, n, 30.0, |x, y| (5.0 * r(x, y)) as f32).unwrap();
-    let area = eval::drainage::d8_area(&funnel);
+    let area = d8_area(&funnel, Edges::Outlets);
     // Edge cells are outlets; every other cell reaches the centre.
     let inner = ((n - 2) * (n - 2)) as u32;
     assert_eq!(area[31 * n + 31], inner, "everything reaches the centre");
+    // Draining into the grid (masks), the edge cells reach it too.
+    let area = d8_area(&funnel, Edges::Inside);
+    assert_eq!(area[31 * n + 31], (n * n) as u32, "edges included");
     let pits = describe(&funnel).unwrap().pits();
     assert_eq!(pits, 1.0 / inner as f64, "the centre is the only pit");
     let cone = Heightfield::from_fn(n, n, 30.0, |x, y| (1000.0 - 5.0 * r(x, y)) as f32).unwrap();
-    let area = eval::drainage::d8_area(&cone);
+    let area = d8_area(&cone, Edges::Outlets);
     assert_eq!(area[31 * n + 31], 1, "the summit collects only itself");
     let max = *area.iter().max().unwrap();
     assert!(
@@ -221,8 +225,7 @@ fn a_jitter_free_copy_scores_about_one_and_fbm_far_above() {
         "ratios: jitter-0 copy {copy_ratio:.2}, default synthesis {jitter_ratio:.2}, fBm {:.2}",
         c.ratio
     );
-    // Measured: 0.44, 1.44 and 3.48 (fBm of other seeds and roughness on
-    // this crop: 2.6 to 4.5).
+    // Measured: 0.84, 2.97 and 6.44.
     assert!(
         copy_ratio <= 1.0,
         "a copy of the exemplar: ratio {copy_ratio}"
@@ -232,6 +235,27 @@ fn a_jitter_free_copy_scores_about_one_and_fbm_far_above() {
         "fBm matched in σ: ratio {} (copy {copy_ratio})",
         c.ratio
     );
+}
+
+/// The baseline compares the top half with the bottom half: 0 when they
+/// are one terrain twice, and on the real crop within the spread the
+/// shared DEMs show (0.4–7 on the 8 of them).
+#[test]
+fn the_baseline_compares_top_with_bottom() {
+    let Some((ex, _)) = crop_db() else { return };
+    let hf = &ex.heights;
+    let reference = Reference::new(hf).unwrap();
+    let real = reference.baseline(hf).unwrap();
+    eprintln!("baseline of the crop: {real:.2}");
+    assert!(real > 0.2 && real < 10.0, "{real}");
+    let half = hf.height() / 2;
+    let twice = Heightfield::from_fn(hf.width(), 2 * half, hf.cell_size(), |x, y| {
+        hf.get(x, y % half)
+    })
+    .unwrap();
+    let reference = Reference::new(&twice).unwrap();
+    assert!(reference.halves.iter().any(|&d| d > 0.0), "left ≠ right");
+    assert_eq!(reference.baseline(&twice).unwrap(), 0.0, "top = bottom");
 }
 
 #[test]
@@ -493,6 +517,7 @@ fn cli_synth_coords_eval_and_suite() {
     assert_eq!(dem["name"], "crop");
     assert_eq!(dem["seeds"].as_array().unwrap().len(), 2);
     assert!(dem["median"]["ratio"].as_f64().unwrap() > 0.0);
+    assert!(dem["baseline"].as_f64().unwrap() > 0.0);
     assert_eq!(
         v["typed"]["median"].as_array().unwrap().len(),
         types.present().len()

@@ -4,44 +4,47 @@
 
 use super::interior;
 use crate::heightfield::Heightfield;
+use crate::procedural::grid::{MOORE, neighbour};
 use rayon::prelude::*;
 
-/// The 8 neighbour offsets in the fixed order ties are broken by (the first
-/// steepest wins), with their distances in cells.
-const NEIGHBOURS: [(isize, isize, f64); 8] = [
-    (-1, -1, std::f64::consts::SQRT_2),
-    (0, -1, 1.0),
-    (1, -1, std::f64::consts::SQRT_2),
-    (-1, 0, 1.0),
-    (1, 0, 1.0),
-    (-1, 1, std::f64::consts::SQRT_2),
-    (0, 1, 1.0),
-    (1, 1, std::f64::consts::SQRT_2),
-];
+/// What flow does at the edge of the grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Edges {
+    /// Edge cells are outlets: they collect but pass nothing on, as if the
+    /// terrain went on beyond them. What a descriptor wants: otherwise a
+    /// slope falling outwards turns every edge into a channel running along
+    /// the border, collecting a quarter of a cone at each corner.
+    Outlets,
+    /// Edge cells pass their flow on like any other, to neighbours inside
+    /// the grid (`masks`: the grid is all there is, and its lowest edge
+    /// cell should show the river that leaves it).
+    Inside,
+}
 
 /// No downslope neighbour: the flow ends here.
 const SINK: u32 = u32::MAX;
 
-/// D8 drainage area in cells (the cell itself included) of every cell: each
-/// cell sends everything it collects to the neighbour of steepest descent
-/// (drop over distance, diagonals at √2), or nowhere when no neighbour is
-/// lower (a pit or a flat). Cells on the edge are outlets: they collect
-/// but pass nothing on, as if the terrain went on beyond them (otherwise
-/// every edge would become a channel running along the border, collecting a
-/// quarter of a cone at each corner).
-pub fn d8_area(hf: &Heightfield) -> Vec<u32> {
+/// D8 drainage area in cells (O'Callaghan & Mark 1984; the cell itself
+/// included) of every cell: each cell sends everything it collects to the
+/// neighbour of steepest descent (drop over distance, diagonals at √2; the
+/// first of [`MOORE`] wins a tie), or nowhere when no neighbour is lower (a
+/// pit or a flat: no depression filling). `edges` says what edge cells do.
+pub fn d8_area(hf: &Heightfield, edges: Edges) -> Vec<u32> {
     let (w, h) = (hf.width(), hf.height());
     let data = hf.data();
     let mut receiver = vec![SINK; w * h];
     receiver.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        if y == 0 || y == h - 1 {
-            return;
-        }
-        for (x, r) in row.iter_mut().enumerate().take(w - 1).skip(1) {
+        for (x, r) in row.iter_mut().enumerate() {
+            let edge = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+            if edge && edges == Edges::Outlets {
+                continue;
+            }
             let c = data[y * w + x] as f64;
             let mut best = 0.0;
-            for &(dx, dy, dist) in &NEIGHBOURS {
-                let k = ((y as isize + dy) * w as isize + x as isize + dx) as usize;
+            for &(dx, dy, dist) in &MOORE {
+                let Some(k) = neighbour(x, y, dx, dy, w, h) else {
+                    continue;
+                };
                 let drop = (c - data[k] as f64) / dist;
                 if drop > best {
                     best = drop;
@@ -78,7 +81,7 @@ pub fn d8_area(hf: &Heightfield) -> Vec<u32> {
 
 /// log₁₀ of [`d8_area`], the form its distribution is compared in.
 pub fn log_area(hf: &Heightfield) -> Vec<f32> {
-    d8_area(hf)
+    d8_area(hf, Edges::Outlets)
         .par_iter()
         .map(|&a| (a as f32).log10())
         .collect()
@@ -89,7 +92,7 @@ pub fn log_area(hf: &Heightfield) -> Vec<f32> {
 pub fn pit_fraction(hf: &Heightfield) -> f64 {
     let pits = interior(hf, 1, |n| {
         let c = n.at(0, 0);
-        let pit = NEIGHBOURS.iter().all(|&(dx, dy, _)| n.at(dx, dy) > c);
+        let pit = MOORE.iter().all(|&(dx, dy, _)| n.at(dx, dy) > c);
         pit as u8 as f32
     });
     if pits.is_empty() {

@@ -18,7 +18,7 @@ pub enum EvalError {
     Nodata { count: usize, x: usize, y: usize },
     #[error(
         "coordinates map pixel ({x}, {y}) names exemplar {exemplar}, but the database has {count} (0..={max})",
-        max = count - 1
+        max = count.saturating_sub(1)
     )]
     NoSuchExemplar {
         x: usize,

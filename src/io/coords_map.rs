@@ -9,10 +9,11 @@
 //! < 65536 texels across), so the map is exact; a person reads the
 //! 8-bit picture `synth --coords-preview` writes instead.
 
-use super::limits::{DEFLATE_RATIO, check_justified};
 use super::{FormatError, IoError, write_atomic};
-use std::io::Cursor;
 use std::path::Path;
+
+/// The PNG's colour type and depth.
+const LAYOUT: (png::ColorType, png::BitDepth) = (png::ColorType::Rgb, png::BitDepth::Sixteen);
 
 /// Exemplar index meaning "drawn from no exemplar".
 pub const NO_EXEMPLAR: u16 = u16::MAX;
@@ -57,43 +58,17 @@ impl CoordsMap {
                 raw.extend_from_slice(&v.to_be_bytes());
             }
         }
-        let mut out = Vec::new();
-        let mut enc = png::Encoder::new(&mut out, self.width as u32, self.height as u32);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Sixteen);
-        enc.set_compression(png::Compression::Fast);
-        let mut w = enc.write_header().expect("writing to a Vec cannot fail");
-        w.write_image_data(&raw)
-            .expect("the buffer matches the header");
-        drop(w);
-        out
+        super::png::encode_raw(self.width, self.height, LAYOUT, &raw)
     }
 
     /// Decodes a map; anything but a 16-bit RGB PNG is refused.
     pub fn decode(bytes: &[u8]) -> Result<CoordsMap, FormatError> {
-        let mut decoder = png::Decoder::new(Cursor::new(bytes));
-        decoder.set_transformations(png::Transformations::IDENTITY);
-        let mut reader = decoder
-            .read_info()
-            .map_err(|e| FormatError::Corrupt(format!("not a readable PNG: {e}")))?;
-        let info = reader.info();
-        let (w, h) = (info.width as usize, info.height as usize);
-        if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Sixteen {
-            return Err(FormatError::Unsupported {
-                what: "coordinates map PNG",
-                found: format!("{:?} {}-bit", info.color_type, info.bit_depth as u8),
-                supported: "16-bit RGB (R = x, G = y, B = exemplar), as `synth --coords` writes",
-            });
-        }
-        crate::heightfield::check_dims(w, h)?;
-        check_justified(w, h, 6, bytes.len(), DEFLATE_RATIO)?;
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| FormatError::Corrupt("PNG output size overflows".into()))?;
-        let mut buf = vec![0u8; size];
-        reader
-            .next_frame(&mut buf)
-            .map_err(|e| FormatError::Corrupt(format!("corrupt PNG data: {e}")))?;
+        let (w, h, buf) = super::png::decode_raw(
+            bytes,
+            LAYOUT,
+            "coordinates map PNG",
+            "16-bit RGB (R = x, G = y, B = exemplar), as `synth --coords` writes",
+        )?;
         let word = |c: &[u8], k: usize| u16::from_be_bytes([c[2 * k], c[2 * k + 1]]);
         let sources = buf
             .chunks_exact(6)

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::scene::{Scene, SceneEdits, overlay};
 use terrasynth::synth::session::Session;
+use terrasynth::synth::source_map::source_map;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -93,7 +94,8 @@ pub fn synth_scene(
             .and_then(|l| l.last())
             .ok_or("no level-0 coordinates: the scene runs 0 correction passes")?;
         let stride = terrasynth::synth::state::level_size(scene.width, scene.height, 0).0;
-        crate::synth::write_coords(&l0.coords, stride, (scene.width, scene.height), &db, coords)?;
+        let map = source_map(&l0.coords, stride, scene.width, scene.height, &db);
+        crate::synth::write_coords(&map, &db, coords)?;
     }
     Ok(())
 }

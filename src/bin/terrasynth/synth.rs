@@ -4,9 +4,8 @@ use crate::CliResult;
 use crate::args::{BackendArg, EngineArg, load_database, parse_size, select_backend, write_output};
 use std::path::{Path, PathBuf};
 use terrasynth::database::Database;
-use terrasynth::io;
+use terrasynth::io::{self, CoordsMap};
 use terrasynth::render::{self, RenderOptions};
-use terrasynth::synth::fixed::Coord;
 use terrasynth::synth::source_map::source_map;
 use terrasynth::synth::{Params, Synthesizer};
 
@@ -144,21 +143,18 @@ pub fn run(a: Args) -> CliResult {
     }
     if let Some(l0) = result.levels.first() {
         let paths = (a.coords.as_deref(), a.coords_preview.as_deref());
-        write_coords(&l0.coords, l0.width, (w, h), &db, paths)?;
+        write_coords(&source_map(&l0.coords, l0.width, w, h, &db), &db, paths)?;
     }
     Ok(())
 }
 
-/// Writes the sources of a `w × h` synthesis (level-0 coordinates, `stride`
-/// per row): the exact map and/or its picture.
+/// Writes where every pixel of a synthesis was drawn from: the exact map
+/// and/or its picture.
 pub fn write_coords(
-    coords: &[Coord],
-    stride: usize,
-    (w, h): (usize, usize),
+    map: &CoordsMap,
     db: &Database,
     (exact, picture): (Option<&Path>, Option<&Path>),
 ) -> CliResult {
-    let map = source_map(coords, stride, w, h, db);
     if let Some(p) = exact {
         map.write(p)?;
         eprintln!("wrote {}", p.display());
@@ -170,7 +166,7 @@ pub fn write_coords(
             .iter()
             .map(|e| (e.width, e.height))
             .collect();
-        render::write_png(p, &render::coords_preview(&map, &sizes))?;
+        render::write_png(p, &render::coords_preview(map, &sizes))?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())
