@@ -505,7 +505,11 @@ fn guided_correct_matches_on_real_guides() {
             st
         };
         let st = from(maps);
-        let parent = out.levels.get(i + 1).filter(|m| !m.coords.is_empty()).map(from);
+        let parent = out
+            .levels
+            .get(i + 1)
+            .filter(|m| !m.coords.is_empty())
+            .map(from);
         let lg = &guides.levels[i];
         let r = &f1.levels[i][0];
         let g = Guide {

@@ -269,12 +269,19 @@ fn check_real_states(db: &Database, ctx: Arc<Context>, (w, h): (usize, usize), s
     let l = db.level_count() - 1;
     for maps in out.levels.iter().filter(|m| !m.coords.is_empty()) {
         let st = state_from(maps.width, maps.height, &maps.coords, &maps.offsets);
-        let parent = out.levels.get(maps.level + 1).filter(|m| !m.coords.is_empty());
+        let parent = out
+            .levels
+            .get(maps.level + 1)
+            .filter(|m| !m.coords.is_empty());
         let parent = parent.map(|m| state_from(m.width, m.height, &m.coords, &m.offsets));
         if maps.level <= l {
             for (k, &(px, py)) in SUBPASSES.iter().enumerate() {
                 let what = format!("real state, level {}, subpass {k}", maps.level);
-                let p = CorrectParams { px, py, prior: DEFAULT_PRIOR };
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: DEFAULT_PRIOR,
+                };
                 check_correct(&pair, maps.level, (&st, parent.as_ref()), &p, &what);
             }
         }

@@ -42,7 +42,10 @@ fn assert_guided_paths_agree(
     g: &Guide<'_>,
     what: &str,
 ) {
-    for (&(px, py), &prior) in SUBPASSES.iter().flat_map(|s| PRIORS.iter().map(move |p| (s, p))) {
+    for (&(px, py), &prior) in SUBPASSES
+        .iter()
+        .flat_map(|s| PRIORS.iter().map(move |p| (s, p)))
+    {
         let p = CorrectParams { px, py, prior };
         let fast = state_from(st.width, st.height, &st.coords(), &st.offsets());
         let slow = state_from(st.width, st.height, &st.coords(), &st.offsets());
@@ -76,11 +79,24 @@ fn fast_and_scalar_correction_agree_on_real_states() {
         .unwrap();
     let coarsest = db().level_count() - 1;
     let mut checked = 0;
-    for (i, maps) in out.levels.iter().enumerate().filter(|(_, m)| m.level <= coarsest) {
+    for (i, maps) in out
+        .levels
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m.level <= coarsest)
+    {
         let atlas = AtlasLevel::new(db(), maps.level);
         let st = state_from(maps.width, maps.height, &maps.coords, &maps.offsets);
-        let parent = out.levels.get(i + 1).map(|p| state_from(p.width, p.height, &p.coords, &p.offsets));
-        assert_paths_agree(&atlas, &st, parent.as_ref(), &format!("level {}", maps.level));
+        let parent = out
+            .levels
+            .get(i + 1)
+            .map(|p| state_from(p.width, p.height, &p.coords, &p.offsets));
+        assert_paths_agree(
+            &atlas,
+            &st,
+            parent.as_ref(),
+            &format!("level {}", maps.level),
+        );
         checked += 1;
     }
     assert!(checked >= 3, "only {checked} levels checked");

@@ -152,7 +152,14 @@ pub fn blocks(
 /// Level `top` of a `width × height` output without blocks: the centre of
 /// exemplar `e` at the level `min(top, l)` of `a`, spread so that each level
 /// halves the spacing (in level-L units above L).
-pub fn centre(a: &AtlasLevel<'_>, e: usize, width: usize, height: usize, top: usize, l: usize) -> State {
+pub fn centre(
+    a: &AtlasLevel<'_>,
+    e: usize,
+    width: usize,
+    height: usize,
+    top: usize,
+    l: usize,
+) -> State {
     let r = a.level.layout.rects[e];
     let (w, h) = level_size(width, height, top);
     let st = State::new(w, h);

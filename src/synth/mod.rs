@@ -623,7 +623,13 @@ impl<'db> Synthesizer<'db> {
             levels: vec![LevelTiming::default(); m + 1],
             ..Default::default()
         };
-        let start = Start::choose(self.jitter > 0, m, l, &self.atlas[l], self.params.start_exemplar);
+        let start = Start::choose(
+            self.jitter > 0,
+            m,
+            l,
+            &self.atlas[l],
+            self.params.start_exemplar,
+        );
         Ok((start, start.top(m, l), l, timings))
     }
 
