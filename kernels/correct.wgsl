@@ -28,9 +28,9 @@ struct CorrectParams {
     y1: u32,
     // The level above (the prior's anchor), when has_parent is 1.
     parent_width: u32,
+    parent_height: u32,
     has_parent: u32,
     pad0: u32,
-    pad1: u32,
 }
 
 const F_TARGETS: u32 = 1u;
@@ -70,6 +70,25 @@ struct GuideCell {
 // The pixel's Prior::v (set once per invocation in `main`; every score of
 // the pixel reads it, like the `prior` argument of the Rust scores).
 var<private> prior_v: i32;
+
+// correct::parent_v: the parent's V at child (x, y), bilinear (9, 3, 3, 1
+// of 16 from the parent under it and the three nearest, clamped at the
+// level's edges), rounded to nearest with ties up (>> is arithmetic).
+fn parent_offset(x: u32, y: u32) -> i32 {
+    let px = x / 2u;
+    let py = y / 2u;
+    var qx = min(px + 1u, p.parent_width - 1u);
+    if (x % 2u == 0u) {
+        qx = max(px, 1u) - 1u;
+    }
+    var qy = min(py + 1u, p.parent_height - 1u);
+    if (y % 2u == 0u) {
+        qy = max(py, 1u) - 1u;
+    }
+    let w = p.parent_width;
+    return (9 * parent_v[py * w + px] + 3 * parent_v[py * w + qx] + 3 * parent_v[qy * w + px]
+        + parent_v[qy * w + qx] + 8) >> 4u;
+}
 
 // correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT;
 // types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; blend::MAX_ERROR.
@@ -354,7 +373,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Prior::at.
     prior_v = 0;
     if (p.has_parent != 0u) {
-        prior_v = parent_v[(uy / 2u) * p.parent_width + ux / 2u];
+        prior_v = parent_offset(ux, uy);
     }
 
     var diag = DIAGONALS;
