@@ -42,7 +42,7 @@ fn a_valid_scene_parses_to_what_it_says() {
     assert_eq!(s.curves[1].spec.widgets[1].slope_deg, [-30.0, -20.0]);
     assert_eq!(s.curves[1].spec.widgets[1].reach_px, [8.0, 9.0]);
     assert_eq!(s.junctions[0].height_m, 450.0);
-    assert!(matches!(&s.types, Some(TypePaint::Strokes(v)) if v[0].0 == "hills"));
+    assert!(matches!(&s.types, Some(TypePaint::Strokes(v)) if v[0].0.as_deref() == Some("hills")));
     assert!(matches!(&s.freeze, Some(Freeze::Strokes(v)) if v.len() == 1));
     assert_eq!(s.pastes[0].source, PasteSource::Exemplar(1));
     assert_eq!(s.pastes[0].delta_m, -50.0);

@@ -9,6 +9,8 @@ mod generate;
 mod info;
 mod progress;
 mod render;
+#[cfg(feature = "serve")]
+mod serve;
 mod sketch;
 mod synth;
 
@@ -48,6 +50,10 @@ enum Command {
     Generate(generate::Args),
     /// Turn a ridge/valley sketch into terrain made of real DEM patches.
     Sketch(sketch::Args),
+    /// The interactive editor: a web page on this machine where you sketch,
+    /// paint and drag constraints and see the terrain change.
+    #[cfg(feature = "serve")]
+    Serve(serve::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -65,6 +71,8 @@ fn main() -> ExitCode {
         Command::Edit(a) => edit::run(a),
         Command::Generate(a) => generate::run(a),
         Command::Sketch(a) => sketch::run(a),
+        #[cfg(feature = "serve")]
+        Command::Serve(a) => serve::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
