@@ -2,8 +2,12 @@
 #![allow(dead_code)]
 
 pub mod dem;
+#[cfg(feature = "serve")]
+pub mod editor;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+#[cfg(feature = "serve")]
+pub mod http;
 
 use terrasynth::Heightfield;
 use terrasynth::io::Format;

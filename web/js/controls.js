@@ -100,6 +100,12 @@ function sampled(ed, pts) {
   return hs;
 }
 
+/** Keeps a preset's height inside the exemplars' range (red means outside). */
+function inRange(ed, h) {
+  const { lo, hi, relief } = ed.range();
+  return Math.max(lo + 0.03 * relief, Math.min(hi - 0.03 * relief, h));
+}
+
 export function newPoint(ed, doc, at, preset) {
   const { relief } = ed.range();
   const h0 = ed.heightAt(at) ?? (ed.range().lo + relief / 2);
@@ -107,7 +113,7 @@ export function newPoint(ed, doc, at, preset) {
   return {
     id: newId(doc, 'point'),
     at: g.r1p(at),
-    height_m: round(clampHeight(h0 + POINT_PRESETS[preset].rise * relief)),
+    height_m: round(inRange(ed, h0 + POINT_PRESETS[preset].rise * relief)),
     slope_deg: 0,
     slope_direction_deg: 0,
     radius_px: round(Math.max(4, side * 0.06)),
@@ -119,7 +125,7 @@ export function newCurve(ed, doc, pts, preset) {
   const hs = sampled(ed, pts);
   const { relief } = ed.range();
   const mean = hs.reduce((a, b) => a + b, 0) / hs.length;
-  const h = preset === 'ridge' ? Math.max(...hs) + 0.1 * relief : preset === 'valley' ? Math.min(...hs) - 0.1 * relief : mean;
+  const h = preset === 'ridge' ? Math.max(...hs) + 0.05 * relief : preset === 'valley' ? Math.min(...hs) - 0.05 * relief : mean;
   const side = Math.max(doc.size[0], doc.size[1]);
   return {
     id: newId(doc, 'curve'),
@@ -127,7 +133,7 @@ export function newCurve(ed, doc, pts, preset) {
     smoothing: 2,
     widgets: [{
       at: 0.5,
-      height_m: round(clampHeight(h)),
+      height_m: round(inRange(ed, h)),
       slope_deg: P.slope.slice(),
       reach_px: P.reach.map((f) => round(Math.min(4096, Math.max(4, side * f)))),
     }],

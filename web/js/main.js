@@ -9,6 +9,11 @@ import { Panel } from './panel.js';
 
 const $ = (id) => document.getElementById(id);
 
+// Scripts (and the browser test) read the page's errors here.
+window.__errors = [];
+window.addEventListener('error', (e) => window.__errors.push(String(e.message)));
+window.addEventListener('unhandledrejection', (e) => window.__errors.push(String(e.reason)));
+
 export const ed = {
   api: new Api(),
   map: new MapView($('map')),
@@ -102,6 +107,7 @@ async function showFrame(frame, job) {
   if (frame.scene) ed.doc = frame.scene;
   ed.map.draw();
   if (job) {
+    $('status-error').textContent = '';
     const ms = performance.now() - job.t0;
     ed.latency.push({
       kind: job.kind,

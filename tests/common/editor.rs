@@ -1,0 +1,41 @@
+//! Starting the editor's server in a test: on 127.0.0.1, an ephemeral
+//! port, the embedded default database built once per test binary.
+
+use super::http;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::OnceLock;
+use terrasynth::database::{Database, default};
+use terrasynth::progress::Silent;
+use terrasynth::server::{self, Config, DbSource, Running};
+
+pub fn database() -> &'static Database {
+    static DB: OnceLock<&'static Database> = OnceLock::new();
+    DB.get_or_init(|| Box::leak(Box::new(default::build_default(&Silent).unwrap())))
+}
+
+/// A running server, ready (database loaded).
+pub fn serve(size: usize, scene: Option<PathBuf>, max_sessions: usize) -> Running {
+    let running = server::start(Config {
+        bind: SocketAddr::from(([127, 0, 0, 1], 0)),
+        database: Some(DbSource::Loaded(database())),
+        scene,
+        size: (size, size),
+        seed: 3,
+        max_sessions,
+        ..Config::default()
+    })
+    .expect("the server starts");
+    running.wait_ready().expect("the database loads");
+    running
+}
+
+/// The session's heights (an r32 export: little-endian f32, row-major).
+pub fn heights(addr: SocketAddr, session: &str) -> Vec<f32> {
+    let r = http::get(addr, &format!("/api/sessions/{session}/export?format=r32"));
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+    r.body
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}

@@ -1,0 +1,381 @@
+//! The editor end to end in a real browser: Debian's headless Chromium
+//! driven over WebDriver (chromedriver, through fantoccini) with real
+//! pointer actions on the page served by `terrasynth::server`.
+//!
+//! The design session: freeze a region, place a point, sketch a curve
+//! through the frozen region, paint a type, place a second point and undo
+//! it, save. Then the saved scene file must hold exactly those controls,
+//! and the heightfield must have changed where the controls act and not at
+//! all inside the frozen region. Screenshots of every step go to
+//! `target/editor-screenshots/` (or `$TERRASYNTH_SCREENSHOTS`).
+//!
+//! Without chromium and chromedriver the test says so and passes, unless
+//! `TERRASYNTH_REQUIRE_BROWSER` is set (as `.ci/run` does), which makes a
+//! missing browser a failure.
+#![cfg(feature = "serve")]
+
+mod common;
+
+use common::editor::{self, heights};
+use fantoccini::actions::{InputSource, MouseActions, PointerAction};
+use fantoccini::{Client, ClientBuilder, Locator};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+use terrasynth::scene::Scene;
+
+const SIZE: usize = 256;
+
+fn find(names: &[&str]) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    for dir in std::env::split_paths(&path).chain([PathBuf::from("/usr/bin")]) {
+        for n in names {
+            let p = dir.join(n);
+            if p.is_file() {
+                return Some(p);
+            }
+        }
+    }
+    None
+}
+
+/// chromedriver, stopped (by its own id) when dropped.
+struct Driver {
+    child: Child,
+    port: u16,
+}
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn start_driver(exe: &Path) -> Driver {
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let child = Command::new(exe)
+        .arg(format!("--port={port}"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("chromedriver starts");
+    let d = Driver { child, port };
+    let t = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            t.elapsed() < Duration::from_secs(20),
+            "chromedriver did not listen"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    d
+}
+
+async fn js(c: &Client, script: &str) -> Value {
+    c.execute(script, vec![])
+        .await
+        .unwrap_or_else(|e| panic!("{script}: {e}"))
+}
+
+async fn wait_for(c: &Client, what: &str, script: &str, secs: u64) {
+    let t = Instant::now();
+    loop {
+        if js(c, script).await == json!(true) {
+            return;
+        }
+        if t.elapsed() > Duration::from_secs(secs) {
+            let status = js(c, "return document.getElementById('status')?.innerText").await;
+            panic!("timed out waiting for {what}; status line: {status}");
+        }
+        tokio::time::sleep(Duration::from_millis(40)).await;
+    }
+}
+
+/// Waits for a frame newer than `rev` with nothing in flight.
+async fn settled(c: &Client, rev: i64) {
+    let script = format!(
+        "return !!window.terrasynth && window.terrasynth.revision > {rev} && !window.terrasynth.api.busy()"
+    );
+    wait_for(c, &format!("a frame after revision {rev}"), &script, 90).await;
+}
+
+async fn revision(c: &Client) -> i64 {
+    js(c, "return window.terrasynth.revision")
+        .await
+        .as_i64()
+        .unwrap()
+}
+
+/// Viewport coordinates of a terrain position.
+async fn screen(c: &Client, p: (f64, f64)) -> (f64, f64) {
+    let v = js(
+        c,
+        &format!(
+            "const q = window.terrasynth.map.toScreen([{}, {}]); const r = document.getElementById('map').getBoundingClientRect(); return [q[0] + r.left, q[1] + r.top];",
+            p.0, p.1
+        ),
+    )
+    .await;
+    (v[0].as_f64().unwrap(), v[1].as_f64().unwrap())
+}
+
+/// A left-button drag through terrain positions (a click when only one).
+async fn drag(c: &Client, pts: &[(f64, f64)]) {
+    let mut m = MouseActions::new("mouse".into());
+    let first = screen(c, pts[0]).await;
+    m = m
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: first.0.round(),
+            y: first.1.round(),
+        })
+        .then(PointerAction::Down { button: 0 });
+    for p in &pts[1..] {
+        let q = screen(c, *p).await;
+        m = m.then(PointerAction::MoveTo {
+            duration: Some(Duration::from_millis(60)),
+            x: q.0.round(),
+            y: q.1.round(),
+        });
+    }
+    m = m.then(PointerAction::Up { button: 0 });
+    c.perform_actions(m).await.expect("pointer actions");
+}
+
+async fn click(c: &Client, css: &str) {
+    c.find(Locator::Css(css))
+        .await
+        .unwrap_or_else(|e| panic!("{css}: {e}"))
+        .click()
+        .await
+        .unwrap_or_else(|e| panic!("click {css}: {e}"));
+}
+
+async fn shot(c: &Client, dir: &Path, name: &str) {
+    let png = c.screenshot().await.expect("screenshot");
+    std::fs::write(dir.join(format!("{name}.png")), png).unwrap();
+}
+
+/// Pixels whose heights differ (bit for bit) between two frames.
+fn changed(a: &[f32], b: &[f32], mask: impl Fn(usize, usize) -> bool) -> (usize, usize) {
+    let (mut n, mut total) = (0, 0);
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        if mask(k % SIZE, k / SIZE) {
+            total += 1;
+            n += (x.to_bits() != y.to_bits()) as usize;
+        }
+    }
+    (n, total)
+}
+
+#[test]
+fn a_design_session_in_chromium() {
+    let required = std::env::var_os("TERRASYNTH_REQUIRE_BROWSER").is_some_and(|v| !v.is_empty());
+    let (Some(chromium), Some(driver)) = (
+        find(&["chromium", "chromium-browser"]),
+        find(&["chromedriver"]),
+    ) else {
+        assert!(
+            !required,
+            "TERRASYNTH_REQUIRE_BROWSER is set but chromium or chromedriver is missing (apt-get install chromium chromium-driver)"
+        );
+        eprintln!(
+            "skipped: the browser test needs chromium and chromedriver (Debian: apt-get install chromium chromium-driver)"
+        );
+        return;
+    };
+    let started = Instant::now();
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("design.json");
+    let server = editor::serve(SIZE, Some(scene_path.clone()), 2);
+    let shots = std::env::var_os("TERRASYNTH_SCREENSHOTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/editor-screenshots")
+        });
+    std::fs::create_dir_all(&shots).unwrap();
+    let wd = start_driver(&driver);
+    let profile = dir.path().join("chromium-profile");
+    let caps = json!({
+        "goog:chromeOptions": {
+            "binary": chromium,
+            "args": [
+                "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                "--disable-background-networking", "--disable-component-update",
+                "--disable-sync", "--no-first-run", "--window-size=1400,900",
+                format!("--user-data-dir={}", profile.display()),
+            ],
+        }
+    });
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    rt.block_on(async {
+        let c = ClientBuilder::new(hyper_util::client::legacy::connect::HttpConnector::new())
+            .capabilities(caps.as_object().unwrap().clone())
+            .connect(&format!("http://127.0.0.1:{}", wd.port))
+            .await
+            .expect("a WebDriver session");
+        c.goto(&server.url()).await.unwrap();
+        settled(&c, -1).await;
+        shot(&c, &shots, "01-loaded").await;
+        let session = js(&c, "return window.terrasynth.api.session").await;
+        let session = session.as_str().unwrap().to_string();
+        let addr = server.addr;
+        let h0 = heights(addr, &session);
+
+        // Freeze a band; nothing moves yet.
+        click(&c, "[data-tool=freeze]").await;
+        let rev = revision(&c).await;
+        drag(&c, &[(40.0, 60.0), (70.0, 62.0), (100.0, 64.0)]).await;
+        settled(&c, rev).await;
+        let h_frozen = heights(addr, &session);
+        shot(&c, &shots, "02-frozen").await;
+
+        // A point whose reach overlaps the frozen band.
+        click(&c, "[data-tool=point]").await;
+        let rev = revision(&c).await;
+        drag(&c, &[(120.0, 80.0)]).await;
+        settled(&c, rev).await;
+        shot(&c, &shots, "03-point").await;
+
+        // A curve across the terrain, through the frozen band.
+        click(&c, "[data-tool=curve]").await;
+        let rev = revision(&c).await;
+        let curve: Vec<(f64, f64)> = (0..=12)
+            .map(|k| {
+                let t = k as f64 / 12.0;
+                (30.0 + 200.0 * t, 40.0 + 180.0 * t)
+            })
+            .collect();
+        drag(&c, &curve).await;
+        settled(&c, rev).await;
+        shot(&c, &shots, "04-curve").await;
+
+        // Paint a type.
+        click(&c, "[data-tool=types]").await;
+        click(&c, ".palette button:nth-child(3)").await;
+        let type_name = js(&c, "return window.terrasynth.info.database.types[2].name").await;
+        let rev = revision(&c).await;
+        drag(&c, &[(150.0, 170.0), (190.0, 180.0), (230.0, 200.0)]).await;
+        settled(&c, rev).await;
+        shot(&c, &shots, "05-types").await;
+        let h_before_second = heights(addr, &session);
+
+        // A second point, then undo it.
+        click(&c, "[data-tool=point]").await;
+        let rev = revision(&c).await;
+        drag(&c, &[(200.0, 60.0)]).await;
+        settled(&c, rev).await;
+        let h_second = heights(addr, &session);
+        let rev = revision(&c).await;
+        click(&c, "#undo").await;
+        settled(&c, rev).await;
+        shot(&c, &shots, "06-undone").await;
+
+        // Save, and read what the page says.
+        click(&c, "#save").await;
+        wait_for(
+            &c,
+            "the save",
+            "return document.getElementById('status-main').textContent.startsWith('saved')",
+            30,
+        )
+        .await;
+        shot(&c, &shots, "07-saved").await;
+        let errors = js(&c, "return window.__errors || []").await;
+        assert_eq!(errors, json!([]), "the page logged errors");
+        let latency = js(&c, "return window.terrasynth.latency").await;
+        eprintln!("in-browser edit → preview (ms): {latency}");
+        let h_final = heights(addr, &session);
+        c.close().await.unwrap();
+
+        // The saved scene has exactly the design's controls.
+        let text = std::fs::read(&scene_path).expect("the scene was saved");
+        let saved: Value = serde_json::from_slice(&text).unwrap();
+        let scene = Scene::parse(&text, &scene_path).expect("the saved scene parses");
+        assert_eq!(
+            scene.points.len(),
+            1,
+            "one point (the second was undone): {saved}"
+        );
+        let p = &scene.points[0];
+        assert!(
+            (p.at.x - 120.0).abs() < 2.0 && (p.at.y - 80.0).abs() < 2.0,
+            "{saved}"
+        );
+        assert_eq!(scene.curves.len(), 1, "{saved}");
+        let line = &scene.curves[0].spec.points;
+        assert!(line.len() >= 4, "{saved}");
+        assert!(
+            line[0].distance(glam::DVec2::new(30.0, 40.0)) < 3.0,
+            "{saved}"
+        );
+        assert!(
+            line[line.len() - 1].distance(glam::DVec2::new(230.0, 220.0)) < 3.0,
+            "{saved}"
+        );
+        assert_eq!(
+            saved["types"]["strokes"].as_array().unwrap().len(),
+            1,
+            "{saved}"
+        );
+        assert_eq!(saved["types"]["strokes"][0]["type"], type_name, "{saved}");
+        assert_eq!(
+            saved["freeze"]["strokes"].as_array().unwrap().len(),
+            1,
+            "{saved}"
+        );
+
+        // Frozen pixels kept their heights through every edit, bit for bit.
+        let frozen = scene.freeze_raster().unwrap().unwrap();
+        let (moved, total) = changed(&h_frozen, &h_final, |x, y| frozen[y * SIZE + x]);
+        assert!(total > 200, "the freeze stroke covers {total} pixels");
+        assert_eq!(moved, 0, "{moved} of {total} frozen pixels changed");
+        assert_eq!(
+            changed(&h0, &h_frozen, |_, _| true).0,
+            0,
+            "freezing alone changed heights"
+        );
+        // The point, the curve and the painted type changed the terrain
+        // where they act (outside the frozen band).
+        let free = |x: usize, y: usize| !frozen[y * SIZE + x];
+        let near = |q: (f64, f64), r: f64| {
+            move |x: usize, y: usize| {
+                free(x, y) && (x as f64 + 0.5 - q.0).hypot(y as f64 + 0.5 - q.1) <= r
+            }
+        };
+        let (n, t) = changed(&h0, &h_final, near((120.0, 80.0), 8.0));
+        assert!(n * 10 > t * 9, "around the point {n} of {t} pixels changed");
+        let (n, t) = changed(&h0, &h_final, near((130.0, 130.0), 6.0));
+        assert!(n * 10 > t * 9, "on the curve {n} of {t} pixels changed");
+        let (n, t) = changed(&h0, &h_final, near((190.0, 180.0), 6.0));
+        assert!(n * 2 > t, "under the type stroke {n} of {t} pixels changed");
+        // Undo took the second point's raise away again.
+        let site = 60 * SIZE + 200;
+        let raise = h_second[site] - h_before_second[site];
+        let left = h_final[site] - h_before_second[site];
+        assert!(
+            raise > 50.0,
+            "the second point raised its site by {raise} m"
+        );
+        assert!(
+            left.abs() < raise / 2.0,
+            "after undo {left} m of {raise} m remain"
+        );
+    });
+    drop(wd);
+    server.stop();
+    eprintln!(
+        "browser test took {:.1} s; screenshots in {}",
+        started.elapsed().as_secs_f64(),
+        shots.display()
+    );
+}
