@@ -463,7 +463,7 @@ impl Editor {
     fn render(&mut self, whole: bool) -> Result<(), ApiError> {
         let t = Instant::now();
         let fail = |e: String| ApiError::Internal(format!("rendering the preview failed: {e}"));
-        let types = self.scene.type_raster(self.db.type_names())?;
+        let types = self.edits.type_raster().map(<[u8]>::to_vec);
         let (w, h) = (self.heightfield.width(), self.heightfield.height());
         let heights = self.changed.and_then(|(_, b)| b).map(|b| {
             [

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+#[cfg(feature = "serve")]
+pub mod browser;
 pub mod dem;
 #[cfg(feature = "serve")]
 pub mod editor;

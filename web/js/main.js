@@ -115,6 +115,7 @@ async function showFrame(frame, job) {
       server_ms: frame.timing_ms.total,
       synth_ms: frame.timing_ms.synth,
       render_ms: frame.timing_ms.render,
+      edits_ms: frame.timing_ms.edits,
       size: `${w}x${h}`,
       changed: frame.changed ? frame.changed.pixels : null,
     });
@@ -392,6 +393,8 @@ async function boot() {
   $('loading').hidden = true;
   ed.tools.select('select');
   // For tests and scripts: the page's state and coordinate mapping.
+  ed.undo = () => undoRedo('undo');
+  ed.redo = () => undoRedo('redo');
   window.terrasynth = ed;
 }
 
