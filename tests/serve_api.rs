@@ -495,6 +495,52 @@ fn save_writes_only_the_scene_file_and_a_restart_reloads_it() {
     assert_eq!(f["scene"], d);
 }
 
+/// The editor_request fuzz target's seeds, replayed as the target runs
+/// them: each parses or is refused with an error naming a field.
+#[test]
+fn fuzz_seeds_of_the_request_parsers_replay() {
+    use terrasynth::server::request;
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/editor_request");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let data = std::fs::read(entry.unwrap().path()).unwrap();
+        let (&which, rest) = data.split_first().unwrap();
+        let field = match which % 3 {
+            0 => request::view(rest).err(),
+            1 => request::new_session(rest).err(),
+            _ => {
+                let q = request::query(
+                    Some(std::str::from_utf8(rest).unwrap()),
+                    &["commit", "format", "sidecar", "revision"],
+                );
+                q.and_then(|p| request::flag(&p, "commit", true).and(request::revision(&p)))
+                    .err()
+            }
+        }
+        .map(|e| e.field().to_string());
+        assert!(field.is_none_or(|f| !f.is_empty()));
+        n += 1;
+    }
+    assert!(n >= 6, "{n} seeds");
+    // The seeds' refusals name what was wrong.
+    assert_eq!(
+        request::view(br#"{"contours": 1}"#).unwrap_err().field(),
+        "contours"
+    );
+    assert_eq!(
+        request::new_session(br#"{"sc\u00e8ne": 1}"#)
+            .unwrap_err()
+            .field(),
+        "scène"
+    );
+    let q = request::query(
+        Some("commit=maybe&&=&revision=-1&revision=2"),
+        &["commit", "revision"],
+    )
+    .unwrap_err();
+    assert_eq!(q.field(), "$");
+}
+
 /// Values that do not belong in a scene document.
 fn junk() -> impl Strategy<Value = Value> {
     prop_oneof![

@@ -20,8 +20,11 @@ mod assets;
 mod doc;
 mod editor;
 mod error;
+mod frame;
 mod history;
+mod output;
 mod registry;
+pub mod request;
 mod routes;
 mod view;
 

@@ -25,16 +25,15 @@
 
 use super::editor::{Handle, Reply, Task};
 use super::error::ApiError;
-use super::view::View;
-use super::{App, DbState, assets};
+use super::request::{self, json_body};
+use super::{App, DbState, assets, output};
 use crate::database::Database;
-use crate::heightfield::Heightfield;
-use crate::io::{self, Format, WriteOptions};
+use crate::io::Format;
 use axum::Router;
-use axum::body::{Body, Bytes};
+use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
 use axum::extract::{DefaultBodyLimit, Path, RawQuery, Request, State};
-use axum::http::{HeaderMap, HeaderValue, Method, StatusCode, header};
+use axum::http::{HeaderMap, Method, StatusCode, header};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post, put};
@@ -49,18 +48,18 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/", get(index))
         .route("/assets/{*path}", get(asset))
         .route("/api/info", get(info))
-        .route("/api/exemplars/{index}/preview.png", get(exemplar))
+        .route("/api/exemplars/{index}/preview.png", get(output::exemplar))
         .route("/api/sessions", post(create))
         .route("/api/sessions/{id}", get(state))
         .route("/api/sessions/{id}/scene", put(put_scene))
         .route("/api/sessions/{id}/undo", post(undo))
         .route("/api/sessions/{id}/redo", post(redo))
         .route("/api/sessions/{id}/view", put(put_view))
-        .route("/api/sessions/{id}/preview.png", get(preview))
-        .route("/api/sessions/{id}/tile.png", get(tile))
-        .route("/api/sessions/{id}/heights", get(heights))
-        .route("/api/sessions/{id}/export", get(export))
-        .route("/api/sessions/{id}/save", post(save))
+        .route("/api/sessions/{id}/preview.png", get(output::preview))
+        .route("/api/sessions/{id}/tile.png", get(output::tile))
+        .route("/api/sessions/{id}/heights", get(output::heights))
+        .route("/api/sessions/{id}/export", get(output::export))
+        .route("/api/sessions/{id}/save", post(output::save))
         .route("/api/sessions/{id}/ping", post(ping))
         .route("/api/sessions/{id}/close", post(close))
         .fallback(not_found)
@@ -130,7 +129,7 @@ fn asset_response(path: &str) -> Response {
 }
 
 impl App {
-    fn ready(&self) -> Result<&'static Database, ApiError> {
+    pub(super) fn ready(&self) -> Result<&'static Database, ApiError> {
         match &*self.db.read().unwrap_or_else(|e| e.into_inner()) {
             DbState::Ready(db) => Ok(db),
             DbState::Loading => Err(ApiError::NotReady(
@@ -138,71 +137,6 @@ impl App {
             )),
             DbState::Failed(e) => Err(ApiError::NotReady(e.clone())),
         }
-    }
-}
-
-/// A JSON body (empty allowed), with its media type checked.
-fn json_body(headers: &HeaderMap, body: Result<Bytes, BytesRejection>, limit: usize) -> Api<Bytes> {
-    let body = body.map_err(|e| match e.status() {
-        StatusCode::PAYLOAD_TOO_LARGE => ApiError::TooLarge { limit },
-        _ => ApiError::malformed("$", e.body_text()),
-    })?;
-    if body.is_empty() {
-        return Ok(body);
-    }
-    let json = headers
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .is_some_and(|v| {
-            v.split(';')
-                .next()
-                .is_some_and(|t| t.trim() == "application/json")
-        });
-    if !json {
-        return Err(ApiError::MediaType);
-    }
-    Ok(body)
-}
-
-/// Query parameters; only `allowed` names, each at most once.
-fn query(raw: Option<String>, allowed: &[&str]) -> Api<Vec<(String, String)>> {
-    let pairs: Vec<(String, String)> = raw
-        .as_deref()
-        .unwrap_or("")
-        .split('&')
-        .filter(|p| !p.is_empty())
-        .map(|p| {
-            let (k, v) = p.split_once('=').unwrap_or((p, ""));
-            (k.to_string(), v.to_string())
-        })
-        .collect();
-    for (i, (k, _)) in pairs.iter().enumerate() {
-        if !allowed.contains(&k.as_str()) {
-            return Err(ApiError::malformed(
-                k.clone(),
-                format!("unknown parameter: expected {}", allowed.join(", ")),
-            ));
-        }
-        if pairs[..i].iter().any(|(q, _)| q == k) {
-            return Err(ApiError::malformed(k.clone(), "given more than once"));
-        }
-    }
-    Ok(pairs)
-}
-
-fn flag(pairs: &[(String, String)], name: &str, default: bool) -> Api<bool> {
-    match pairs
-        .iter()
-        .find(|(k, _)| k == name)
-        .map(|(_, v)| v.as_str())
-    {
-        None => Ok(default),
-        Some("true" | "1") => Ok(true),
-        Some("false" | "0") => Ok(false),
-        Some(v) => Err(ApiError::malformed(
-            name,
-            format!("{v:?} is not true or false"),
-        )),
     }
 }
 
@@ -264,74 +198,6 @@ fn database_info(app: &App, db: &Database) -> Value {
     })
 }
 
-async fn exemplar(State(app): State<Arc<App>>, Path(index): Path<String>) -> Api<Response> {
-    let db = app.ready()?;
-    let count = db.meta().exemplars.len();
-    let i = index
-        .parse::<usize>()
-        .ok()
-        .filter(|&i| i < count)
-        .ok_or_else(|| {
-            ApiError::invalid(
-                "index",
-                format!("{index:?} is not an exemplar index in 0..={}", count - 1),
-            )
-        })?;
-    let cached = app
-        .exemplar_previews
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())[i]
-        .clone();
-    let png = match cached {
-        Some(p) => p,
-        None => {
-            let png = tokio::task::spawn_blocking(move || exemplar_png(db, i))
-                .await
-                .map_err(|e| ApiError::Internal(e.to_string()))??;
-            let png = Arc::new(png);
-            app.exemplar_previews
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())[i] = Some(png.clone());
-            png
-        }
-    };
-    Ok(png_response(png.to_vec(), None))
-}
-
-/// An exemplar's level-0 heights, rendered like the terrain.
-fn exemplar_png(db: &Database, i: usize) -> Api<Vec<u8>> {
-    let r = db.level(0).layout.rects[i];
-    let q = db.quantization();
-    let n = r.texels() as usize;
-    let start = r.offset as usize;
-    let data: Vec<f32> = db.heights()[start..start + n]
-        .iter()
-        .map(|&u| q.metres(u as f64) as f32)
-        .collect();
-    let cell = db.meta().exemplars[i].cell_size_m;
-    let hf = Heightfield::from_vec(r.width as usize, r.height as usize, cell, data)
-        .map_err(|e| ApiError::Internal(e.to_string()))?;
-    let style = super::view::Style::new(db);
-    let view = View {
-        range: false,
-        ..View::default()
-    };
-    let image = style.render(&hf, None, view).map_err(ApiError::Internal)?;
-    crate::render::encode_png(&image).map_err(|e| ApiError::Internal(e.to_string()))
-}
-
-fn png_response(bytes: Vec<u8>, download: Option<String>) -> Response {
-    let mut r = ([(header::CONTENT_TYPE, "image/png")], bytes).into_response();
-    r.headers_mut()
-        .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
-    if let Some(name) = download
-        && let Ok(v) = HeaderValue::from_str(&format!("attachment; filename=\"{name}\""))
-    {
-        r.headers_mut().insert(header::CONTENT_DISPOSITION, v);
-    }
-    r
-}
-
 async fn create(
     State(app): State<Arc<App>>,
     headers: HeaderMap,
@@ -339,24 +205,7 @@ async fn create(
 ) -> Api {
     let db = app.ready()?;
     let body = json_body(&headers, body, app.max_request_bytes)?;
-    let doc = if body.is_empty() {
-        app.initial.clone()
-    } else {
-        let v: Value = serde_json::from_slice(&body)
-            .map_err(|e| ApiError::malformed("$", format!("not valid JSON: {e}")))?;
-        let o = v.as_object().ok_or_else(|| {
-            ApiError::malformed("$", "expected an object {\"scene\": …} or no body")
-        })?;
-        if let Some(k) = o.keys().find(|k| *k != "scene") {
-            return Err(ApiError::malformed(
-                k.clone(),
-                "unknown field: expected scene",
-            ));
-        }
-        o.get("scene")
-            .cloned()
-            .ok_or_else(|| ApiError::malformed("scene", "missing: expected a scene document"))?
-    };
+    let doc = request::new_session(&body)?.unwrap_or_else(|| app.initial.clone());
     // Field paths inside {"scene": …} are the document's own.
     let scene = app.policy.check_value(&doc)?;
     let style = app
@@ -400,8 +249,8 @@ async fn put_scene(
     body: Result<Bytes, BytesRejection>,
 ) -> Api {
     let h = app.registry.get(&id)?;
-    let q = query(raw, &["commit"])?;
-    let commit = flag(&q, "commit", true)?;
+    let q = request::query(raw.as_deref(), &["commit"])?;
+    let commit = request::flag(&q, "commit", true)?;
     let body = json_body(&headers, body, app.max_request_bytes)?;
     if body.is_empty() {
         return Err(ApiError::malformed(
@@ -434,185 +283,8 @@ async fn put_view(
 ) -> Api {
     let h = app.registry.get(&id)?;
     let body = json_body(&headers, body, app.max_request_bytes)?;
-    let v: Value = serde_json::from_slice(&body)
-        .map_err(|e| ApiError::malformed("$", format!("not valid JSON: {e}")))?;
-    let o = v
-        .as_object()
-        .ok_or_else(|| ApiError::malformed("$", "expected an object of true/false layers"))?;
-    let mut view = View::default();
-    for (k, val) in o {
-        let slot = match k.as_str() {
-            "contours" => &mut view.contours,
-            "types" => &mut view.types,
-            "range" => &mut view.range,
-            _ => {
-                return Err(ApiError::malformed(
-                    k.clone(),
-                    "unknown layer: expected contours, types, range",
-                ));
-            }
-        };
-        *slot = val
-            .as_bool()
-            .ok_or_else(|| ApiError::invalid(k.clone(), format!("{val} is not true or false")))?;
-    }
+    let view = request::view(&body)?;
     reply(h.submit(Task::View(view))).await
-}
-
-fn latest(app: &App, id: &str) -> Api<super::editor::Latest> {
-    app.registry
-        .get(id)?
-        .latest()
-        .ok_or_else(|| ApiError::NotReady("the first frame is not ready".into()))
-}
-
-async fn preview(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<Response> {
-    let h = app.registry.get(&id)?;
-    let (revision, png) = tokio::task::spawn_blocking(move || h.preview_png())
-        .await
-        .map_err(|e| ApiError::Internal(e.to_string()))?
-        .ok_or_else(|| ApiError::NotReady("the first frame is not ready".into()))??;
-    let mut r = png_response(png.to_vec(), None);
-    if let Ok(v) = HeaderValue::from_str(&revision.to_string()) {
-        r.headers_mut().insert("x-revision", v);
-    }
-    Ok(r)
-}
-
-async fn tile(
-    State(app): State<Arc<App>>,
-    Path(id): Path<String>,
-    RawQuery(raw): RawQuery,
-) -> Api<Response> {
-    let q = query(raw, &["revision"])?;
-    let text = q
-        .iter()
-        .find(|(k, _)| k == "revision")
-        .map(|(_, v)| v.as_str())
-        .ok_or_else(|| ApiError::malformed("revision", "missing: expected a frame's revision"))?;
-    let revision: u64 = text.parse().map_err(|_| {
-        ApiError::malformed("revision", format!("{text:?} is not a revision number"))
-    })?;
-    let t = app.registry.get(&id)?.tile(revision).ok_or_else(|| {
-        ApiError::NotFound(format!(
-            "no tile of revision {revision}: it is too old (load preview.png instead)"
-        ))
-    })?;
-    let mut r = png_response(t.png.to_vec(), None);
-    let rect = t.rect.map(|v| v.to_string()).join(",");
-    if let Ok(v) = HeaderValue::from_str(&rect) {
-        r.headers_mut().insert("x-rect", v);
-    }
-    Ok(r)
-}
-
-/// At most this many samples per side in `heights`.
-const HEIGHTS_SIDE: usize = 512;
-
-async fn heights(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<Response> {
-    let hf = latest(&app, &id)?.heightfield;
-    let stride = hf.width().max(hf.height()).div_ceil(HEIGHTS_SIDE);
-    let (w, h) = (hf.width().div_ceil(stride), hf.height().div_ceil(stride));
-    let mut out = Vec::with_capacity(12 + 4 * w * h);
-    for v in [w as u32, h as u32, stride as u32] {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
-    for y in 0..h {
-        for x in 0..w {
-            out.extend_from_slice(&hf.get(x * stride, y * stride).to_le_bytes());
-        }
-    }
-    Ok(([(header::CONTENT_TYPE, "application/octet-stream")], out).into_response())
-}
-
-/// File extension of a writable format.
-fn extension(f: Format) -> &'static str {
-    match f {
-        Format::Png16 | Format::Png8 => "png",
-        Format::Tiff => "tif",
-        other => other.name(),
-    }
-}
-
-async fn export(
-    State(app): State<Arc<App>>,
-    Path(id): Path<String>,
-    RawQuery(raw): RawQuery,
-) -> Api<Response> {
-    let q = query(raw, &["format", "sidecar"])?;
-    let sidecar = flag(&q, "sidecar", false)?;
-    let writable: Vec<&str> = Format::ALL
-        .iter()
-        .filter(|f| f.can_write())
-        .map(|f| f.name())
-        .collect();
-    let expected = || format!("one of {}, or preview", writable.join(", "));
-    let name = q
-        .iter()
-        .find(|(k, _)| k == "format")
-        .map(|(_, v)| v.clone())
-        .ok_or_else(|| {
-            ApiError::malformed("format", format!("missing: expected {}", expected()))
-        })?;
-    let l = latest(&app, &id)?;
-    let stem = app
-        .scene_file
-        .as_ref()
-        .and_then(|p| p.file_stem())
-        .map(|s| s.to_string_lossy().into_owned())
-        .filter(|s| {
-            s.chars()
-                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
-        })
-        .unwrap_or_else(|| "terrain".into());
-    if name == "preview" {
-        let png =
-            crate::render::encode_png(&l.image).map_err(|e| ApiError::Internal(e.to_string()))?;
-        return Ok(png_response(png, Some(format!("{stem}-preview.png"))));
-    }
-    let format = Format::from_name(&name)
-        .filter(|f| f.can_write())
-        .ok_or_else(|| ApiError::invalid("format", format!("{name:?} is not {}", expected())))?;
-    if sidecar && !format.uses_sidecar() {
-        return Err(ApiError::invalid(
-            "sidecar",
-            format!("{format} has no sidecar: only png16, r16 and r32 do"),
-        ));
-    }
-    let hf = l.heightfield.clone();
-    let enc =
-        tokio::task::spawn_blocking(move || io::encode(&hf, format, &WriteOptions::default()))
-            .await
-            .map_err(|e| ApiError::Internal(e.to_string()))?
-            .map_err(|e| ApiError::Internal(format!("encoding {format} failed: {e}")))?;
-    let (bytes, file, mime) = match (sidecar, enc.sidecar) {
-        (true, Some(sc)) => (sc, format!("{stem}-terrain.json"), "application/json"),
-        _ => (
-            enc.bytes,
-            format!("{stem}-terrain.{}", extension(format)),
-            "application/octet-stream",
-        ),
-    };
-    let mut r = ([(header::CONTENT_TYPE, mime)], Body::from(bytes)).into_response();
-    if let Ok(v) = HeaderValue::from_str(&format!("attachment; filename=\"{file}\"")) {
-        r.headers_mut().insert(header::CONTENT_DISPOSITION, v);
-    }
-    Ok(r)
-}
-
-async fn save(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api {
-    let l = latest(&app, &id)?;
-    let path = app.scene_file.clone().ok_or(ApiError::NoSavePath)?;
-    let text = serde_json::to_string_pretty(&l.committed)
-        .map_err(|e| ApiError::Internal(e.to_string()))?;
-    let p = path.clone();
-    tokio::task::spawn_blocking(move || io::write_atomic(&p, text.as_bytes()))
-        .await
-        .map_err(|e| ApiError::Internal(e.to_string()))?
-        .map_err(|e| ApiError::Internal(format!("saving failed: {e}")))?;
-    Ok(axum::Json(
-        json!({"path": path.display().to_string(), "revision": l.revision}),
-    ))
 }
 
 async fn ping(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<StatusCode> {
