@@ -12,6 +12,7 @@ use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::scene::{Scene, SceneEdits};
 use crate::synth::session::{Frame, Session};
+use crate::synth::union;
 use image::RgbaImage;
 use serde_json::{Value, json};
 use std::sync::Arc;
@@ -319,19 +320,6 @@ fn type_change(old: Option<&[u8]>, new: Option<&[u8]>, width: usize) -> Option<[
         b = union(b, Some([x, y, x + 1, y + 1]));
     }
     b
-}
-
-fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
-    match (a, b) {
-        (Some(a), Some(b)) => Some([
-            a[0].min(b[0]),
-            a[1].min(b[1]),
-            a[2].max(b[2]),
-            a[3].max(b[3]),
-        ]),
-        (a, None) => a,
-        (None, b) => b,
-    }
 }
 
 /// Pixels that differ between two heightfields (all when sizes differ).

@@ -52,6 +52,16 @@ function diamond(ctx, q, r, fill, selected) {
   ctx.stroke();
 }
 
+/** A handle's stem: a light line from its control to the handle. */
+function stem(ctx, q, r, width) {
+  ctx.beginPath();
+  ctx.moveTo(q[0], q[1]);
+  ctx.lineTo(r[0], r[1]);
+  ctx.lineWidth = width;
+  ctx.strokeStyle = COL.halo;
+  ctx.stroke();
+}
+
 function square(ctx, q, r, fill, selected) {
   ctx.fillStyle = fill;
   ctx.fillRect(q[0] - r, q[1] - r, 2 * r, 2 * r);
@@ -184,12 +194,7 @@ export function drawCurves(ctx, map, ed, sel) {
       if (wsel) {
         for (const [side, sign] of [[0, 1], [1, -1]]) {
           const r = map.toScreen(g.add(f.at, g.scale(f.left, sign * w.reach_px[side])));
-          ctx.beginPath();
-          ctx.moveTo(q[0], q[1]);
-          ctx.lineTo(r[0], r[1]);
-          ctx.lineWidth = 1.5;
-          ctx.strokeStyle = COL.halo;
-          ctx.stroke();
+          stem(ctx, q, r, 1.5);
           square(ctx, r, 5, side === 0 ? '#9fe870' : '#70c8e8', false);
         }
         heightBar(ctx, ed, q, w.height_m, C.barRange(ed), `${Math.round(w.height_m)} m`);
@@ -220,12 +225,7 @@ export function drawPoints(ctx, map, ed, sel) {
     ctx.stroke();
     if (selected) {
       const t = map.toScreen(C.slopeTip(p));
-      ctx.beginPath();
-      ctx.moveTo(q[0], q[1]);
-      ctx.lineTo(t[0], t[1]);
-      ctx.lineWidth = 2;
-      ctx.strokeStyle = COL.halo;
-      ctx.stroke();
+      stem(ctx, q, t, 2);
       // The arrow points downhill.
       const a = Math.atan2(t[1] - q[1], t[0] - q[0]);
       ctx.beginPath();

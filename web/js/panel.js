@@ -174,9 +174,12 @@ export class Panel {
     let pts = null;
     const draw = () => {
       if (img) ctx.drawImage(img, 0, 0);
-      if (pts && pts.length > 1) {
+      // The loop being drawn, else the one waiting to be pasted.
+      const P = t.pending;
+      const loop = pts || (P && P.source === 'exemplar' && P.exemplar === i ? P.lasso : null);
+      if (loop && loop.length > 1) {
         ctx.beginPath();
-        pts.forEach((p, k) => (k ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
+        loop.forEach((p, k) => (k ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
         ctx.closePath();
         ctx.lineWidth = 3;
         ctx.strokeStyle = '#ff7800';
