@@ -20,10 +20,12 @@ use common::browser::{
     click, connect, drag, executables, js, revision, settled, shot, start_driver, wait_for,
 };
 use common::editor::{self, heights};
+use fantoccini::Client;
 use serde_json::{Value, json};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use terrasynth::scene::Scene;
+use terrasynth::server::Running;
 
 const SIZE: usize = 256;
 
@@ -37,6 +39,101 @@ fn changed(a: &[f32], b: &[f32], mask: impl Fn(usize, usize) -> bool) -> (usize,
         }
     }
     (n, total)
+}
+
+/// What the design session left: the heights after each step, the type
+/// painted.
+struct Steps {
+    h0: Vec<f32>,
+    h_frozen: Vec<f32>,
+    h_before_second: Vec<f32>,
+    h_second: Vec<f32>,
+    h_final: Vec<f32>,
+    type_name: Value,
+}
+
+/// The design session in the browser (see the module docs).
+async fn design(c: &Client, server: &Running, shots: &Path) -> Steps {
+    c.goto(&server.url()).await.unwrap();
+    settled(&c, -1).await;
+    shot(&c, &shots, "01-loaded").await;
+    let session = js(&c, "return window.terrasynth.api.session").await;
+    let session = session.as_str().unwrap().to_string();
+    let addr = server.addr;
+    let h0 = heights(addr, &session);
+
+    // Freeze a band; nothing moves yet.
+    click(&c, "[data-tool=freeze]").await;
+    let rev = revision(&c).await;
+    drag(&c, &[(40.0, 60.0), (70.0, 62.0), (100.0, 64.0)]).await;
+    settled(&c, rev).await;
+    let h_frozen = heights(addr, &session);
+    shot(&c, &shots, "02-frozen").await;
+
+    // A point whose reach overlaps the frozen band.
+    click(&c, "[data-tool=point]").await;
+    let rev = revision(&c).await;
+    drag(&c, &[(120.0, 80.0)]).await;
+    settled(&c, rev).await;
+    shot(&c, &shots, "03-point").await;
+
+    // A curve across the terrain, through the frozen band.
+    click(&c, "[data-tool=curve]").await;
+    let rev = revision(&c).await;
+    let curve: Vec<(f64, f64)> = (0..=12)
+        .map(|k| {
+            let t = k as f64 / 12.0;
+            (30.0 + 200.0 * t, 40.0 + 180.0 * t)
+        })
+        .collect();
+    drag(&c, &curve).await;
+    settled(&c, rev).await;
+    shot(&c, &shots, "04-curve").await;
+
+    // Paint a type.
+    click(&c, "[data-tool=types]").await;
+    click(&c, ".palette button:nth-child(3)").await;
+    let type_name = js(&c, "return window.terrasynth.info.database.types[2].name").await;
+    let rev = revision(&c).await;
+    drag(&c, &[(150.0, 170.0), (190.0, 180.0), (230.0, 200.0)]).await;
+    settled(&c, rev).await;
+    shot(&c, &shots, "05-types").await;
+    let h_before_second = heights(addr, &session);
+
+    // A second point, then undo it.
+    click(&c, "[data-tool=point]").await;
+    let rev = revision(&c).await;
+    drag(&c, &[(200.0, 60.0)]).await;
+    settled(&c, rev).await;
+    let h_second = heights(addr, &session);
+    let rev = revision(&c).await;
+    click(&c, "#undo").await;
+    settled(&c, rev).await;
+    shot(&c, &shots, "06-undone").await;
+
+    // Save, and read what the page says.
+    click(&c, "#save").await;
+    wait_for(
+        &c,
+        "the save",
+        "return document.getElementById('status-main').textContent.startsWith('saved')",
+        30,
+    )
+    .await;
+    shot(&c, &shots, "07-saved").await;
+    let errors = js(&c, "return window.__errors || []").await;
+    assert_eq!(errors, json!([]), "the page logged errors");
+    let latency = js(&c, "return window.terrasynth.latency").await;
+    eprintln!("in-browser edit → preview (ms): {latency}");
+    let h_final = heights(addr, &session);
+    Steps {
+        h0,
+        h_frozen,
+        h_before_second,
+        h_second,
+        h_final,
+        type_name,
+    }
 }
 
 #[test]
@@ -59,156 +156,95 @@ fn a_design_session_in_chromium() {
         .enable_all()
         .build()
         .unwrap();
-    rt.block_on(async {
-        let c = connect(&wd, &chromium, dir.path()).await;
-        c.goto(&server.url()).await.unwrap();
-        settled(&c, -1).await;
-        shot(&c, &shots, "01-loaded").await;
-        let session = js(&c, "return window.terrasynth.api.session").await;
-        let session = session.as_str().unwrap().to_string();
-        let addr = server.addr;
-        let h0 = heights(addr, &session);
+    let c = rt.block_on(connect(&wd, &chromium, dir.path()));
+    // Close the browser even when a step fails (chromedriver alone would
+    // leave it running).
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        rt.block_on(design(&c, &server, &shots))
+    }));
+    let _ = rt.block_on(c.close());
+    let Steps {
+        h0,
+        h_frozen,
+        h_before_second,
+        h_second,
+        h_final,
+        type_name,
+    } = outcome.unwrap_or_else(|p| std::panic::resume_unwind(p));
 
-        // Freeze a band; nothing moves yet.
-        click(&c, "[data-tool=freeze]").await;
-        let rev = revision(&c).await;
-        drag(&c, &[(40.0, 60.0), (70.0, 62.0), (100.0, 64.0)]).await;
-        settled(&c, rev).await;
-        let h_frozen = heights(addr, &session);
-        shot(&c, &shots, "02-frozen").await;
+    // The saved scene has exactly the design's controls.
+    let text = std::fs::read(&scene_path).expect("the scene was saved");
+    let saved: Value = serde_json::from_slice(&text).unwrap();
+    let scene = Scene::parse(&text, &scene_path).expect("the saved scene parses");
+    assert_eq!(
+        scene.points.len(),
+        1,
+        "one point (the second was undone): {saved}"
+    );
+    let p = &scene.points[0];
+    assert!(
+        (p.at.x - 120.0).abs() < 2.0 && (p.at.y - 80.0).abs() < 2.0,
+        "{saved}"
+    );
+    assert_eq!(scene.curves.len(), 1, "{saved}");
+    let line = &scene.curves[0].spec.points;
+    assert!(line.len() >= 4, "{saved}");
+    assert!(
+        line[0].distance(glam::DVec2::new(30.0, 40.0)) < 3.0,
+        "{saved}"
+    );
+    assert!(
+        line[line.len() - 1].distance(glam::DVec2::new(230.0, 220.0)) < 3.0,
+        "{saved}"
+    );
+    assert_eq!(
+        saved["types"]["strokes"].as_array().unwrap().len(),
+        1,
+        "{saved}"
+    );
+    assert_eq!(saved["types"]["strokes"][0]["type"], type_name, "{saved}");
+    assert_eq!(
+        saved["freeze"]["strokes"].as_array().unwrap().len(),
+        1,
+        "{saved}"
+    );
 
-        // A point whose reach overlaps the frozen band.
-        click(&c, "[data-tool=point]").await;
-        let rev = revision(&c).await;
-        drag(&c, &[(120.0, 80.0)]).await;
-        settled(&c, rev).await;
-        shot(&c, &shots, "03-point").await;
-
-        // A curve across the terrain, through the frozen band.
-        click(&c, "[data-tool=curve]").await;
-        let rev = revision(&c).await;
-        let curve: Vec<(f64, f64)> = (0..=12)
-            .map(|k| {
-                let t = k as f64 / 12.0;
-                (30.0 + 200.0 * t, 40.0 + 180.0 * t)
-            })
-            .collect();
-        drag(&c, &curve).await;
-        settled(&c, rev).await;
-        shot(&c, &shots, "04-curve").await;
-
-        // Paint a type.
-        click(&c, "[data-tool=types]").await;
-        click(&c, ".palette button:nth-child(3)").await;
-        let type_name = js(&c, "return window.terrasynth.info.database.types[2].name").await;
-        let rev = revision(&c).await;
-        drag(&c, &[(150.0, 170.0), (190.0, 180.0), (230.0, 200.0)]).await;
-        settled(&c, rev).await;
-        shot(&c, &shots, "05-types").await;
-        let h_before_second = heights(addr, &session);
-
-        // A second point, then undo it.
-        click(&c, "[data-tool=point]").await;
-        let rev = revision(&c).await;
-        drag(&c, &[(200.0, 60.0)]).await;
-        settled(&c, rev).await;
-        let h_second = heights(addr, &session);
-        let rev = revision(&c).await;
-        click(&c, "#undo").await;
-        settled(&c, rev).await;
-        shot(&c, &shots, "06-undone").await;
-
-        // Save, and read what the page says.
-        click(&c, "#save").await;
-        wait_for(
-            &c,
-            "the save",
-            "return document.getElementById('status-main').textContent.startsWith('saved')",
-            30,
-        )
-        .await;
-        shot(&c, &shots, "07-saved").await;
-        let errors = js(&c, "return window.__errors || []").await;
-        assert_eq!(errors, json!([]), "the page logged errors");
-        let latency = js(&c, "return window.terrasynth.latency").await;
-        eprintln!("in-browser edit → preview (ms): {latency}");
-        let h_final = heights(addr, &session);
-        c.close().await.unwrap();
-
-        // The saved scene has exactly the design's controls.
-        let text = std::fs::read(&scene_path).expect("the scene was saved");
-        let saved: Value = serde_json::from_slice(&text).unwrap();
-        let scene = Scene::parse(&text, &scene_path).expect("the saved scene parses");
-        assert_eq!(
-            scene.points.len(),
-            1,
-            "one point (the second was undone): {saved}"
-        );
-        let p = &scene.points[0];
-        assert!(
-            (p.at.x - 120.0).abs() < 2.0 && (p.at.y - 80.0).abs() < 2.0,
-            "{saved}"
-        );
-        assert_eq!(scene.curves.len(), 1, "{saved}");
-        let line = &scene.curves[0].spec.points;
-        assert!(line.len() >= 4, "{saved}");
-        assert!(
-            line[0].distance(glam::DVec2::new(30.0, 40.0)) < 3.0,
-            "{saved}"
-        );
-        assert!(
-            line[line.len() - 1].distance(glam::DVec2::new(230.0, 220.0)) < 3.0,
-            "{saved}"
-        );
-        assert_eq!(
-            saved["types"]["strokes"].as_array().unwrap().len(),
-            1,
-            "{saved}"
-        );
-        assert_eq!(saved["types"]["strokes"][0]["type"], type_name, "{saved}");
-        assert_eq!(
-            saved["freeze"]["strokes"].as_array().unwrap().len(),
-            1,
-            "{saved}"
-        );
-
-        // Frozen pixels kept their heights through every edit, bit for bit.
-        let frozen = scene.freeze_raster().unwrap().unwrap();
-        let (moved, total) = changed(&h_frozen, &h_final, |x, y| frozen[y * SIZE + x]);
-        assert!(total > 200, "the freeze stroke covers {total} pixels");
-        assert_eq!(moved, 0, "{moved} of {total} frozen pixels changed");
-        assert_eq!(
-            changed(&h0, &h_frozen, |_, _| true).0,
-            0,
-            "freezing alone changed heights"
-        );
-        // The point, the curve and the painted type changed the terrain
-        // where they act (outside the frozen band).
-        let free = |x: usize, y: usize| !frozen[y * SIZE + x];
-        let near = |q: (f64, f64), r: f64| {
-            move |x: usize, y: usize| {
-                free(x, y) && (x as f64 + 0.5 - q.0).hypot(y as f64 + 0.5 - q.1) <= r
-            }
-        };
-        let (n, t) = changed(&h0, &h_final, near((120.0, 80.0), 8.0));
-        assert!(n * 10 > t * 9, "around the point {n} of {t} pixels changed");
-        let (n, t) = changed(&h0, &h_final, near((130.0, 130.0), 6.0));
-        assert!(n * 10 > t * 9, "on the curve {n} of {t} pixels changed");
-        let (n, t) = changed(&h0, &h_final, near((190.0, 180.0), 6.0));
-        assert!(n * 2 > t, "under the type stroke {n} of {t} pixels changed");
-        // Undo took the second point's raise away again.
-        let site = 60 * SIZE + 200;
-        let raise = h_second[site] - h_before_second[site];
-        let left = h_final[site] - h_before_second[site];
-        assert!(
-            raise > 50.0,
-            "the second point raised its site by {raise} m"
-        );
-        assert!(
-            left.abs() < raise / 2.0,
-            "after undo {left} m of {raise} m remain"
-        );
-    });
+    // Frozen pixels kept their heights through every edit, bit for bit.
+    let frozen = scene.freeze_raster().unwrap().unwrap();
+    let (moved, total) = changed(&h_frozen, &h_final, |x, y| frozen[y * SIZE + x]);
+    assert!(total > 200, "the freeze stroke covers {total} pixels");
+    assert_eq!(moved, 0, "{moved} of {total} frozen pixels changed");
+    assert_eq!(
+        changed(&h0, &h_frozen, |_, _| true).0,
+        0,
+        "freezing alone changed heights"
+    );
+    // The point, the curve and the painted type changed the terrain
+    // where they act (outside the frozen band).
+    let free = |x: usize, y: usize| !frozen[y * SIZE + x];
+    let near = |q: (f64, f64), r: f64| {
+        move |x: usize, y: usize| {
+            free(x, y) && (x as f64 + 0.5 - q.0).hypot(y as f64 + 0.5 - q.1) <= r
+        }
+    };
+    let (n, t) = changed(&h0, &h_final, near((120.0, 80.0), 8.0));
+    assert!(n * 10 > t * 9, "around the point {n} of {t} pixels changed");
+    let (n, t) = changed(&h0, &h_final, near((130.0, 130.0), 6.0));
+    assert!(n * 10 > t * 9, "on the curve {n} of {t} pixels changed");
+    let (n, t) = changed(&h0, &h_final, near((190.0, 180.0), 6.0));
+    assert!(n * 2 > t, "under the type stroke {n} of {t} pixels changed");
+    // Undo took the second point's raise away again.
+    let site = 60 * SIZE + 200;
+    let raise = h_second[site] - h_before_second[site];
+    let left = h_final[site] - h_before_second[site];
+    assert!(
+        raise > 50.0,
+        "the second point raised its site by {raise} m"
+    );
+    assert!(
+        left.abs() < raise / 2.0,
+        "after undo {left} m of {raise} m remain"
+    );
     drop(wd);
     server.stop();
     eprintln!(
