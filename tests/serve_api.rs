@@ -233,9 +233,10 @@ fn queued_documents_coalesce_latest_wins() {
         d["points"] = json!([{"at": [x, 30], "height_m": 900, "radius_px": 5}]);
         d
     };
-    // A slow first job: a new seed at a larger size is a whole new session.
+    // A slow first job: a new seed at a larger size is a whole new session
+    // (a second or so; the next two arrive within 120 ms).
     let mut slow = seeded(9, 10.0);
-    slow["size"] = json!([512, 512]);
+    slow["size"] = json!([1024, 1024]);
     let id2 = id.clone();
     let t1 = std::thread::spawn(move || put_scene(a, &id2, &slow, true));
     std::thread::sleep(Duration::from_millis(60));

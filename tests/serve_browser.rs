@@ -55,77 +55,82 @@ struct Steps {
 /// The design session in the browser (see the module docs).
 async fn design(c: &Client, server: &Running, shots: &Path) -> Steps {
     c.goto(&server.url()).await.unwrap();
-    settled(&c, -1).await;
-    shot(&c, &shots, "01-loaded").await;
-    let session = js(&c, "return window.terrasynth.api.session").await;
+    settled(c, -1).await;
+    shot(c, shots, "01-loaded").await;
+    let session = js(c, "return window.terrasynth.api.session").await;
     let session = session.as_str().unwrap().to_string();
     let addr = server.addr;
     let h0 = heights(addr, &session);
 
     // Freeze a band; nothing moves yet.
-    click(&c, "[data-tool=freeze]").await;
-    let rev = revision(&c).await;
-    drag(&c, &[(40.0, 60.0), (70.0, 62.0), (100.0, 64.0)]).await;
-    settled(&c, rev).await;
+    click(c, "[data-tool=freeze]").await;
+    let rev = revision(c).await;
+    drag(c, &[(40.0, 60.0), (70.0, 62.0), (100.0, 64.0)]).await;
+    settled(c, rev).await;
     let h_frozen = heights(addr, &session);
-    shot(&c, &shots, "02-frozen").await;
+    shot(c, shots, "02-frozen").await;
 
     // A point whose reach overlaps the frozen band.
-    click(&c, "[data-tool=point]").await;
-    let rev = revision(&c).await;
-    drag(&c, &[(120.0, 80.0)]).await;
-    settled(&c, rev).await;
-    shot(&c, &shots, "03-point").await;
+    click(c, "[data-tool=point]").await;
+    let rev = revision(c).await;
+    drag(c, &[(120.0, 80.0)]).await;
+    settled(c, rev).await;
+    shot(c, shots, "03-point").await;
 
     // A curve across the terrain, through the frozen band.
-    click(&c, "[data-tool=curve]").await;
-    let rev = revision(&c).await;
+    click(c, "[data-tool=curve]").await;
+    let rev = revision(c).await;
     let curve: Vec<(f64, f64)> = (0..=12)
         .map(|k| {
             let t = k as f64 / 12.0;
             (30.0 + 200.0 * t, 40.0 + 180.0 * t)
         })
         .collect();
-    drag(&c, &curve).await;
-    settled(&c, rev).await;
-    shot(&c, &shots, "04-curve").await;
+    drag(c, &curve).await;
+    settled(c, rev).await;
+    shot(c, shots, "04-curve").await;
 
     // Paint a type.
-    click(&c, "[data-tool=types]").await;
-    click(&c, ".palette button:nth-child(3)").await;
-    let type_name = js(&c, "return window.terrasynth.info.database.types[2].name").await;
-    let rev = revision(&c).await;
-    drag(&c, &[(150.0, 170.0), (190.0, 180.0), (230.0, 200.0)]).await;
-    settled(&c, rev).await;
-    shot(&c, &shots, "05-types").await;
+    click(c, "[data-tool=types]").await;
+    click(c, ".palette button:nth-child(3)").await;
+    let type_name = js(c, "return window.terrasynth.info.database.types[2].name").await;
+    let rev = revision(c).await;
+    drag(c, &[(150.0, 170.0), (190.0, 180.0), (230.0, 200.0)]).await;
+    settled(c, rev).await;
+    shot(c, shots, "05-types").await;
     let h_before_second = heights(addr, &session);
 
     // A second point, then undo it.
-    click(&c, "[data-tool=point]").await;
-    let rev = revision(&c).await;
-    drag(&c, &[(200.0, 60.0)]).await;
-    settled(&c, rev).await;
+    click(c, "[data-tool=point]").await;
+    let rev = revision(c).await;
+    drag(c, &[(200.0, 60.0)]).await;
+    settled(c, rev).await;
     let h_second = heights(addr, &session);
-    let rev = revision(&c).await;
-    click(&c, "#undo").await;
-    settled(&c, rev).await;
-    shot(&c, &shots, "06-undone").await;
+    let rev = revision(c).await;
+    click(c, "#undo").await;
+    settled(c, rev).await;
+    shot(c, shots, "06-undone").await;
 
     // Save, and read what the page says.
-    click(&c, "#save").await;
+    click(c, "#save").await;
     wait_for(
-        &c,
+        c,
         "the save",
         "return document.getElementById('status-main').textContent.startsWith('saved')",
         30,
     )
     .await;
-    shot(&c, &shots, "07-saved").await;
-    let errors = js(&c, "return window.__errors || []").await;
+    shot(c, shots, "07-saved").await;
+    let errors = js(c, "return window.__errors || []").await;
     assert_eq!(errors, json!([]), "the page logged errors");
-    let latency = js(&c, "return window.terrasynth.latency").await;
+    let latency = js(c, "return window.terrasynth.latency").await;
     eprintln!("in-browser edit → preview (ms): {latency}");
     let h_final = heights(addr, &session);
+    // A reload keeps the tab's design (a new session starts from it).
+    c.refresh().await.unwrap();
+    settled(c, -1).await;
+    let kept = js(c, "const d = window.terrasynth.doc; return [d.points.length, d.curves.length, d.types.strokes.length, d.freeze.strokes.length]").await;
+    assert_eq!(kept, json!([1, 1, 1, 1]), "the design after a reload");
     Steps {
         h0,
         h_frozen,

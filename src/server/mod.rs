@@ -151,6 +151,9 @@ pub(crate) struct App {
     /// Host names requests may name (loopback binds only; empty = any).
     hosts: Vec<String>,
     exemplar_previews: Mutex<Vec<Option<Arc<Vec<u8>>>>>,
+    /// This run of the server: a page reloaded while it runs restores its
+    /// unsaved document; after a restart the saved scene is loaded.
+    instance: String,
 }
 
 /// A server running on its own threads.
@@ -364,6 +367,7 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
         max_request_bytes: config.max_request_bytes,
         hosts: Vec::new(),
         exemplar_previews: Mutex::new(Vec::new()),
+        instance: registry::new_id(),
     };
     Ok((app, source))
 }

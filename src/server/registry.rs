@@ -134,7 +134,7 @@ fn available_bytes() -> Option<u64> {
 /// 128 random bits as hex (from the standard library's randomly keyed
 /// hasher: session ids need to be unguessable by other local pages, not
 /// cryptographic keys).
-fn new_id() -> String {
+pub fn new_id() -> String {
     let mut out = String::new();
     for k in 0..2u64 {
         let mut h = std::collections::hash_map::RandomState::new().build_hasher();

@@ -159,6 +159,7 @@ async fn info(State(app): State<Arc<App>>) -> axum::Json<Value> {
     let p = &app.progress;
     axum::Json(json!({
         "version": env!("CARGO_PKG_VERSION"),
+        "instance": app.instance,
         "status": status,
         "error": error,
         "progress": {

@@ -122,10 +122,22 @@ async function showFrame(frame, job) {
     ed.lastRoundTrip = ms;
   }
   document.body.dataset.revision = String(frame.revision);
+  keep();
   ed.panel.refresh();
   ed.updateBar();
   status();
   scheduleHeights();
+}
+
+/** Where this tab keeps its document, so a reload loses no unsaved work. */
+const kept = () => `terrasynth-doc-${ed.info.instance}`;
+
+function keep() {
+  try {
+    sessionStorage.setItem(kept(), JSON.stringify(ed.doc));
+  } catch (_) {
+    /* storage full or off: reloading then starts from the server's scene */
+  }
 }
 
 let heightsTimer = null;
@@ -355,7 +367,8 @@ async function boot() {
   bar.removeAttribute('value');
   let frame;
   try {
-    frame = await ed.api.create();
+    const before = sessionStorage.getItem(kept());
+    frame = before ? await ed.api.create(JSON.parse(before)).catch(() => ed.api.create()) : await ed.api.create();
   } catch (e) {
     clearInterval(tick);
     $('loading').classList.add('failed');
