@@ -44,14 +44,7 @@ pub struct Stats {
     pub nodata: usize,
 }
 
-/// Optional georeference carried through formats that have one (GeoTIFF
-/// tiepoint, ESRI ASCII `xllcorner`/`yllcorner`): map coordinates of the
-/// outer corner of the top-left cell.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Georef {
-    pub origin_x: f64,
-    pub origin_y: f64,
-}
+pub use crate::georef::Georef;
 
 /// A row-major grid of heights in metres; row 0 is north, column 0 is west.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,8 +137,9 @@ impl Heightfield {
         self.cell_size = cell_size;
         Ok(())
     }
-    pub fn georef(&self) -> Option<Georef> {
-        self.georef
+    /// Where the grid lies on a map, when its file said so (see [`Georef`]).
+    pub fn georef(&self) -> Option<&Georef> {
+        self.georef.as_ref()
     }
     pub fn set_georef(&mut self, georef: Option<Georef>) {
         self.georef = georef;
@@ -285,10 +279,7 @@ impl<'a> View<'a> {
         for y in 0..self.height {
             data.extend_from_slice(self.row(y));
         }
-        let georef = self.hf.georef.map(|g| Georef {
-            origin_x: g.origin_x + self.x0 as f64 * self.hf.cell_size,
-            origin_y: g.origin_y - self.y0 as f64 * self.hf.cell_size,
-        });
+        let georef = self.hf.georef.as_ref().map(|g| g.shifted(self.x0, self.y0));
         Heightfield {
             width: self.width,
             height: self.height,
@@ -345,19 +336,13 @@ mod tests {
     #[test]
     fn crop_copies_window_and_shifts_georef() {
         let mut hf = Heightfield::from_fn(4, 3, 2.0, |x, y| (x + 10 * y) as f32).unwrap();
-        hf.set_georef(Some(Georef {
-            origin_x: 100.0,
-            origin_y: 50.0,
-        }));
+        let mut g = Georef::local(3, 2.0);
+        (g.origin_x, g.origin_y) = (100.0, 50.0);
+        hf.set_georef(Some(g));
         let c = hf.crop(1, 1, 2, 2).unwrap();
         assert_eq!(c.data(), &[11.0, 12.0, 21.0, 22.0]);
-        assert_eq!(
-            c.georef(),
-            Some(Georef {
-                origin_x: 102.0,
-                origin_y: 48.0
-            })
-        );
+        let g = c.georef().unwrap();
+        assert_eq!((g.origin_x, g.origin_y), (102.0, 48.0));
         assert!(hf.crop(3, 0, 2, 1).is_err());
         assert_eq!(
             hf.view(0, 2, 4, 1).unwrap().row(0),

@@ -92,3 +92,118 @@ fn convert_fills_nodata_on_request() {
     let s = hf.stats().unwrap();
     assert!(s.min >= 0.99 && s.max <= 12.01, "{s:?}");
 }
+
+/// `synth --scene X.json -o X.png` would write the PNG's sidecar over the
+/// scene: refused before anything is written, the scene intact.
+#[test]
+fn synth_never_overwrites_its_scene_and_checks_memory_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("x.json");
+    let text = std::fs::read(repo("data/scenes/canyonlands.json")).unwrap();
+    std::fs::write(&scene, &text).unwrap();
+    let png = dir.path().join("x.png");
+    let out = terrasynth(&[
+        "synth",
+        "--scene",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&out, "refusing to overwrite the input");
+    assert_eq!(
+        std::fs::read(&scene).unwrap(),
+        text,
+        "the scene is untouched"
+    );
+    assert!(!png.exists());
+    // A scene far beyond memory is refused up front with the numbers.
+    let mut v: serde_json::Value = serde_json::from_slice(&text).unwrap();
+    v["size"] = serde_json::json!([30000, 30000]);
+    let big = dir.path().join("big.json");
+    std::fs::write(&big, serde_json::to_vec(&v).unwrap()).unwrap();
+    let out = terrasynth(&[
+        "synth",
+        "--scene",
+        big.to_str().unwrap(),
+        "-o",
+        dir.path().join("big.exr").to_str().unwrap(),
+    ]);
+    if terrasynth::io::available_memory().is_some() {
+        assert_clean_failure(&out, "a 30000x30000 synthesis needs about");
+    }
+}
+
+/// `info` says when the cell size is a default and prints both spacings
+/// and the CRS; `convert --for unity` prints the import settings.
+#[test]
+fn info_spacings_and_engine_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let hf = terrasynth::Heightfield::from_fn(40, 30, 10.0, |x, y| (x + y) as f32).unwrap();
+    let png = dir.path().join("plain.png");
+    terrasynth::io::write(&hf, &png, &Default::default()).unwrap();
+    std::fs::remove_file(dir.path().join("plain.json")).unwrap();
+    let out = terrasynth(&["info", png.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("10 m (default"), "{text}");
+    assert!(
+        text.contains("spacing:   10.000 m east-west x 10.000 m north-south"),
+        "{text}"
+    );
+    assert!(text.contains("crs:       none"), "{text}");
+    let out = terrasynth(&["info", "--json", png.to_str().unwrap()]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["cell_size_default"], true);
+    let raw = dir.path().join("t.raw");
+    let out = terrasynth(&[
+        "convert",
+        "--for",
+        "unity",
+        png.to_str().unwrap(),
+        raw.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    for want in [
+        "40x30 -> 65x65",
+        "Resolution: 65",
+        "Byte Order: Windows",
+        "Flip Vertically: off",
+        "Terrain Size: X = 393.846, Y = 6553.500, Z = 295.385",
+    ] {
+        assert!(err.contains(want), "{want}: {err}");
+    }
+    assert_eq!(std::fs::metadata(&raw).unwrap().len(), 65 * 65 * 2);
+    let bad = dir.path().join("t.exr");
+    let out = terrasynth(&[
+        "convert",
+        "--for",
+        "unity",
+        png.to_str().unwrap(),
+        bad.to_str().unwrap(),
+    ]);
+    assert_clean_failure(&out, "--for unity writes a 16-bit .raw");
+    // masks: every file, sized like the heightfield.
+    let masks = dir.path().join("masks");
+    let out = terrasynth(&[
+        "masks",
+        png.to_str().unwrap(),
+        "--out-dir",
+        masks.to_str().unwrap(),
+        "--splat",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "slope.png",
+        "flow.png",
+        "types.png",
+        "types.json",
+        "splat.png",
+        "masks.json",
+    ] {
+        assert!(masks.join(f).exists(), "{f}");
+    }
+}

@@ -6,8 +6,8 @@
 mod common;
 
 use std::path::PathBuf;
+use terrasynth::Heightfield;
 use terrasynth::io::{self, Format, FormatError, ReadOptions, WriteOptions};
-use terrasynth::{Georef, Heightfield};
 
 fn fixture(name: &str) -> Heightfield {
     let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures")).join(name);
@@ -36,13 +36,8 @@ fn tiff_tiles_int16_with_gdal_nodata() {
             );
         }
     }
-    assert_eq!(
-        hf.georef(),
-        Some(Georef {
-            origin_x: 1000.0,
-            origin_y: 2000.0
-        })
-    );
+    let g = hf.georef().unwrap();
+    assert_eq!((g.origin_x, g.origin_y), (1000.0, 2000.0));
 }
 
 #[test]
@@ -52,25 +47,52 @@ fn tiff_deflate_strips_uint16_in_feet_pixel_is_point() {
     assert!((hf.cell_size() - 3.048).abs() < 1e-12, "10 ft = 3.048 m");
     assert_eq!(hf.get(8, 6), 1086.0);
     assert_eq!(hf.nodata_count(), 0);
-    // The tiepoint names the centre of pixel (0, 0): the corner is half a cell out.
+    // The tiepoint names the centre of pixel (0, 0): the corner is half a
+    // cell out, in the CRS's own unit (feet).
     let g = hf.georef().unwrap();
-    assert!((g.origin_x - 95.0 * 0.3048).abs() < 1e-9, "{g:?}");
-    assert!((g.origin_y - 205.0 * 0.3048).abs() < 1e-9, "{g:?}");
+    assert_eq!(
+        (g.origin_x, g.origin_y, g.pixel_x),
+        (95.0, 205.0, 10.0),
+        "{g:?}"
+    );
+    assert_eq!(g.pixel_is, terrasynth::georef::PixelIs::Point);
+    assert_eq!(g.metres_per_unit(), Some(0.3048));
 }
 
+/// A grid in degrees at 42° N is 1/cos(42°) too wide if its north–south
+/// spacing is taken as square: it is resampled east–west instead.
 #[test]
-fn tiff_big_endian_geographic_float32() {
-    let hf = fixture("geographic_f32_be.tif");
-    assert_eq!((hf.width(), hf.height()), (6, 4));
-    // 3 arc-seconds of latitude on the WGS84 equator.
+fn tiff_big_endian_geographic_float32_is_resampled_not_stretched() {
+    let p = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures"))
+        .join("geographic_f32_be.tif");
+    let loaded = io::load(&p, &ReadOptions::default()).unwrap();
+    let hf = &loaded.heightfield;
+    // 6 columns of 69.0 m and 4 rows of 92.5 m → 4 columns of 92.5 m.
+    let (dx, dy) = loaded.grid.native_spacing.unwrap();
     assert!(
-        (hf.cell_size() - 92.766).abs() < 0.001,
-        "{}",
-        hf.cell_size()
+        (dy - 92.56).abs() < 0.01 && (dx - 69.04).abs() < 0.01,
+        "{dx} x {dy}"
     );
-    assert_eq!(hf.georef(), None, "degrees are not a metre georeference");
-    assert!(hf.get(5, 0).is_nan());
-    assert_eq!(hf.get(2, 3), 100.5 + 2.0 - 6.0);
+    assert_eq!((hf.width(), hf.height()), (4, 4));
+    assert!((hf.cell_size() - dy).abs() < 1e-9, "{}", hf.cell_size());
+    let g = hf.georef().unwrap();
+    assert!(g.is_geographic());
+    assert!(
+        (g.pixel_x * 4.0 - 6.0 / 1200.0).abs() < 1e-15,
+        "same extent"
+    );
+    assert!(
+        loaded.grid.notes[0].contains("6x4 -> 4x4"),
+        "{:?}",
+        loaded.grid.notes
+    );
+    // Rows are untouched (v = 100.5 + x - 2 y); the void at (5, 0) only
+    // drops out of its neighbours' weights.
+    for x in 0..4 {
+        let d = hf.get(x, 1) - hf.get(x, 2);
+        assert!((d - 2.0).abs() < 1e-4, "column {x}: {d}");
+    }
+    assert_eq!(hf.nodata_count(), 0);
 }
 
 #[test]
@@ -119,13 +141,7 @@ fn esri_centre_corners_crlf_nodata_and_wrapped_rows() {
         );
     }
     // Lower-left centre (105, 205) → corner (100, 200) → top-left (100, 230).
-    assert_eq!(
-        hf.georef(),
-        Some(Georef {
-            origin_x: 100.0,
-            origin_y: 230.0
-        })
-    );
+    assert_eq!(hf.georef(), Some(&common::placed(100.0, 230.0, 10.0)));
 }
 
 #[test]

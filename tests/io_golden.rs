@@ -9,8 +9,8 @@
 mod common;
 
 use std::path::PathBuf;
-use terrasynth::Georef;
 use terrasynth::Heightfield;
+use terrasynth::georef::{Crs, Units};
 use terrasynth::io::{self, Format, ReadOptions, WriteOptions};
 
 fn golden_dir() -> PathBuf {
@@ -22,10 +22,16 @@ fn golden_dir() -> PathBuf {
 fn input(f: Format) -> Heightfield {
     let mut hf = common::sample(7, 5, 2.5, common::stores_nodata(f));
     if matches!(f, Format::Tiff | Format::Asc) {
-        hf.set_georef(Some(Georef {
-            origin_x: 500_000.0,
-            origin_y: 4_650_012.5,
-        }));
+        let mut g = common::placed(500_000.0, 4_650_012.5, 2.5);
+        let mut crs = Crs::epsg(
+            32633,
+            Units::Linear {
+                metres_per_unit: 1.0,
+            },
+        );
+        crs.name = Some("WGS 84 / UTM zone 33N".into());
+        g.crs = Some(crs);
+        hf.set_georef(Some(g));
     }
     hf
 }

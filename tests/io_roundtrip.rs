@@ -6,8 +6,8 @@
 mod common;
 
 use proptest::prelude::*;
+use terrasynth::Heightfield;
 use terrasynth::io::{self, Format, ReadOptions, WriteOptions};
-use terrasynth::{Georef, Heightfield};
 
 /// A random heightfield: 1..=40 per side, heights in a random band of up to
 /// 9 km anywhere in -500..9000 m, cell size 0.5..100 m, some NaN holes.
@@ -32,8 +32,9 @@ fn heightfield() -> impl Strategy<Value = Heightfield> {
 fn check_roundtrip(
     mut hf: Heightfield,
     f: Format,
-    georef: Option<Georef>,
+    georef: Option<(f64, f64)>,
 ) -> Result<(), TestCaseError> {
+    let georef = georef.map(|(x, y)| common::placed(x, y, hf.cell_size()));
     if !common::stores_nodata(f) {
         for v in hf.data_mut() {
             if v.is_nan() {
@@ -41,7 +42,7 @@ fn check_roundtrip(
             }
         }
     }
-    hf.set_georef(georef);
+    hf.set_georef(georef.clone());
     let enc = io::encode(&hf, f, &WriteOptions::default())
         .map_err(|e| TestCaseError::fail(format!("{f}: {e}")))?;
     let back = io::decode(
@@ -90,7 +91,6 @@ proptest! {
         hf in heightfield(),
         georef in proptest::option::of((-1e6f64..1e6, -1e7f64..1e7)),
     ) {
-        let georef = georef.map(|(x, y)| Georef { origin_x: x, origin_y: y });
         for f in common::writable() {
             check_roundtrip(hf.clone(), f, georef)?;
         }

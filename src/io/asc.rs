@@ -1,24 +1,34 @@
 //! ESRI ASCII grids (`.asc`, read/write).
 //!
 //! Header: one `keyword value` pair per line, keywords in any order and any
-//! case: `ncols`, `nrows`, `cellsize` (required), `xllcorner` | `xllcenter`
-//! and `yllcorner` | `yllcenter` (optional, both or neither),
-//! `NODATA_value` (optional). Values follow, rows north to south, separated
-//! by any whitespace (rows may wrap across lines). Samples equal to
-//! `NODATA_value`, or spelled `nan`, become NaN. The cell size is taken to
-//! be metres; the lower-left corner becomes the [`Georef`] (which names the
-//! top-left corner). Errors name the line.
+//! case: `ncols`, `nrows`, `cellsize` or both `dx` and `dy` (GDAL writes
+//! those for non-square cells), `xllcorner` | `xllcenter` and `yllcorner` |
+//! `yllcenter` (optional, both or neither), `NODATA_value` (optional, a
+//! number or `nan`, as GDAL writes for float grids). Values follow, rows
+//! north to south, separated by any whitespace (rows may wrap across
+//! lines). Samples equal to `NODATA_value`, or spelled `nan`, become NaN.
+//! Errors name the line.
+//!
+//! The grid's placement becomes a [`Georef`] without CRS; a `.prj` beside
+//! the file gives the CRS (read by [`super::load`]). Without a `.prj` the
+//! units are taken to be metres; cells of degrees without a `.prj` are
+//! refused with a hint ([`super::ground`]), and `dx` ≠ `dy` is resampled
+//! to square cells there.
 //!
 //! Writing uses Rust's shortest round-trip float formatting, so every f32
 //! reads back bit-exact; `NODATA_value` is written only when there is
-//! nodata, with a value that no sample has.
+//! nodata, with a value that no sample has. A georeferenced heightfield is
+//! written in its own map units (`dx`/`dy` when its cells are not square in
+//! them, as for a geographic grid), and [`super::write`] puts its CRS in
+//! a `.prj`.
 
 use super::{Encoded, FormatError};
-use crate::heightfield::{Georef, Heightfield, check_dims};
+use crate::georef::{Georef, PixelIs};
+use crate::heightfield::{Heightfield, check_dims};
 use std::fmt::Write as _;
 
 const KEYWORDS: &str =
-    "ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter, cellsize, NODATA_value";
+    "ncols, nrows, xllcorner|xllcenter, yllcorner|yllcenter, cellsize or dx and dy, NODATA_value";
 
 #[derive(Default)]
 struct Header {
@@ -27,6 +37,8 @@ struct Header {
     xll: Option<(f64, bool)>,
     yll: Option<(f64, bool)>,
     cellsize: Option<f64>,
+    dx: Option<f64>,
+    dy: Option<f64>,
     nodata: Option<f64>,
 }
 
@@ -75,7 +87,13 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
     };
     let w = header.ncols.ok_or_else(|| missing("ncols"))?;
     let h = header.nrows.ok_or_else(|| missing("nrows"))?;
-    let cell = header.cellsize.ok_or_else(|| missing("cellsize"))?;
+    let (cx, cy) = match (header.cellsize, header.dx, header.dy) {
+        (Some(c), None, None) => (c, c),
+        (None, Some(x), Some(y)) => (x, y),
+        (None, None, None) => return Err(missing("cellsize (or dx and dy)")),
+        (Some(_), _, _) => return Err(missing("cellsize or dx/dy (both are given)")),
+        (None, _, _) => return Err(missing("dx and dy (one is given without the other)")),
+    };
     check_dims(w, h)?;
     // Every value takes at least one digit and one separator (the last
     // needs no separator): refuse before allocating.
@@ -84,21 +102,35 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
         return Err(FormatError::not_justified(w, h, bytes.len()));
     }
     let georef = match (header.xll, header.yll) {
-        (None, None) => None,
-        (Some((x, xc)), Some((y, yc))) => {
-            let x = if xc { x - cell / 2.0 } else { x };
-            let y = if yc { y - cell / 2.0 } else { y };
-            Some(Georef {
-                origin_x: x,
-                origin_y: y + h as f64 * cell,
-            })
-        }
+        (None, None) if cx == cy => None,
+        // Non-square cells still need their geometry to be resampled.
+        (None, None) => Some((0.0, false, 0.0, false)),
+        (Some((x, xc)), Some((y, yc))) => Some((x, xc, y, yc)),
         _ => {
             return Err(missing(
                 "xllcorner and yllcorner (one is given without the other)",
             ));
         }
-    };
+    }
+    .map(|(x, xc, y, yc)| {
+        let x = if xc { x - cx / 2.0 } else { x };
+        let y = if yc { y - cy / 2.0 } else { y };
+        Georef {
+            crs: None,
+            origin_x: x,
+            origin_y: y + h as f64 * cy,
+            pixel_x: cx,
+            pixel_y: cy,
+            pixel_is: PixelIs::Area,
+        }
+    });
+    if georef.as_ref().is_some_and(|g| !g.is_valid()) {
+        return Err(syntax(
+            first_data_line,
+            "the corner and cell size place the grid beyond finite coordinates".into(),
+        ));
+    }
+    let cell = cy;
 
     let n = w * h;
     let nodata = header.nodata.map(|v| v as f32);
@@ -178,12 +210,21 @@ fn parse_keyword(header: &mut Header, key: &str, value: &str) -> Result<(), Stri
         "nrows" => header.nrows.replace(count()?).is_some(),
         "xllcorner" | "xllcenter" => header.xll.replace((number()?, k == "xllcenter")).is_some(),
         "yllcorner" | "yllcenter" => header.yll.replace((number()?, k == "yllcenter")).is_some(),
-        "cellsize" => {
+        "cellsize" | "dx" | "dy" => {
             let c = number()?;
             if c <= 0.0 {
-                return Err(format!("cellsize is {value}: expected a value > 0"));
+                return Err(format!("{key} is {value}: expected a value > 0"));
             }
-            header.cellsize.replace(c).is_some()
+            match k.as_str() {
+                "dx" => header.dx.replace(c),
+                "dy" => header.dy.replace(c),
+                _ => header.cellsize.replace(c),
+            }
+            .is_some()
+        }
+        // GDAL writes `nan` for float grids whose nodata is NaN.
+        "nodata_value" if value.eq_ignore_ascii_case("nan") => {
+            header.nodata.replace(f64::NAN).is_some()
         }
         "nodata_value" => header.nodata.replace(number()?).is_some(),
         _ => {
@@ -199,19 +240,22 @@ fn parse_keyword(header: &mut Header, key: &str, value: &str) -> Result<(), Stri
 }
 
 pub(super) fn encode(hf: &Heightfield) -> Result<Encoded, FormatError> {
-    let (w, h, c) = (hf.width(), hf.height(), hf.cell_size());
-    let g = hf.georef().unwrap_or(Georef {
-        origin_x: 0.0,
-        origin_y: h as f64 * c,
-    });
+    let (w, h) = (hf.width(), hf.height());
+    let local = Georef::local(h, hf.cell_size());
+    let g = hf.georef().unwrap_or(&local);
     let mut s = String::with_capacity(hf.len() * 9 + 200);
     // Writing to a String cannot fail.
     let _ = write!(
         s,
-        "ncols {w}\nnrows {h}\nxllcorner {}\nyllcorner {}\ncellsize {c}\n",
+        "ncols {w}\nnrows {h}\nxllcorner {}\nyllcorner {}\n",
         g.origin_x,
-        g.origin_y - h as f64 * c
+        g.origin_y - h as f64 * g.pixel_y
     );
+    if g.pixel_x == g.pixel_y {
+        let _ = writeln!(s, "cellsize {}", g.pixel_x);
+    } else {
+        let _ = write!(s, "dx {}\ndy {}\n", g.pixel_x, g.pixel_y);
+    }
     let nodata = match hf.stats() {
         _ if hf.nodata_count() == 0 => None,
         None => Some(-9999.0),

@@ -46,6 +46,8 @@ pub enum FormatError {
     Corrupt(String),
     #[error("invalid metadata: {0}")]
     Metadata(String),
+    #[error("invalid .prj (WKT): {0}")]
+    Prj(String),
     #[error("cannot write: {0}")]
     Unwritable(String),
     #[error(
@@ -113,6 +115,16 @@ pub enum IoError {
         "{path}: cannot tell the format from the file name; give it explicitly (one of: {formats})"
     )]
     UnknownFormat { path: PathBuf, formats: String },
+    #[error("{path}: refusing to overwrite the input {input}; choose another output name")]
+    WouldOverwrite { path: PathBuf, input: PathBuf },
+    #[error(
+        "{what} needs about {needed_mib} MiB of memory but only {available_mib} MiB are available; choose a smaller size"
+    )]
+    Memory {
+        what: String,
+        needed_mib: u64,
+        available_mib: u64,
+    },
 }
 
 impl IoError {

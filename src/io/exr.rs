@@ -30,6 +30,16 @@ const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 /// Blocks below which decompression runs on the calling thread.
 const PARALLEL_MIN_BLOCKS: usize = 64;
 
+/// Whether the header names the cell size attribute (else the cell size
+/// read is the default). The header precedes the pixels and attribute
+/// names are stored as plain text.
+pub(super) fn has_cell_size(bytes: &[u8]) -> bool {
+    let name = CELL_SIZE_ATTRIBUTE.as_bytes();
+    bytes
+        .windows(name.len() + 1)
+        .any(|w| &w[..name.len()] == name && w[name.len()] == 0)
+}
+
 pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(FormatError::bad_magic("OpenEXR magic 76 2F 31 01", bytes));

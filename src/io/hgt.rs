@@ -3,13 +3,13 @@
 //!
 //! The size follows from the byte count alone: 1201² samples (SRTM3, 3
 //! arc-seconds) or 3601² (SRTM1, 1 arc-second); anything else is refused.
-//! The cell size is the posting on the WGS84 equator — 1″ = 30.92 m, so
-//! 92.77 m for SRTM3 and 30.92 m for SRTM1. North–south spacing stays within
-//! 0.4 % of that at every latitude; east–west spacing shrinks with
-//! cos(latitude) and the tile is not resampled, so away from the equator the
-//! cells are not square on the ground (pass `--cell-size` to choose another
-//! value). The tile's position (its file name, e.g. `N41E001`) is not
-//! parsed: the heightfield gets no georeference.
+//! The tile's name (`N41E001.hgt`) places it: [`super::ground::hgt_georef`]
+//! gives it an EPSG:4326 georeference, and [`super::load`] then resamples
+//! it east–west to square cells of its true north–south spacing (a tile is
+//! not square on the ground away from the equator). A tile whose name says
+//! nowhere keeps the posting on the WGS84 equator — 1″ = 30.92 m, so 92.77 m
+//! for SRTM3 and 30.92 m for SRTM1 — as its cell size, unplaced and
+//! unresampled: rename it, or pass `--cell-size`.
 
 use super::FormatError;
 use crate::heightfield::Heightfield;

@@ -13,6 +13,9 @@ pub const DEFLATE_RATIO: u64 = 1032;
 /// TIFF LZW: no code is shorter than 9 bits and none emits more than 4096
 /// bytes (the 12-bit table size), so 4096 / 1.125 bytes per code.
 pub const LZW_RATIO: u64 = 3641;
+/// ZSTD: an RLE block spends 4 bytes (3-byte header, 1 byte) on at most
+/// 128 KiB of output (RFC 8878, Block_Maximum_Size).
+pub const ZSTD_RATIO: u64 = 32768;
 /// PackBits: a 2-byte run emits at most 128 bytes.
 pub const PACKBITS_RATIO: u64 = 64;
 /// Fixed allowance for headers, tables and block padding, so that tiny

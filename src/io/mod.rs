@@ -16,19 +16,27 @@
 //! | png16 | .png + .json | yes | yes | u16 | code 0 (sidecar `nodata_value`) | cell size, metre mapping | (max−min)/65535/2 |
 //! | png8 | .png + .json | yes | — | u8 | sidecar `nodata_value` | cell size, metre mapping | — |
 //! | exr | .exr | yes | yes | f32 (f16 read) | NaN | cell size (`cellSizeMetres`) | exact |
-//! | tiff | .tif .tiff | yes | yes | i16, u16, f32 read; f32 written | `GDAL_NODATA`, NaN | cell size, georeference | exact |
-//! | hgt | .hgt | yes | — | i16 BE, 1201² / 3601² | −32768 | cell size from the product | — |
-//! | asc | .asc | yes | yes | decimal text | `NODATA_value` | cell size, georeference | exact |
-//! | r16 | .r16 .raw + .json | yes | yes | u16 LE | refused | size, cell size, metre mapping | (max−min)/65535/2 |
+//! | tiff | .tif .tiff | yes | yes | (u)int8/16/32, f32, f64, any band read; f32 written | `GDAL_NODATA`, NaN | cell size, georeference, CRS, scale/offset (read) | exact |
+//! | hgt | .hgt | yes | — | i16 BE, 1201² / 3601² | −32768 | georeference from the tile name | — |
+//! | asc | .asc + .prj | yes | yes | decimal text | `NODATA_value` (number or nan) | cell size (`dx`/`dy` read), georeference, CRS (.prj) | exact |
+//! | r16 | .r16 .raw + .json | yes | yes | u16 LE | refused | size, cell size, metre mapping, georeference | (max−min)/65535/2 |
 //! | r32 | .r32 + .json | yes | yes | f32 LE | NaN | size, cell size | exact |
 //! | ter | .ter | yes | yes | i16 LE | refused | cell size (f32) | ≈ (max−min+cell)/131070 |
+//!
+//! After decoding, [`ground::square_cells`] brings georeferenced grids whose
+//! true spacings differ (geographic DEMs, ESRI `dx` ≠ `dy`) to square metric
+//! cells, so nothing is ever stretched; [`load`] reports what it did.
 
 mod asc;
 mod atomic;
+pub mod engine;
 mod error;
 mod exr;
+mod geotiff;
+pub mod ground;
 mod hgt;
 mod limits;
+mod memory;
 mod png;
 mod quantize;
 mod raw;
@@ -36,11 +44,14 @@ mod sidecar;
 mod ter;
 mod tiff;
 pub mod type_mask;
+pub mod wkt;
 
 pub use atomic::write_atomic;
 pub use error::{FormatError, IoError};
 pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
+pub use ground::GridReport;
 pub use hgt::ARC_SECOND_M;
+pub use memory::{available_memory, check_memory};
 pub use sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
 pub use tiff::METRES_PER_DEGREE;
 pub use type_mask::TypeMask;
@@ -158,8 +169,11 @@ pub struct ReadOptions {
     pub format: Option<Format>,
     /// Dimensions of headerless raw files (R16/R32) when no sidecar gives them.
     pub size: Option<(usize, usize)>,
-    /// Overrides the cell size found in the file or sidecar.
+    /// The cell size in metres: a georeferenced grid is resampled to it
+    /// (see [`ground`]), any other grid's cell size is overridden.
     pub cell_size: Option<f64>,
+    /// Band of a multi-band GeoTIFF, 1-based (as GDAL's `-b`).
+    pub band: Option<usize>,
 }
 
 /// How to write a file.
@@ -170,6 +184,12 @@ pub struct WriteOptions {
     /// Height range mapped onto the integer range of quantized formats
     /// (PNG16, R16); by default the data's own min..max, so no precision is wasted.
     pub height_range: Option<(f64, f64)>,
+    /// Files the command read (inputs, scene files): no output, sidecar or
+    /// `.prj` may replace one of them.
+    pub inputs: Vec<PathBuf>,
+    /// PNG16 / R16: store rows south to north (Unity's order, see
+    /// [`engine`]); the sidecar records it so terrasynth reads them back.
+    pub south_up: bool,
 }
 
 /// Decodes a heightfield from bytes. `sidecar` is the JSON sidecar's bytes for
@@ -180,22 +200,97 @@ pub fn decode(
     sidecar: Option<&[u8]>,
     opts: &ReadOptions,
 ) -> Result<Heightfield, FormatError> {
-    let sidecar = sidecar.map(Sidecar::parse).transpose()?;
+    let companions = Companions {
+        sidecar,
+        ..Default::default()
+    };
+    load_bytes(bytes, format, &companions, opts).map(|l| l.heightfield)
+}
+
+/// The files beside a data file that complete it.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Companions<'a> {
+    /// The JSON sidecar (`<stem>.json`), for formats that use one.
+    pub sidecar: Option<&'a [u8]>,
+    /// The ESRI `.prj` (WKT), for formats without a CRS of their own.
+    pub prj: Option<&'a [u8]>,
+    /// The data file's name (SRTM tiles are placed by it).
+    pub file_name: Option<&'a str>,
+}
+
+/// A heightfield as read, with what the reader had to decide.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub heightfield: Heightfield,
+    /// The cell size is the documented default (nothing in the file gave one).
+    pub cell_size_default: bool,
+    /// Spacings as read and notices (resampling, dropped placement).
+    pub grid: GridReport,
+}
+
+/// Decodes bytes with their companion files, then brings the grid to
+/// square metric cells ([`ground::square_cells`]).
+pub fn load_bytes(
+    bytes: &[u8],
+    format: Format,
+    companions: &Companions,
+    opts: &ReadOptions,
+) -> Result<Loaded, FormatError> {
+    let sidecar = companions.sidecar.map(Sidecar::parse).transpose()?;
     let sc = sidecar.as_ref();
     let mut hf = match format {
         Format::Png16 | Format::Png8 => png::decode(bytes, sc)?,
         Format::Exr => exr::decode(bytes)?,
-        Format::Tiff => tiff::decode(bytes)?,
+        Format::Tiff => tiff::decode(bytes, opts.band)?,
         Format::Hgt => hgt::decode(bytes)?,
         Format::Asc => asc::decode(bytes)?,
         Format::R16 => raw::decode16(bytes, sc, opts.size)?,
         Format::R32 => raw::decode32(bytes, sc, opts.size)?,
         Format::Ter => ter::decode(bytes)?,
     };
-    if let Some(cell) = opts.cell_size {
-        hf.set_cell_size(cell)?;
+    if format != Format::Tiff && opts.band.is_some_and(|b| b != 1) {
+        return Err(FormatError::Metadata(format!(
+            "--band {} needs a multi-band GeoTIFF; {format} files have one band",
+            opts.band.unwrap_or(1)
+        )));
     }
-    Ok(hf)
+    if let Some(g) = sc.and_then(|s| s.georef.clone()) {
+        hf.set_georef(Some(g));
+    }
+    if format == Format::Hgt
+        && let Some(g) = companions
+            .file_name
+            .and_then(|n| ground::hgt_georef(n, hf.width()))
+    {
+        hf.set_georef(Some(g));
+    }
+    if let Some(prj) = companions.prj {
+        let crs = wkt::parse(prj).map_err(FormatError::Prj)?;
+        if let Some(g) = hf.georef().cloned()
+            && g.crs.is_none()
+        {
+            hf.set_georef(Some(crate::georef::Georef {
+                crs: Some(crs),
+                ..g
+            }));
+        }
+    }
+    let cell_size_default = opts.cell_size.is_none()
+        && hf.georef().is_none()
+        && match format {
+            Format::Png16 | Format::Png8 | Format::R16 | Format::R32 => {
+                sc.is_none_or(|s| s.cell_size_m.is_none())
+            }
+            Format::Exr => !exr::has_cell_size(bytes),
+            Format::Tiff => hf.cell_size() == DEFAULT_CELL_SIZE_M,
+            Format::Hgt | Format::Asc | Format::Ter => false,
+        };
+    let (heightfield, grid) = ground::square_cells(hf, opts.cell_size)?;
+    Ok(Loaded {
+        heightfield,
+        cell_size_default,
+        grid,
+    })
 }
 
 /// What [`encode`] produces: the file's bytes and, for formats that need one,
@@ -214,11 +309,11 @@ pub fn encode(
     opts: &WriteOptions,
 ) -> Result<Encoded, FormatError> {
     match format {
-        Format::Png16 => png::encode16(hf, opts.height_range),
+        Format::Png16 => png::encode16(hf, opts.height_range, opts.south_up),
         Format::Exr => exr::encode(hf),
         Format::Tiff => tiff::encode(hf),
         Format::Asc => asc::encode(hf),
-        Format::R16 => raw::encode16(hf, opts.height_range),
+        Format::R16 => raw::encode16(hf, opts.height_range, opts.south_up),
         Format::R32 => raw::encode32(hf),
         Format::Ter => ter::encode(hf),
         Format::Png8 | Format::Hgt => Err(FormatError::Unwritable(format!(
@@ -246,26 +341,52 @@ fn input_format(path: &Path, bytes: &[u8], opts: &ReadOptions) -> Result<Format,
     })
 }
 
+/// Reads a companion file, `None` when it does not exist.
+fn companion(path: &Path) -> Result<Option<Vec<u8>>, IoError> {
+    match std::fs::read(path) {
+        Ok(b) => Ok(Some(b)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(IoError::os(path, e)),
+    }
+}
+
+/// The `.prj` path of a data file.
+pub fn prj_path(path: &Path) -> PathBuf {
+    path.with_extension("prj")
+}
+
 /// Reads a heightfield file (and its sidecar when the format uses one).
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Heightfield, IoError> {
+    load(path, opts).map(|l| l.heightfield)
+}
+
+/// Reads a heightfield file with its companions (sidecar, `.prj`), and says
+/// what the reader decided ([`Loaded`]).
+pub fn load(path: &Path, opts: &ReadOptions) -> Result<Loaded, IoError> {
     let bytes = std::fs::read(path).map_err(|e| IoError::os(path, e))?;
     let format = input_format(path, &bytes, opts)?;
     let sidecar_bytes = if format.uses_sidecar() {
-        let sc = sidecar_path(path);
-        match std::fs::read(&sc) {
-            Ok(b) => Some(b),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-            Err(e) => return Err(IoError::os(&sc, e)),
-        }
+        companion(&sidecar_path(path))?
     } else {
         None
     };
-    decode(&bytes, format, sidecar_bytes.as_deref(), opts).map_err(|kind| {
-        // A sidecar problem is reported against the sidecar's path.
-        let p = if matches!(kind, FormatError::InvalidSidecar(_)) {
-            sidecar_path(path)
-        } else {
-            path.to_path_buf()
+    let prj = if format == Format::Asc {
+        companion(&prj_path(path))?
+    } else {
+        None
+    };
+    let name = path.file_name().and_then(|n| n.to_str());
+    let companions = Companions {
+        sidecar: sidecar_bytes.as_deref(),
+        prj: prj.as_deref(),
+        file_name: name,
+    };
+    load_bytes(&bytes, format, &companions, opts).map_err(|kind| {
+        // A sidecar or .prj problem is reported against that file.
+        let p = match kind {
+            FormatError::InvalidSidecar(_) => sidecar_path(path),
+            FormatError::Prj(_) => prj_path(path),
+            _ => path.to_path_buf(),
         };
         IoError::Format { path: p, kind }
     })
@@ -273,6 +394,20 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Heightfield, IoError> {
 
 /// Writes a heightfield atomically (and its sidecar when the format has one).
 pub fn write(hf: &Heightfield, path: &Path, opts: &WriteOptions) -> Result<(), IoError> {
+    write_noted(hf, path, opts).map(|_| ())
+}
+
+/// [`write`], returning one-line notices for the user (a CRS that the
+/// format cannot carry).
+///
+/// Every file it would write — the data file, its sidecar, its `.prj` — is
+/// first checked against [`WriteOptions::inputs`]: an output that would
+/// replace an input is refused before anything is written.
+pub fn write_noted(
+    hf: &Heightfield,
+    path: &Path,
+    opts: &WriteOptions,
+) -> Result<Vec<String>, IoError> {
     let format = match opts.format {
         Some(f) => f,
         None => Format::from_path(path).ok_or_else(|| IoError::unknown_format(path))?,
@@ -281,10 +416,93 @@ pub fn write(hf: &Heightfield, path: &Path, opts: &WriteOptions) -> Result<(), I
         path: path.to_path_buf(),
         kind,
     })?;
+    let mut notes = Vec::new();
+    let prj = match (format, hf.georef().and_then(|g| g.crs.as_ref())) {
+        (Format::Asc, Some(crs)) if !hf.georef().is_some_and(|g| g.is_local()) => {
+            match crs.wkt.clone().or_else(|| crs.epsg.and_then(wkt::for_epsg)) {
+                Some(w) => Some(w),
+                None => {
+                    notes.push(format!(
+                        "{} has no .prj: the CRS {} has no WKT here (write a GeoTIFF to keep it)",
+                        path.display(),
+                        crs.label()
+                    ));
+                    None
+                }
+            }
+        }
+        _ => None,
+    };
+    // A CRS known only by its WKT: GDAL does not rebuild one from GeoKeys
+    // alone, so it also goes into GDAL's PAM sidecar (`<file>.aux.xml`),
+    // which GDAL and QGIS read with the TIFF.
+    let pam = match (format, hf.georef().and_then(|g| g.crs.as_ref())) {
+        (Format::Tiff, Some(c)) if c.epsg.is_none() && c.wkt.is_some() => Some(format!(
+            "<PAMDataset>\n  <SRS>{}</SRS>\n</PAMDataset>\n",
+            xml_escape(c.wkt.as_deref().unwrap_or_default())
+        )),
+        _ => None,
+    };
+    let mut targets = vec![path.to_path_buf()];
+    if pam.is_some() {
+        targets.push(pam_path(path));
+    }
+    if enc.sidecar.is_some() {
+        targets.push(sidecar_path(path));
+    }
+    if prj.is_some() {
+        targets.push(prj_path(path));
+    }
+    for t in &targets {
+        if let Some(input) = opts.inputs.iter().find(|i| same_file(i, t)) {
+            return Err(IoError::WouldOverwrite {
+                path: t.clone(),
+                input: input.clone(),
+            });
+        }
+    }
     // The sidecar goes first: a reader that finds the data file then always
     // finds the mapping that belongs to it.
     if let Some(sc) = &enc.sidecar {
         write_atomic(&sidecar_path(path), sc)?;
     }
-    write_atomic(path, &enc.bytes)
+    if let Some(w) = &prj {
+        write_atomic(&prj_path(path), w.as_bytes())?;
+    }
+    if let Some(x) = &pam {
+        write_atomic(&pam_path(path), x.as_bytes())?;
+    }
+    write_atomic(path, &enc.bytes)?;
+    Ok(notes)
+}
+
+/// GDAL's PAM sidecar of a data file (`<file>.aux.xml`).
+pub fn pam_path(path: &Path) -> PathBuf {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".aux.xml");
+    PathBuf::from(name)
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// Whether two paths name the same file (or would: an output that does not
+/// exist yet is compared by its absolute path).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    let abs = |p: &Path| {
+        std::fs::canonicalize(p).unwrap_or_else(|_| {
+            let parent = p
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            std::fs::canonicalize(parent)
+                .map(|d| d.join(p.file_name().unwrap_or_default()))
+                .unwrap_or_else(|_| p.to_path_buf())
+        })
+    };
+    abs(a) == abs(b)
 }

@@ -82,8 +82,9 @@ pub(super) fn decode(bytes: &[u8], sidecar: Option<&Sidecar>) -> Result<Heightfi
 pub(super) fn encode16(
     hf: &Heightfield,
     range: Option<(f64, f64)>,
+    south_up: bool,
 ) -> Result<Encoded, FormatError> {
-    let q = quantize16(hf, range)?;
+    let q = quantize16(hf, range, south_up)?;
     let mut bytes = Vec::with_capacity(q.codes.len() * 2);
     for c in &q.codes {
         bytes.extend_from_slice(&c.to_be_bytes());

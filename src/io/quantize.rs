@@ -19,6 +19,7 @@ pub(super) struct Quantized {
 pub(super) fn quantize16(
     hf: &Heightfield,
     range: Option<(f64, f64)>,
+    south_up: bool,
 ) -> Result<Quantized, FormatError> {
     let has_nodata = hf.nodata_count() > 0;
     let (min, max) = match (range, hf.stats()) {
@@ -41,9 +42,13 @@ pub(super) fn quantize16(
         offset_m: m.offset_m - lo as f64 * m.scale_m,
         scale_m: m.scale_m,
     };
-    let codes = hf
-        .data()
-        .iter()
+    let rows: Box<dyn Iterator<Item = usize>> = if south_up {
+        Box::new((0..hf.height()).rev())
+    } else {
+        Box::new(0..hf.height())
+    };
+    let codes = rows
+        .flat_map(|y| hf.row(y))
         .map(|&v| {
             let code = if v.is_nan() {
                 0
@@ -62,6 +67,8 @@ pub(super) fn quantize16(
         width: Some(hf.width()),
         height: Some(hf.height()),
         nodata_value: has_nodata.then_some(0.0),
+        georef: hf.georef().cloned(),
+        south_up,
     };
     Ok(Quantized {
         codes,
@@ -85,7 +92,7 @@ pub(super) fn dequantize(
     let cell = sidecar
         .and_then(|s| s.cell_size_m)
         .unwrap_or(DEFAULT_CELL_SIZE_M);
-    let data: Vec<f32> = codes
+    let mut data: Vec<f32> = codes
         .take(width * height)
         .map(|v| {
             if nodata == Some(v as f64) {
@@ -95,5 +102,10 @@ pub(super) fn dequantize(
             }
         })
         .collect();
+    if sidecar.is_some_and(|s| s.south_up) && data.len() == width * height {
+        // Rows stored south to north (Unity's order): back to north-up.
+        let flipped: Vec<f32> = data.chunks_exact(width).rev().flatten().copied().collect();
+        data = flipped;
+    }
     Ok(Heightfield::from_vec(width, height, cell, data)?)
 }

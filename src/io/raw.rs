@@ -109,9 +109,10 @@ fn dimensions(
 pub(super) fn encode16(
     hf: &Heightfield,
     range: Option<(f64, f64)>,
+    south_up: bool,
 ) -> Result<Encoded, FormatError> {
     FormatError::check_no_nodata(hf, Format::R16)?;
-    let q = quantize16(hf, range)?;
+    let q = quantize16(hf, range, south_up)?;
     Ok(Encoded {
         bytes: q.codes.iter().flat_map(|c| c.to_le_bytes()).collect(),
         sidecar: Some(q.sidecar),
@@ -128,6 +129,8 @@ pub(super) fn encode32(hf: &Heightfield) -> Result<Encoded, FormatError> {
         width: Some(hf.width()),
         height: Some(hf.height()),
         nodata_value: None,
+        georef: hf.georef().cloned(),
+        south_up: false,
     };
     let (min, max) = hf
         .stats()

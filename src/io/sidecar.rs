@@ -6,12 +6,20 @@
 //! sidecars load as they are. Written: the same shape, so a file we write
 //! reads back in any tool that reads the shared DEMs.
 //!
+//! The georeference travels as `georeference.geotransform` (GDAL's six
+//! numbers, north-up), `pixel_is` (`area` / `point`) and the CRS
+//! (`crs_epsg`, `crs_wkt`, `crs_name`, `crs_units` = `degree` or
+//! `metres_per_unit`). The shared DEMs' descriptive `georeference` (corner
+//! latitudes and longitudes of an already resampled grid) has no
+//! geotransform and is not read as one.
+//!
 //! Without a sidecar, [`HeightMapping::default_for_bits`] applies: 16-bit
 //! samples are decimetres (0–6553.5 m), 8-bit samples are 10 m steps
 //! (0–2550 m), and cells are 10 m (the paper's scale). These defaults are a
 //! convention, not a guess about the file; `info` reports when they were used.
 
 use super::FormatError;
+use crate::georef::{Crs, Georef, PixelIs, Units};
 use serde_json::{Map, Value, json};
 
 /// Metres of an integer sample `v`: `offset_m + scale_m * v`.
@@ -60,6 +68,11 @@ pub struct Sidecar {
     pub height: Option<usize>,
     /// Integer sample value that marks nodata, if any.
     pub nodata_value: Option<f64>,
+    /// Where the grid lies, when known.
+    pub georef: Option<Georef>,
+    /// Rows are stored south to north (`"row_order": "south_to_north"`,
+    /// written for Unity); default north to south.
+    pub south_up: bool,
 }
 
 impl Sidecar {
@@ -103,6 +116,20 @@ impl Sidecar {
             width: dimension(top, "width")?,
             height: dimension(top, "height")?,
             nodata_value: number(top, "nodata_value", "")?,
+            south_up: match top.get("row_order") {
+                None | Some(Value::Null) => false,
+                Some(Value::String(s)) if s == "south_to_north" => true,
+                Some(Value::String(s)) if s == "north_to_south" => false,
+                Some(other) => {
+                    return Err(bad(format!(
+                        "row_order is {other}: expected \"north_to_south\" or \"south_to_north\""
+                    )));
+                }
+            },
+            georef: match top.get("georeference") {
+                Some(Value::Object(g)) if g.contains_key("geotransform") => Some(georef(g)?),
+                _ => None,
+            },
         })
     }
 
@@ -141,6 +168,25 @@ impl Sidecar {
         if let Some(n) = self.nodata_value {
             v["nodata_value"] = json!(n);
         }
+        if self.south_up {
+            v["row_order"] = json!("south_to_north");
+        }
+        if let Some(g) = &self.georef {
+            let c = g.crs.as_ref();
+            v["georeference"] = json!({
+                "geotransform": [g.origin_x, g.pixel_x, 0.0, g.origin_y, 0.0, -g.pixel_y],
+                "pixel_is": if g.pixel_is == PixelIs::Point { "point" } else { "area" },
+                "crs_epsg": c.and_then(|c| c.epsg),
+                "crs_name": c.and_then(|c| c.name.clone()),
+                "crs_wkt": c.and_then(|c| c.wkt.clone()),
+                "crs_units": match c.map(|c| c.units) {
+                    None => json!(null),
+                    Some(Units::Degrees) => json!("degree"),
+                    Some(Units::Linear { metres_per_unit }) => json!({ "metres_per_unit": metres_per_unit }),
+                },
+                "crs_vertical_epsg": c.and_then(|c| c.vertical_epsg),
+            });
+        }
         let mut s = serde_json::to_vec_pretty(&v).expect("JSON values always serialize");
         s.push(b'\n');
         s
@@ -160,6 +206,73 @@ fn number(obj: &Map<String, Value>, key: &str, prefix: &str) -> Result<Option<f6
             "{prefix}{key} must be a number, found {other}"
         ))),
     }
+}
+
+/// Our own `georeference` object (see the module docs).
+fn georef(g: &Map<String, Value>) -> Result<Georef, FormatError> {
+    let bad = |m: &str| FormatError::InvalidSidecar(format!("georeference.{m}"));
+    let t: Vec<f64> = g
+        .get("geotransform")
+        .and_then(Value::as_array)
+        .filter(|a| a.len() == 6)
+        .and_then(|a| a.iter().map(Value::as_f64).collect())
+        .ok_or_else(|| bad("geotransform must be an array of 6 numbers"))?;
+    if t[2] != 0.0 || t[4] != 0.0 {
+        return Err(bad(
+            "geotransform is rotated: expected a north-up grid (terms 2 and 4 = 0)",
+        ));
+    }
+    let code = |k: &str| -> Result<Option<u32>, FormatError> {
+        match g.get(k) {
+            None | Some(Value::Null) => Ok(None),
+            Some(v) => v
+                .as_u64()
+                .and_then(|c| u32::try_from(c).ok())
+                .map(Some)
+                .ok_or_else(|| bad(&format!("{k} must be an EPSG code"))),
+        }
+    };
+    let text = |k: &str| g.get(k).and_then(Value::as_str).map(str::to_string);
+    let units = match g.get("crs_units") {
+        None | Some(Value::Null) => None,
+        Some(Value::String(s)) if s == "degree" => Some(Units::Degrees),
+        Some(Value::Object(o)) => match o.get("metres_per_unit").and_then(Value::as_f64) {
+            Some(m) if m.is_finite() && m > 0.0 => Some(Units::Linear { metres_per_unit: m }),
+            _ => return Err(bad("crs_units.metres_per_unit must be a number > 0")),
+        },
+        Some(_) => {
+            return Err(bad(
+                "crs_units must be \"degree\" or {\"metres_per_unit\": m}",
+            ));
+        }
+    };
+    let crs = units.map(|units| -> Result<Crs, FormatError> {
+        Ok(Crs {
+            epsg: code("crs_epsg")?,
+            wkt: text("crs_wkt"),
+            name: text("crs_name"),
+            units,
+            vertical_epsg: code("crs_vertical_epsg")?,
+        })
+    });
+    let out = Georef {
+        crs: crs.transpose()?,
+        origin_x: t[0],
+        origin_y: t[3],
+        pixel_x: t[1],
+        pixel_y: -t[5],
+        pixel_is: match g.get("pixel_is").and_then(Value::as_str) {
+            Some("point") => PixelIs::Point,
+            None | Some("area") => PixelIs::Area,
+            Some(_) => return Err(bad("pixel_is must be \"area\" or \"point\"")),
+        },
+    };
+    if !out.is_valid() {
+        return Err(bad(
+            "geotransform must be finite with cell sizes > 0 (term 1 > 0, term 5 < 0)",
+        ));
+    }
+    Ok(out)
 }
 
 fn dimension(obj: &Map<String, Value>, key: &str) -> Result<Option<usize>, FormatError> {
@@ -233,7 +346,32 @@ mod tests {
             width: Some(900),
             height: Some(900),
             nodata_value: None,
+            georef: None,
+            south_up: false,
         };
         assert_eq!(Sidecar::parse(&s.to_json(-17.0, 1206.0)).unwrap(), s);
+        let mut crs = Crs::epsg(4326, Units::Degrees);
+        crs.name = Some("WGS 84".into());
+        let s = Sidecar {
+            georef: Some(Georef {
+                crs: Some(crs),
+                origin_x: 1.0,
+                origin_y: 41.75,
+                pixel_x: 0.001,
+                pixel_y: 1.0 / 1200.0,
+                pixel_is: PixelIs::Point,
+            }),
+            ..s
+        };
+        assert_eq!(Sidecar::parse(&s.to_json(-17.0, 1206.0)).unwrap(), s);
+        let local = Sidecar {
+            georef: Some(Georef::local(900, 92.55)),
+            south_up: true,
+            ..s
+        };
+        assert_eq!(
+            Sidecar::parse(&local.to_json(-17.0, 1206.0)).unwrap(),
+            local
+        );
     }
 }

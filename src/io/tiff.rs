@@ -1,31 +1,36 @@
-//! GeoTIFF / TIFF heightfields: greyscale int16, uint16 or float32 (read,
-//! strips or tiles, any compression the `tiff` crate decodes), float32 (write).
+//! GeoTIFF / TIFF heightfields: read any greyscale or multi-band image of
+//! 8-, 16- or 32-bit integers or 32- or 64-bit floats, in strips or tiles,
+//! uncompressed or LZW, Deflate, PackBits or ZSTD; write float32.
 //!
-//! Metadata read:
-//! - `GDAL_NODATA` (tag 42113, ASCII): samples equal to it become NaN; NaN
-//!   float samples are nodata regardless.
-//! - `ModelPixelScaleTag` (33550): the cell size. Projected units are
-//!   converted to metres from `ProjLinearUnitsGeoKey` (metre, foot, US survey
-//!   foot). Geographic rasters (`GTModelTypeGeoKey` = 2) have scales in
-//!   degrees: the cell size becomes the north–south spacing,
-//!   `scale_y × 111 319.49 m` (one degree on the WGS84 equator), and the
-//!   georeference is dropped because [`Georef`] is in metres.
-//! - `ModelTiepointTag` (33922): the map position of the top-left corner
-//!   ([`Georef`]), shifted by half a cell for `RasterPixelIsPoint`.
+//! Read:
+//! - one band: the only one, or `ReadOptions::band` (1-based, as GDAL's
+//!   `-b`) of a multi-band file, which without it is refused with the band
+//!   count;
+//! - `GDAL_NODATA` (tag 42113): samples equal to it become NaN; NaN float
+//!   samples are nodata regardless;
+//! - GDAL's per-band scale, offset and unit, and the vertical unit GeoKey:
+//!   heights are `(raw × scale + offset) × metres per unit`;
+//! - the georeference and CRS ([`super::geotiff`]). The cell size is the
+//!   pixel size in metres for projected files; geographic files keep their
+//!   degree geometry here and are resampled to square metric cells by
+//!   [`super::ground`];
+//! - LERC (34887) and LZMA (34925) are refused with the GDAL command that
+//!   rewrites the file in a codec we read: no maintained pure-Rust decoder is
+//!   wired into the `tiff` crate for them.
 //!
 //! Written: float32, uncompressed strips (every GeoTIFF reader opens them),
-//! NaN for nodata with `GDAL_NODATA = "nan"`, the pixel scale, the tiepoint
-//! when the heightfield has a georeference, and a minimal GeoKeyDirectory
-//! (projected model, pixel-is-area, metres) so that the scale is never
-//! mistaken for degrees. No CRS is claimed: we do not know one.
+//! NaN for nodata with `GDAL_NODATA = "nan"`, and the georeference with its
+//! CRS, or — for a terrain that has none — a local grid in metres with the
+//! correct cell size and its lower-left corner at (0, 0), named as such
+//! ([`Georef::local`]), never an invented EPSG code.
 
-use super::limits::{DEFLATE_RATIO, LZW_RATIO, PACKBITS_RATIO, check_justified};
+use super::geotiff::{self, GeoKeys};
+use super::limits::{DEFLATE_RATIO, LZW_RATIO, PACKBITS_RATIO, ZSTD_RATIO, check_justified};
 use super::sidecar::DEFAULT_CELL_SIZE_M;
 use super::{Encoded, FormatError};
-use crate::heightfield::{Georef, Heightfield, check_dims};
-use std::collections::HashMap;
+use crate::georef::Georef;
+use crate::heightfield::{Heightfield, check_dims};
 use std::io::Cursor;
-use tiff::ColorType;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::encoder::{TiffEncoder, colortype::Gray32Float};
 use tiff::tags::{SampleFormat, Tag};
@@ -33,33 +38,15 @@ use tiff::tags::{SampleFormat, Tag};
 /// Metres per degree on the WGS84 equator (40 075 016.686 m / 360).
 pub const METRES_PER_DEGREE: f64 = 111_319.490_793;
 
-const KEY_MODEL_TYPE: u16 = 1024;
-const KEY_RASTER_TYPE: u16 = 1025;
-const KEY_ANGULAR_UNITS: u16 = 2054;
-const KEY_LINEAR_UNITS: u16 = 3076;
-const MODEL_PROJECTED: u16 = 1;
-const MODEL_GEOGRAPHIC: u16 = 2;
-const RASTER_PIXEL_IS_AREA: u16 = 1;
-const RASTER_PIXEL_IS_POINT: u16 = 2;
-const UNIT_METRE: u16 = 9001;
-const UNIT_DEGREE: u16 = 9102;
-
-pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
+pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, FormatError> {
     prescan(bytes)?;
     let mut dec = Decoder::new(Cursor::new(bytes)).map_err(tiff_error)?;
     let (w, h) = dec.dimensions().map_err(tiff_error)?;
     let (w, h) = (w as usize, h as usize);
     check_dims(w, h)?;
-    let bits = match dec.colortype().map_err(tiff_error)? {
-        ColorType::Gray(b @ (16 | 32)) => b,
-        other => {
-            return Err(FormatError::Unsupported {
-                what: "TIFF sample layout",
-                found: format!("{other:?}"),
-                supported: "one greyscale sample of int16, uint16 or float32",
-            });
-        }
-    };
+    let ratio = compression_ratio(&mut dec)?;
+    let color = dec.colortype().map_err(tiff_error)?;
+    let (bits, samples) = (color.bit_depth(), color.num_samples().max(1) as usize);
     let format = match dec.find_tag_unsigned_vec::<u16>(Tag::SampleFormat) {
         Ok(Some(v)) => v
             .first()
@@ -69,73 +56,215 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
         Err(e) => return Err(tiff_error(e)),
     };
     match (bits, format) {
-        (16, SampleFormat::Int | SampleFormat::Uint) | (32, SampleFormat::IEEEFP) => {}
+        (8 | 16 | 32, SampleFormat::Int | SampleFormat::Uint) | (32 | 64, SampleFormat::IEEEFP) => {
+        }
         _ => {
             return Err(FormatError::Unsupported {
                 what: "TIFF sample format",
                 found: format!("{bits}-bit {format:?}"),
-                supported: "int16, uint16 or float32",
+                supported: "int8/16/32, uint8/16/32, float32 or float64 (gdal_translate -ot Float32 converts the rest)",
             });
         }
     }
-    let ratio = match dec
-        .find_tag_unsigned::<u16>(Tag::Compression)
-        .map_err(tiff_error)?
-    {
-        None | Some(1) => 1,
-        Some(32773) => PACKBITS_RATIO,
-        Some(8 | 32946) => DEFLATE_RATIO,
-        // LZW, and whatever else the decoder accepts: the loosest bound.
-        Some(_) => LZW_RATIO,
-    };
-    let bytes_per_sample = bits as u64 / 8;
-    check_justified(w, h, bytes_per_sample, bytes.len(), ratio)?;
+    let band = pick_band(&mut dec, band, samples)?;
+    let bytes_per_pixel = bits as u64 / 8 * samples as u64;
+    check_justified(w, h, bytes_per_pixel, bytes.len(), ratio)?;
     // The decoder's limits, as a second line of defence: the image buffer
     // (checked above) or tag values expanded to the decoder's 32-byte value
     // type, compressed chunks no larger than the file.
     let mut limits = Limits::default();
-    limits.decoding_buffer_size = (w * h * bytes_per_sample as usize).max(32 * bytes.len());
+    limits.decoding_buffer_size = (w * h * bytes_per_pixel as usize).max(32 * bytes.len());
     limits.intermediate_buffer_size = bytes.len();
     limits.ifd_value_size = bytes.len();
     let mut dec = dec.with_limits(limits);
 
     let nodata = gdal_nodata(&mut dec)?;
-    let geo = geo_keys(&mut dec)?;
-    let (cell, georef) = placement(&mut dec, &geo)?;
-
-    let is_void = |v: f64| v.is_nan() || nodata == Some(v);
-    let mut data: Vec<f32> = match dec.read_image().map_err(tiff_error)? {
-        DecodingResult::I16(v) => v.iter().map(|&s| void_or(s as f64, is_void)).collect(),
-        DecodingResult::U16(v) => v.iter().map(|&s| void_or(s as f64, is_void)).collect(),
-        DecodingResult::F32(v) => {
-            let nodata = nodata.map(|n| n as f32);
-            v.iter()
-                .map(|&s| {
-                    if s.is_nan() || Some(s) == nodata {
-                        f32::NAN
-                    } else {
-                        s
-                    }
-                })
-                .collect()
+    let keys = geo_keys(&mut dec)?;
+    // Checked even when nothing places the grid: a CRS we cannot read is
+    // an error, never silently ignored.
+    let crs = keys.crs()?;
+    let scale = f64_tag(
+        &mut dec,
+        Tag::ModelPixelScaleTag,
+        2,
+        "ModelPixelScale (tag 33550)",
+    )?;
+    if let Some(s) = &scale
+        && !(s[0].is_finite() && s[1].is_finite() && s[0] > 0.0 && s[1] > 0.0)
+    {
+        return Err(FormatError::Metadata(format!(
+            "ModelPixelScale (tag 33550) is {} x {}: expected finite values > 0",
+            s[0], s[1]
+        )));
+    }
+    let tie = f64_tag(
+        &mut dec,
+        Tag::ModelTiepointTag,
+        6,
+        "ModelTiepoint (tag 33922)",
+    )?;
+    let matrix = f64_tag(
+        &mut dec,
+        Tag::ModelTransformationTag,
+        16,
+        "ModelTransformation (tag 34264)",
+    )?;
+    let georef = geotiff::placement(&keys, scale.as_deref(), tie.as_deref(), matrix.as_deref())?;
+    let cell = match (&georef, &scale) {
+        (Some(g), _) => cell_size(g, h),
+        // A scale without a position: metres if the keys say so, else as the
+        // north–south size of degrees on the equator (no latitude known).
+        (None, Some(s)) => match crs {
+            Some(c) if c.is_geographic() => s[1] * METRES_PER_DEGREE,
+            Some(c) => s[0] * georef_units(&c),
+            None => s[0],
+        },
+        (None, None) => DEFAULT_CELL_SIZE_M,
+    };
+    let mapping = match dec.find_tag(Tag::Unknown(42112)).map_err(tiff_error)? {
+        Some(v) => {
+            let xml = v.into_string().map_err(|_| {
+                FormatError::Metadata("GDAL_METADATA (tag 42112) must be ASCII text".into())
+            })?;
+            geotiff::band_mapping(&xml, band)?
         }
+        None => geotiff::BandMapping {
+            scale: 1.0,
+            offset: 0.0,
+            unit_m: 1.0,
+        },
+    };
+    let unit = mapping.unit_m * keys.vertical_metres()?;
+    let (scale_z, offset_z) = (mapping.scale * unit, mapping.offset * unit);
+    let identity = scale_z == 1.0 && offset_z == 0.0;
+    let convert = |raw: f64| -> f32 {
+        if raw.is_nan() || nodata == Some(raw) {
+            f32::NAN
+        } else if identity {
+            raw as f32
+        } else {
+            (raw * scale_z + offset_z) as f32
+        }
+    };
+    let n = w * h;
+    fn pick<T: Copy>(
+        v: &[T],
+        band: usize,
+        samples: usize,
+        n: usize,
+        f: impl Fn(T) -> f32,
+    ) -> Vec<f32> {
+        v.iter()
+            .skip(band)
+            .step_by(samples)
+            .take(n)
+            .map(|&s| f(s))
+            .collect()
+    }
+    let image = dec.read_image().map_err(tiff_error)?;
+    // F32 compares with the nodata value in f32, as GDAL does for Float32 bands.
+    let nodata32 = nodata.map(|v| v as f32);
+    let data: Vec<f32> = match &image {
+        DecodingResult::U8(v) => pick(v, band, samples, n, |s| convert(s as f64)),
+        DecodingResult::I8(v) => pick(v, band, samples, n, |s| convert(s as f64)),
+        DecodingResult::U16(v) => pick(v, band, samples, n, |s| convert(s as f64)),
+        DecodingResult::I16(v) => pick(v, band, samples, n, |s| convert(s as f64)),
+        DecodingResult::U32(v) => pick(v, band, samples, n, |s| convert(s as f64)),
+        DecodingResult::I32(v) => pick(v, band, samples, n, |s| convert(s as f64)),
+        DecodingResult::F64(v) => pick(v, band, samples, n, convert),
+        DecodingResult::F32(v) => pick(v, band, samples, n, |s| {
+            if Some(s) == nodata32 {
+                f32::NAN
+            } else {
+                convert(s as f64)
+            }
+        }),
         _ => {
             return Err(FormatError::Corrupt(
                 "TIFF decoded to an unexpected sample type".into(),
             ));
         }
     };
-    if data.len() < w * h {
+    drop(image);
+    if data.len() < n {
         return Err(FormatError::EndsEarly("TIFF image data"));
     }
-    data.truncate(w * h);
     let mut hf = Heightfield::from_vec(w, h, cell, data)?;
     hf.set_georef(georef);
     Ok(hf)
 }
 
-fn void_or(v: f64, is_void: impl Fn(f64) -> bool) -> f32 {
-    if is_void(v) { f32::NAN } else { v as f32 }
+/// Metres per linear unit of a CRS (1 for degrees, which never get here).
+fn georef_units(c: &crate::georef::Crs) -> f64 {
+    match c.units {
+        crate::georef::Units::Linear { metres_per_unit } => metres_per_unit,
+        crate::georef::Units::Degrees => 1.0,
+    }
+}
+
+/// The square cell size in metres: the north–south ground spacing (the
+/// east–west one is checked, and geographic grids resampled, by
+/// [`super::ground`]).
+fn cell_size(g: &Georef, rows: usize) -> f64 {
+    g.ground_spacing(rows).1
+}
+
+/// The best compression ratio of the file's codec; refuses codecs we cannot
+/// decode with the command that rewrites the file.
+fn compression_ratio(dec: &mut Dec) -> Result<u64, FormatError> {
+    let code = dec
+        .find_tag_unsigned::<u16>(Tag::Compression)
+        .map_err(tiff_error)?;
+    let refuse = |name: &'static str| FormatError::Unsupported {
+        what: "TIFF compression",
+        found: format!("{name} ({})", code.unwrap_or(0)),
+        supported: "none, LZW, Deflate, PackBits or ZSTD; rewrite the file with gdal_translate -co COMPRESS=DEFLATE in.tif out.tif",
+    };
+    Ok(match code {
+        None | Some(1) => 1,
+        Some(32773) => PACKBITS_RATIO,
+        Some(8 | 32946) => DEFLATE_RATIO,
+        Some(5) => LZW_RATIO,
+        Some(50000) => ZSTD_RATIO,
+        Some(34887) => return Err(refuse("LERC")),
+        Some(34925) => return Err(refuse("LZMA")),
+        Some(7) => return Err(refuse("JPEG (lossy, not for heights)")),
+        Some(50001) => return Err(refuse("WEBP (lossy, not for heights)")),
+        // Whatever else the decoder accepts: the loosest bound.
+        Some(_) => ZSTD_RATIO,
+    })
+}
+
+/// The 0-based band to read, checked against the file's band count.
+fn pick_band(dec: &mut Dec, band: Option<usize>, samples: usize) -> Result<usize, FormatError> {
+    let b = match (band, samples) {
+        (None, 1) => return Ok(0),
+        (None, n) => {
+            return Err(FormatError::Unsupported {
+                what: "TIFF band count",
+                found: format!("{n} bands"),
+                supported: "one band, or choose one with --band 1..=N",
+            });
+        }
+        (Some(b), n) if (1..=n).contains(&b) => b - 1,
+        (Some(b), n) => {
+            return Err(FormatError::Metadata(format!(
+                "band {b} does not exist: the file has {n} band{} (expected --band 1..={n})",
+                if n == 1 { "" } else { "s" }
+            )));
+        }
+    };
+    let planar = dec
+        .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
+        .map_err(tiff_error)?;
+    if planar == Some(2) && b > 0 {
+        return Err(FormatError::Unsupported {
+            what: "TIFF band layout",
+            found: format!("band {} of a band-interleaved (planar) file", b + 1),
+            supported: "the first band, or pixel-interleaved files; extract the band with gdal_translate -b N in.tif out.tif",
+        });
+    }
+    Ok(b)
 }
 
 type Dec<'a> = Decoder<Cursor<&'a [u8]>>;
@@ -155,101 +284,28 @@ fn gdal_nodata(dec: &mut Dec) -> Result<Option<f64>, FormatError> {
     })
 }
 
-/// The GeoKeyDirectory's short values (keys stored in the directory itself).
-fn geo_keys(dec: &mut Dec) -> Result<HashMap<u16, u16>, FormatError> {
+/// The GeoKeys with their ASCII and double parameters.
+fn geo_keys(dec: &mut Dec) -> Result<GeoKeys, FormatError> {
     let Some(value) = dec.find_tag(Tag::GeoKeyDirectoryTag).map_err(tiff_error)? else {
-        return Ok(HashMap::new());
+        return Ok(GeoKeys::default());
     };
-    let bad = |m: &str| FormatError::Metadata(format!("GeoKeyDirectory (tag 34735) {m}"));
-    let v = value
-        .into_u16_vec()
-        .map_err(|_| bad("must hold SHORT values"))?;
-    if v.len() < 4 {
-        return Err(bad("is shorter than its 4-value header"));
-    }
-    let n = v[3] as usize;
-    if v.len() < 4 + 4 * n {
-        return Err(bad(&format!(
-            "declares {n} keys but holds {}",
-            (v.len() - 4) / 4
-        )));
-    }
-    Ok(v[4..4 + 4 * n]
-        .chunks_exact(4)
-        .filter(|k| k[1] == 0)
-        .map(|k| (k[0], k[3]))
-        .collect())
-}
-
-/// Cell size in metres and georeference from the GeoTIFF tags.
-fn placement(dec: &mut Dec, geo: &HashMap<u16, u16>) -> Result<(f64, Option<Georef>), FormatError> {
-    let Some(scale) = f64_tag(
+    let dir = value.into_u16_vec().map_err(|_| {
+        FormatError::Metadata("GeoKeyDirectory (tag 34735) must hold SHORT values".into())
+    })?;
+    let ascii = match dec.find_tag(Tag::GeoAsciiParamsTag).map_err(tiff_error)? {
+        Some(v) => v.into_string().map_err(|_| {
+            FormatError::Metadata("GeoAsciiParams (tag 34737) must be ASCII text".into())
+        })?,
+        None => String::new(),
+    };
+    let doubles = f64_tag(
         dec,
-        Tag::ModelPixelScaleTag,
-        2,
-        "ModelPixelScale (tag 33550)",
+        Tag::GeoDoubleParamsTag,
+        0,
+        "GeoDoubleParams (tag 34736)",
     )?
-    else {
-        return Ok((DEFAULT_CELL_SIZE_M, None));
-    };
-    let (sx, sy) = (scale[0], scale[1]);
-    if !(sx.is_finite() && sy.is_finite() && sx > 0.0 && sy > 0.0) {
-        return Err(FormatError::Metadata(format!(
-            "ModelPixelScale (tag 33550) is {sx} x {sy}: expected finite values > 0"
-        )));
-    }
-    if geo.get(&KEY_MODEL_TYPE) == Some(&MODEL_GEOGRAPHIC) {
-        let unit = geo.get(&KEY_ANGULAR_UNITS).copied().unwrap_or(UNIT_DEGREE);
-        if unit != UNIT_DEGREE {
-            return Err(FormatError::Unsupported {
-                what: "GeoTIFF angular unit",
-                found: format!("EPSG {unit}"),
-                supported: "degrees (EPSG 9102)",
-            });
-        }
-        return Ok((sy * METRES_PER_DEGREE, None));
-    }
-    let unit = match geo.get(&KEY_LINEAR_UNITS).copied().unwrap_or(UNIT_METRE) {
-        UNIT_METRE => 1.0,
-        9002 => 0.3048,
-        9003 => 1200.0 / 3937.0,
-        other => {
-            return Err(FormatError::Unsupported {
-                what: "GeoTIFF linear unit",
-                found: format!("EPSG {other}"),
-                supported: "metre (9001), foot (9002), US survey foot (9003)",
-            });
-        }
-    };
-    if (sx - sy).abs() > 1e-9 * sx.max(sy) {
-        return Err(FormatError::Unsupported {
-            what: "GeoTIFF cell shape",
-            found: format!("{sx} x {sy} map units"),
-            supported: "square cells (resample first)",
-        });
-    }
-    let georef = match f64_tag(dec, Tag::ModelTiepointTag, 6, "ModelTiepoint (tag 33922)")? {
-        None => None,
-        Some(t) => {
-            let half = if geo.get(&KEY_RASTER_TYPE) == Some(&RASTER_PIXEL_IS_POINT) {
-                0.5
-            } else {
-                0.0
-            };
-            let x = (t[3] - (t[0] + half) * sx) * unit;
-            let y = (t[4] + (t[1] + half) * sy) * unit;
-            if !(x.is_finite() && y.is_finite()) {
-                return Err(FormatError::Metadata(format!(
-                    "ModelTiepoint (tag 33922) places the origin at {x}, {y}: expected finite coordinates"
-                )));
-            }
-            Some(Georef {
-                origin_x: x,
-                origin_y: y,
-            })
-        }
-    };
-    Ok((sx * unit, georef))
+    .unwrap_or_default();
+    GeoKeys::parse(&dir, &ascii, &doubles)
 }
 
 fn f64_tag(
@@ -382,6 +438,15 @@ pub(super) fn encode(hf: &Heightfield) -> Result<Encoded, FormatError> {
         )));
     }
     let unwritable = |e: tiff::TiffError| FormatError::Unwritable(format!("TIFF: {e}"));
+    let local;
+    let g = match hf.georef() {
+        Some(g) => g,
+        None => {
+            local = Georef::local(h, hf.cell_size());
+            &local
+        }
+    };
+    let tags = geotiff::tags(g);
     let mut out = Cursor::new(Vec::new());
     {
         let mut enc = TiffEncoder::new(&mut out).map_err(unwritable)?;
@@ -389,25 +454,16 @@ pub(super) fn encode(hf: &Heightfield) -> Result<Encoded, FormatError> {
             .new_image::<Gray32Float>(w as u32, h as u32)
             .map_err(unwritable)?;
         let dir = image.encoder();
-        let c = hf.cell_size();
-        dir.write_tag(Tag::ModelPixelScaleTag, &[c, c, 0.0][..])
+        dir.write_tag(Tag::ModelPixelScaleTag, &tags.pixel_scale[..])
             .map_err(unwritable)?;
-        if let Some(g) = hf.georef() {
-            dir.write_tag(
-                Tag::ModelTiepointTag,
-                &[0.0, 0.0, 0.0, g.origin_x, g.origin_y, 0.0][..],
-            )
+        dir.write_tag(Tag::ModelTiepointTag, &tags.tiepoint[..])
             .map_err(unwritable)?;
+        dir.write_tag(Tag::GeoKeyDirectoryTag, &tags.keys[..])
+            .map_err(unwritable)?;
+        if !tags.ascii.is_empty() {
+            dir.write_tag(Tag::GeoAsciiParamsTag, tags.ascii.as_str())
+                .map_err(unwritable)?;
         }
-        #[rustfmt::skip]
-        let keys: [u16; 16] = [
-            1, 1, 0, 3, // version 1.1.0, three keys
-            KEY_MODEL_TYPE, 0, 1, MODEL_PROJECTED,
-            KEY_RASTER_TYPE, 0, 1, RASTER_PIXEL_IS_AREA,
-            KEY_LINEAR_UNITS, 0, 1, UNIT_METRE,
-        ];
-        dir.write_tag(Tag::GeoKeyDirectoryTag, &keys[..])
-            .map_err(unwritable)?;
         if hf.nodata_count() > 0 {
             dir.write_tag(Tag::GdalNodata, "nan").map_err(unwritable)?;
         }
@@ -428,7 +484,7 @@ fn tiff_error(e: tiff::TiffError) -> FormatError {
         E::UnsupportedError(u) => FormatError::Unsupported {
             what: "TIFF feature",
             found: u.to_string(),
-            supported: "baseline greyscale strips or tiles, uncompressed, LZW, Deflate or PackBits",
+            supported: "strips or tiles, uncompressed, LZW, Deflate, PackBits or ZSTD; rewrite other files with gdal_translate -co COMPRESS=DEFLATE in.tif out.tif",
         },
         E::LimitsExceeded => FormatError::Corrupt(
             "TIFF strips or tiles decode to more data than the image size".into(),

@@ -11,8 +11,21 @@ pub mod gpu;
 #[cfg(feature = "serve")]
 pub mod http;
 
-use terrasynth::Heightfield;
 use terrasynth::io::Format;
+use terrasynth::{Georef, Heightfield};
+
+/// A placement without CRS (as an ESRI grid without `.prj` has): top-left
+/// corner (x, y), square cells of `cell` metres.
+pub fn placed(x: f64, y: f64, cell: f64) -> Georef {
+    Georef {
+        crs: None,
+        origin_x: x,
+        origin_y: y,
+        pixel_x: cell,
+        pixel_y: cell,
+        pixel_is: terrasynth::georef::PixelIs::Area,
+    }
+}
 
 /// Every format that can be written.
 pub fn writable() -> Vec<Format> {

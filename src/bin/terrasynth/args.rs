@@ -13,21 +13,37 @@ pub struct Input {
     /// Dimensions WxH of headerless raw input (R16/R32) without a sidecar.
     #[arg(long = "in-size", value_parser = parse_size)]
     pub size: Option<(usize, usize)>,
-    /// Override the input's cell size, in metres.
+    /// Cell size in metres. A georeferenced input (GeoTIFF, SRTM tile, ASC
+    /// with .prj) is resampled to square cells of this size; any other
+    /// input's cell size is overridden. Geographic inputs are resampled to
+    /// square cells of their north-south spacing without it.
     #[arg(long = "cell-size")]
     pub cell_size: Option<f64>,
+    /// Band of a multi-band GeoTIFF, 1-based (as gdal_translate -b).
+    #[arg(long)]
+    pub band: Option<usize>,
 }
 
 impl Input {
     pub fn read(&self, path: &Path) -> Result<terrasynth::Heightfield, io::IoError> {
-        io::read(
+        self.load(path).map(|l| l.heightfield)
+    }
+
+    /// Reads with what the reader decided, printing its notices.
+    pub fn load(&self, path: &Path) -> Result<io::Loaded, io::IoError> {
+        let loaded = io::load(
             path,
             &ReadOptions {
                 format: self.format,
                 size: self.size,
                 cell_size: self.cell_size,
+                band: self.band,
             },
-        )
+        )?;
+        for n in &loaded.grid.notes {
+            eprintln!("note: {}: {n}", path.display());
+        }
+        Ok(loaded)
     }
 }
 
@@ -101,6 +117,77 @@ pub fn select_backend(
 ) -> Result<(), terrasynth::synth::SynthError> {
     if let Some(notice) = synth.use_backend(arg.into())? {
         eprintln!("note: {notice}");
+    }
+    Ok(())
+}
+
+/// `--for`: a game engine's heightmap conventions.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum EngineArg {
+    /// Unity Terrain: 16-bit RAW (.raw), 2^n+1 square, rows south to north.
+    Unity,
+    /// Unreal Landscape: 16-bit PNG or .r16 of a recommended size.
+    Unreal,
+}
+
+/// Writes an output heightfield: never over one of `inputs`, with the
+/// engine's conventions and import settings when `engine` is given, and
+/// the writer's notices printed.
+pub fn write_output(
+    hf: &terrasynth::Heightfield,
+    path: &Path,
+    format: Option<Format>,
+    engine: Option<EngineArg>,
+    inputs: &[&Path],
+) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    use terrasynth::io::engine::{self, Engine};
+    let mut opts = io::WriteOptions {
+        format,
+        inputs: inputs.iter().map(|p| p.to_path_buf()).collect(),
+        ..Default::default()
+    };
+    let mut prepared = None;
+    let hf = match engine {
+        None => hf,
+        Some(e) => {
+            let e = match e {
+                EngineArg::Unity => Engine::Unity,
+                EngineArg::Unreal => Engine::Unreal,
+            };
+            let ext = path
+                .extension()
+                .and_then(|x| x.to_str())
+                .unwrap_or("")
+                .to_ascii_lowercase();
+            if format.is_some() || !e.accepts(&ext) {
+                return Err(format!(
+                    "--for {} writes {}; name the output accordingly (e.g. terrain.{})",
+                    e.name(),
+                    if e == Engine::Unity {
+                        "a 16-bit .raw"
+                    } else {
+                        "a 16-bit .png or .r16"
+                    },
+                    if e == Engine::Unity { "raw" } else { "png" }
+                )
+                .into());
+            }
+            let p = prepared.insert(engine::prepare(hf, e)?);
+            for n in &p.notes {
+                eprintln!("note: {n}");
+            }
+            opts.south_up = p.south_up;
+            &p.heightfield
+        }
+    };
+    for n in io::write_noted(hf, path, &opts)? {
+        eprintln!("note: {n}");
+    }
+    if let Some(p) = &prepared {
+        eprintln!("import settings for {}:", path.display());
+        for s in &p.settings {
+            eprintln!("  {s}");
+        }
     }
     Ok(())
 }

@@ -2,10 +2,10 @@
 
 use crate::{
     CliResult,
-    args::{Input, parse_format},
+    args::{EngineArg, Input, parse_format, write_output},
 };
 use std::path::PathBuf;
-use terrasynth::io::{self, Format, WriteOptions};
+use terrasynth::io::Format;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -29,6 +29,11 @@ pub struct Args {
     /// nodata to formats that cannot store it (R16, Terragen).
     #[arg(long)]
     fill_nodata: bool,
+    /// Lay the output out for a game engine and print its import settings:
+    /// unity (16-bit .raw, 2^n+1 square, rows south to north) or unreal
+    /// (16-bit .png or .r16 of a recommended size, with the Z scale).
+    #[arg(long = "for", value_enum)]
+    engine: Option<EngineArg>,
     #[command(flatten)]
     read: Input,
 }
@@ -41,14 +46,7 @@ pub fn run(a: Args) -> CliResult {
             eprintln!("filled {} nodata samples", report.filled);
         }
     }
-    io::write(
-        &hf,
-        &a.output,
-        &WriteOptions {
-            format: a.out_format,
-            ..Default::default()
-        },
-    )?;
+    write_output(&hf, &a.output, a.out_format, a.engine, &[&a.input])?;
     eprintln!(
         "wrote {} ({} x {})",
         a.output.display(),

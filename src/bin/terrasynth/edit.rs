@@ -2,7 +2,7 @@
 //! editing session (coherent re-synthesis between frames).
 
 use crate::CliResult;
-use crate::args::{BackendArg, load_database, select_backend};
+use crate::args::{BackendArg, EngineArg, load_database, select_backend, write_output};
 use std::path::{Path, PathBuf};
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::scene::{Scene, SceneEdits, overlay};
@@ -41,8 +41,17 @@ pub fn synth_scene(
     preview: Option<&Path>,
     overlay: bool,
     backend: BackendArg,
+    engine: Option<EngineArg>,
 ) -> CliResult {
-    let scene = Scene::read(scene)?;
+    let scene_path = scene;
+    let scene = Scene::read(scene_path)?;
+    let mut inputs = vec![scene_path];
+    inputs.extend(scene.database.as_deref());
+    // The output's sidecar (X.json) must never replace the scene (X.json).
+    crate::synth::check_outputs(&[Some(output), preview], &inputs)?;
+    // An editing session keeps every pass of every level (about three
+    // times the state of one synthesis).
+    crate::synth::check_synthesis_memory(scene.width, scene.height, 3.0)?;
     let db = load_database(scene.database.as_deref())?;
     let mut edits = SceneEdits::new();
     let first = edits.edits(&scene, &db)?;
@@ -55,7 +64,7 @@ pub fn synth_scene(
     )?;
     select_backend(session.synthesizer_mut(), backend)?;
     let frame = session.apply(first)?;
-    io::write(&frame.heightfield, output, &WriteOptions::default())?;
+    write_output(&frame.heightfield, output, None, engine, &inputs)?;
     let s = frame.heightfield.stats().expect("synthesis has no nodata");
     eprintln!(
         "wrote {} ({} x {}, seed {}, {} points, {} curves, {} junctions): heights {:.1} .. {:.1} m in {:.0} ms",

@@ -7,6 +7,7 @@ mod db;
 mod edit;
 mod generate;
 mod info;
+mod masks;
 mod progress;
 mod render;
 #[cfg(feature = "serve")]
@@ -34,6 +35,8 @@ enum Command {
     Info(info::Args),
     /// Convert a heightfield between formats (chosen by extension).
     Convert(convert::Args),
+    /// Write slope, flow accumulation, terrain-type and splat masks of a heightfield.
+    Masks(masks::Args),
     /// Time synthesis: median ms per size, level and stage, and memory per pixel.
     Bench(bench::Args),
     /// Build or inspect an exemplar database.
@@ -64,6 +67,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Masks(a) => masks::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),

@@ -1,9 +1,9 @@
 //! `terrasynth synth`: synthesize a terrain from an exemplar database.
 
 use crate::CliResult;
-use crate::args::{BackendArg, load_database, parse_size, select_backend};
-use std::path::PathBuf;
-use terrasynth::io::{self, WriteOptions};
+use crate::args::{BackendArg, EngineArg, load_database, parse_size, select_backend, write_output};
+use std::path::{Path, PathBuf};
+use terrasynth::io;
 use terrasynth::render::{self, RenderOptions};
 use terrasynth::synth::{Params, Synthesizer};
 
@@ -49,6 +49,40 @@ pub struct Args {
     /// With --scene: a preview without the controls drawn on it.
     #[arg(long, requires = "scene")]
     no_overlay: bool,
+    /// Lay the output out for a game engine and print its import settings
+    /// (see `convert --for`).
+    #[arg(long = "for", value_enum)]
+    engine: Option<EngineArg>,
+}
+
+/// Refuses outputs that would replace an input, before any work is done.
+pub fn check_outputs(outputs: &[Option<&Path>], inputs: &[&Path]) -> Result<(), io::IoError> {
+    for out in outputs.iter().flatten() {
+        let mut files = vec![out.to_path_buf()];
+        // Data files may bring a sidecar or a .prj with them.
+        match io::Format::from_path(out) {
+            Some(f) if f.uses_sidecar() => files.push(io::sidecar_path(out)),
+            Some(io::Format::Asc) => files.push(io::prj_path(out)),
+            _ => {}
+        }
+        for f in files {
+            if let Some(input) = inputs.iter().find(|i| io::same_file(i, &f)) {
+                return Err(io::IoError::WouldOverwrite {
+                    path: f,
+                    input: input.to_path_buf(),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a synthesis whose state would not fit in memory. `factor`: how
+/// many copies of the finest levels' state the caller keeps (an editing
+/// session keeps every pass of every level).
+pub fn check_synthesis_memory(width: usize, height: usize, factor: f64) -> Result<(), io::IoError> {
+    let bytes = (width * height) as f64 * Synthesizer::bytes_per_pixel(width, height) * factor;
+    io::check_memory(&format!("a {width}x{height} synthesis"), bytes as u64)
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -59,8 +93,16 @@ pub fn run(a: Args) -> CliResult {
             a.preview.as_deref(),
             !a.no_overlay,
             a.backend,
+            a.engine,
         );
     }
+    let inputs: Vec<&Path> = a.db.as_deref().into_iter().collect();
+    check_outputs(
+        &[Some(&a.output), a.preview.as_deref(), a.coords.as_deref()],
+        &inputs,
+    )?;
+    let (w, h) = a.size;
+    check_synthesis_memory(w, h, 1.0)?;
     let db = load_database(a.db.as_deref())?;
     let params = Params {
         jitter: a.jitter,
@@ -70,9 +112,8 @@ pub fn run(a: Args) -> CliResult {
     };
     let mut synth = Synthesizer::new(&db, params)?;
     select_backend(&mut synth, a.backend)?;
-    let (w, h) = a.size;
     let result = synth.run(w, h, a.seed)?;
-    io::write(&result.heightfield, &a.output, &WriteOptions::default())?;
+    write_output(&result.heightfield, &a.output, None, a.engine, &inputs)?;
     let s = result.heightfield.stats().expect("synthesis has no nodata");
     eprintln!(
         "wrote {} ({w} x {h}, seed {}): heights {:.1} .. {:.1} m in {:.0} ms",

@@ -1,0 +1,186 @@
+//! The masks people expect next to a heightfield, to texture and populate
+//! it in an engine or a GIS: slope, flow accumulation, a terrain-type map
+//! and an optional RGBA splat map. All are 8-bit images of the
+//! heightfield's size, rows north to south like it.
+//!
+//! - **slope**: degrees from the steepest of the central differences
+//!   (Horn's 3×3 would smooth more; central differences keep single-cell
+//!   gullies), `value = round(degrees × 255 / 90)`;
+//! - **flow accumulation**: D8 (O'Callaghan & Mark 1984): every cell sends
+//!   itself and what it received to its steepest lower neighbour (drop over
+//!   distance, diagonals at √2 cells), cells taken from the highest down, so
+//!   one pass suffices; pits keep their water (no depression filling).
+//!   `value = round(255 × ln(cells) / ln(all cells))`, so a single cell is
+//!   0 and a river draining the whole grid 255;
+//! - **types**: [`crate::procedural::types::TypeMask::classify`] (ridge,
+//!   slope, valley floor, plateau, cliff), the same masks the database uses;
+//! - **splat** (RGBA, weights summing to 255): R grass on gentle ground,
+//!   G rock on slopes above 30° (fully at 45°), B snow on the top 15 % of
+//!   the relief where not rock, A wet ground where flow accumulation is in
+//!   its top quarter.
+
+use crate::heightfield::Heightfield;
+use rayon::prelude::*;
+
+/// Slope in degrees, per cell.
+pub fn slope_degrees(hf: &Heightfield) -> Vec<f32> {
+    let (w, h, c) = (hf.width(), hf.height(), hf.cell_size() as f32);
+    let mut out = vec![0.0f32; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, o) in row.iter_mut().enumerate() {
+            let (xi, yi) = (x as isize, y as isize);
+            // One-sided at the border (the span shrinks to one cell).
+            let (x0, x1) = ((xi - 1).max(0), (xi + 1).min(w as isize - 1));
+            let (y0, y1) = ((yi - 1).max(0), (yi + 1).min(h as isize - 1));
+            let dx =
+                (hf.get_clamped(x1, yi) - hf.get_clamped(x0, yi)) / (c * (x1 - x0).max(1) as f32);
+            let dy =
+                (hf.get_clamped(xi, y1) - hf.get_clamped(xi, y0)) / (c * (y1 - y0).max(1) as f32);
+            let g = (dx * dx + dy * dy).sqrt();
+            *o = if g.is_finite() {
+                g.atan().to_degrees()
+            } else {
+                0.0
+            };
+        }
+    });
+    out
+}
+
+/// D8 flow accumulation in cells (each cell counts itself).
+pub fn flow_accumulation(hf: &Heightfield) -> Vec<u32> {
+    let (w, h) = (hf.width(), hf.height());
+    let d = hf.data();
+    let mut order: Vec<u32> = (0..(w * h) as u32).collect();
+    // Highest first; ties by index so the order is deterministic.
+    order.par_sort_unstable_by(|&a, &b| d[b as usize].total_cmp(&d[a as usize]).then(a.cmp(&b)));
+    let mut acc = vec![1u32; w * h];
+    for &i in &order {
+        let i = i as usize;
+        let (x, y) = ((i % w) as isize, (i / w) as isize);
+        let mut best = (0.0f32, usize::MAX);
+        for (dx, dy) in [
+            (-1, -1),
+            (0, -1),
+            (1, -1),
+            (-1, 0),
+            (1, 0),
+            (-1, 1),
+            (0, 1),
+            (1, 1),
+        ] {
+            let (nx, ny) = (x + dx, y + dy);
+            if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
+                continue;
+            }
+            let j = ny as usize * w + nx as usize;
+            let dist = if dx != 0 && dy != 0 {
+                std::f32::consts::SQRT_2
+            } else {
+                1.0
+            };
+            let drop = (d[i] - d[j]) / dist;
+            if drop > best.0 {
+                best = (drop, j);
+            }
+        }
+        if best.1 != usize::MAX {
+            acc[best.1] = acc[best.1].saturating_add(acc[i]);
+        }
+    }
+    acc
+}
+
+/// The masks of one heightfield, as 8-bit samples (RGBA for `splat`).
+pub struct Masks {
+    pub slope: Vec<u8>,
+    pub flow: Vec<u8>,
+    pub splat: Option<Vec<[u8; 4]>>,
+}
+
+/// Computes slope, flow and (when asked) splat masks.
+pub fn compute(hf: &Heightfield, splat: bool) -> Masks {
+    let slope = slope_degrees(hf);
+    let acc = flow_accumulation(hf);
+    let log_all = ((hf.len() as f32).ln()).max(f32::MIN_POSITIVE);
+    let flow_f: Vec<f32> = acc.iter().map(|&a| (a as f32).ln() / log_all).collect();
+    let to_u8 = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let splat = splat.then(|| {
+        let s = hf.stats();
+        let (lo, hi) = s.map_or((0.0, 0.0), |s| (s.min, s.max));
+        let snow_line = hi - 0.15 * (hi - lo);
+        slope
+            .iter()
+            .zip(&flow_f)
+            .zip(hf.data())
+            .map(|((&sl, &fl), &z)| {
+                let rock = ((sl - 30.0) / 15.0).clamp(0.0, 1.0);
+                let snow = if hi > lo && z >= snow_line {
+                    1.0 - rock
+                } else {
+                    0.0
+                };
+                let wet = ((fl - 0.75) / 0.25).clamp(0.0, 1.0) * (1.0 - rock) * (1.0 - snow);
+                let grass = (1.0 - rock - snow - wet).max(0.0);
+                // Integer weights that sum to exactly 255.
+                let r = (grass * 255.0).round() as u8;
+                let g = (rock * 255.0).round().min(255.0 - r as f32) as u8;
+                let b = (snow * 255.0).round().min(255.0 - r as f32 - g as f32) as u8;
+                [r, g, b, 255 - r - g - b]
+            })
+            .collect()
+    });
+    Masks {
+        slope: slope.iter().map(|&d| to_u8(d / 90.0)).collect(),
+        flow: flow_f.iter().map(|&f| to_u8(f)).collect(),
+        splat,
+    }
+}
+
+/// An 8-bit PNG of `channels` samples per pixel (1 grey, 4 RGBA).
+pub fn encode_png8(width: usize, height: usize, channels: usize, data: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
+    enc.set_color(if channels == 4 {
+        png::ColorType::Rgba
+    } else {
+        png::ColorType::Grayscale
+    });
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc
+        .write_header()
+        .expect("writing a PNG header to memory cannot fail");
+    writer
+        .write_image_data(data)
+        .expect("the buffer has width × height × channels bytes");
+    drop(writer);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_of_a_plane_and_flow_down_a_valley() {
+        // A 45° ramp: rise of one cell per cell.
+        let ramp = Heightfield::from_fn(8, 8, 2.0, |x, _| 2.0 * x as f32).unwrap();
+        for d in slope_degrees(&ramp) {
+            assert!((d - 45.0).abs() < 1e-4, "{d}");
+        }
+        // A V valley draining south: column 4 collects everything.
+        let v = Heightfield::from_fn(9, 10, 1.0, |x, y| {
+            (x as f32 - 4.0).abs() * 2.0 + (9 - y) as f32 * 0.1
+        })
+        .unwrap();
+        let acc = flow_accumulation(&v);
+        assert_eq!(acc[9 * 9 + 4], 90, "the outlet drains the whole grid");
+        assert_eq!(acc[0], 1, "a corner receives nothing");
+        let m = compute(&v, true);
+        assert_eq!(m.flow[9 * 9 + 4], 255);
+        assert_eq!(m.flow[0], 0);
+        for p in m.splat.unwrap() {
+            assert_eq!(p.iter().map(|&c| c as u32).sum::<u32>(), 255);
+        }
+    }
+}
