@@ -153,15 +153,22 @@ impl Handle {
         }
         let mut task = task;
         if let Task::Scene { commit, .. } = &mut task
+            && matches!(
+                q.jobs.back(),
+                Some(Job {
+                    task: Task::Scene { .. },
+                    ..
+                })
+            )
             && let Some(Job {
                 task: Task::Scene { commit: older, .. },
+                reply,
                 ..
-            }) = q.jobs.back()
+            }) = q.jobs.pop_back()
         {
             // Latest wins; a commit it replaces is committed by it.
-            *commit |= *older;
-            let old = q.jobs.pop_back().expect("checked");
-            let _ = old.reply.send(Ok(json!({"superseded": true})));
+            *commit |= older;
+            let _ = reply.send(Ok(json!({"superseded": true})));
         }
         q.jobs.push_back(Job {
             task,

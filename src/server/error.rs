@@ -28,7 +28,7 @@ pub enum ApiError {
     /// A JSON body without `Content-Type: application/json` (415).
     #[error("the body must be sent with Content-Type: application/json")]
     MediaType,
-    /// Unknown or closed session (404).
+    /// Unknown or closed session (404, field `id`: the path's session).
     #[error("no editor session {0:?}: it was closed, timed out or never existed; reload the page")]
     NoSession(String),
     /// No such resource (404).
@@ -101,6 +101,7 @@ impl ApiError {
         match self {
             ApiError::Malformed { field, .. } | ApiError::Invalid { field, .. } => field,
             ApiError::Scene(e) => &e.path,
+            ApiError::NoSession(_) => "id",
             _ => "$",
         }
     }

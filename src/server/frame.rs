@@ -147,6 +147,9 @@ impl Editor {
             false => rebuild_reason(&self.scene, &scene),
         };
         if self.rebuilt.is_some() {
+            // The new session is built beside the old one (a new size is
+            // checked as a new tab's is).
+            super::registry::check_memory(scene.width, scene.height)?;
             let (session, edits, frame, timing) = start(self.db, &scene)?;
             self.session = session;
             self.edits = edits;

@@ -10,8 +10,8 @@
 //!
 //! The page sends the whole scene document (the scene-file format of
 //! [`crate::scene`]) with every edit; the server finds what changed and
-//! re-synthesizes only that, coherently. Loopback by default; requests
-//! naming another host, or coming from another site, are refused; bodies
+//! re-synthesizes only that, coherently. Loopback only; requests naming
+//! another host, or coming from another site, are refused; bodies
 //! are bounded; every bad request gets a 4xx JSON error naming the field.
 //! The only file the server writes is the scene file given with `--scene`
 //! (on Save, atomically); exports are downloads.
@@ -89,6 +89,12 @@ impl Default for Config {
 #[non_exhaustive]
 #[derive(Debug, Error)]
 pub enum ServeError {
+    /// The editor has no authentication: anyone who reaches it can read
+    /// and change the terrain and make the server write its scene file.
+    #[error(
+        "--bind {0}: the editor listens on loopback only (127.0.0.1 or [::1]); to reach it from another machine, forward a port (ssh -L 8080:127.0.0.1:8080 host)"
+    )]
+    NotLoopback(SocketAddr),
     #[error("cannot listen on {addr}: {source}")]
     Bind {
         addr: SocketAddr,
@@ -148,7 +154,7 @@ pub(crate) struct App {
     registry: registry::Registry,
     scene_file: Option<PathBuf>,
     max_request_bytes: usize,
-    /// Host names requests may name (loopback binds only; empty = any).
+    /// Host names requests may name (the loopback names of the port).
     hosts: Vec<String>,
     exemplar_previews: Mutex<Vec<Option<Arc<Vec<u8>>>>>,
     /// This run of the server: a page reloaded while it runs restores its
@@ -206,6 +212,9 @@ impl Drop for Running {
 
 /// Binds, starts loading the database, and serves on background threads.
 pub fn start(config: Config) -> Result<Running, ServeError> {
+    if !config.bind.ip().is_loopback() {
+        return Err(ServeError::NotLoopback(config.bind));
+    }
     let (width, height) = config.size;
     crate::heightfield::check_dims(width, height)
         .map_err(|e| ServeError::Size(width, height, e.to_string()))?;
@@ -218,16 +227,14 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
         .set_nonblocking(true)
         .map_err(ServeError::Runtime)?;
     let addr = listener.local_addr().map_err(ServeError::Runtime)?;
-    if addr.ip().is_loopback() {
-        // DNS rebinding: a page of another site that resolves its own name
-        // to 127.0.0.1 still sends its own name as the Host.
-        let port = addr.port();
-        app.hosts = vec![
-            format!("127.0.0.1:{port}"),
-            format!("localhost:{port}"),
-            format!("[::1]:{port}"),
-        ];
-    }
+    // DNS rebinding: a page of another site that resolves its own name to
+    // 127.0.0.1 still sends its own name as the Host.
+    let port = addr.port();
+    app.hosts = vec![
+        format!("127.0.0.1:{port}"),
+        format!("localhost:{port}"),
+        format!("[::1]:{port}"),
+    ];
     let app = Arc::new(app);
     load_database(app.clone(), source);
     let runtime = tokio::runtime::Builder::new_multi_thread()

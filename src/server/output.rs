@@ -4,13 +4,13 @@
 
 use super::App;
 use super::error::ApiError;
-use super::request;
+use super::request::{self, PathParam};
 use super::view::View;
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::io::{self, Format, WriteOptions};
 use axum::body::Body;
-use axum::extract::{Path, RawQuery, State};
+use axum::extract::{RawQuery, State};
 use axum::http::{HeaderValue, header};
 use axum::response::{IntoResponse, Response};
 use serde_json::json;
@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 type Api<T = axum::Json<serde_json::Value>> = Result<T, ApiError>;
 
-pub async fn exemplar(State(app): State<Arc<App>>, Path(index): Path<String>) -> Api<Response> {
+pub async fn exemplar(State(app): State<Arc<App>>, PathParam(index): PathParam) -> Api<Response> {
     let db = app.ready()?;
     let count = db.meta().exemplars.len();
     let i = index
@@ -28,7 +28,7 @@ pub async fn exemplar(State(app): State<Arc<App>>, Path(index): Path<String>) ->
         .ok_or_else(|| {
             ApiError::invalid(
                 "index",
-                format!("{index:?} is not an exemplar index in 0..={}", count - 1),
+                format!("{index:?} is not an exemplar index in 0..{count}"),
             )
         })?;
     let cached = app
@@ -93,7 +93,7 @@ fn latest(app: &App, id: &str) -> Api<super::editor::Latest> {
         .ok_or_else(|| ApiError::NotReady("the first frame is not ready".into()))
 }
 
-pub async fn preview(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<Response> {
+pub async fn preview(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<Response> {
     let h = app.registry.get(&id)?;
     let (revision, png) = tokio::task::spawn_blocking(move || h.preview_png())
         .await
@@ -108,7 +108,7 @@ pub async fn preview(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api
 
 pub async fn tile(
     State(app): State<Arc<App>>,
-    Path(id): Path<String>,
+    PathParam(id): PathParam,
     RawQuery(raw): RawQuery,
 ) -> Api<Response> {
     let revision = request::revision(&request::query(raw.as_deref(), &["revision"])?)?;
@@ -128,7 +128,7 @@ pub async fn tile(
 /// At most this many samples per side in `heights`.
 const HEIGHTS_SIDE: usize = 512;
 
-pub async fn heights(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<Response> {
+pub async fn heights(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<Response> {
     let hf = latest(&app, &id)?.heightfield;
     let stride = hf.width().max(hf.height()).div_ceil(HEIGHTS_SIDE);
     let (w, h) = (hf.width().div_ceil(stride), hf.height().div_ceil(stride));
@@ -155,7 +155,7 @@ fn extension(f: Format) -> &'static str {
 
 pub async fn export(
     State(app): State<Arc<App>>,
-    Path(id): Path<String>,
+    PathParam(id): PathParam,
     RawQuery(raw): RawQuery,
 ) -> Api<Response> {
     let q = request::query(raw.as_deref(), &["format", "sidecar"])?;
@@ -215,7 +215,7 @@ pub async fn export(
     Ok(r)
 }
 
-pub async fn save(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api {
+pub async fn save(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
     let l = latest(&app, &id)?;
     let path = app.scene_file.clone().ok_or(ApiError::NoSavePath)?;
     let text = serde_json::to_string_pretty(&l.committed)

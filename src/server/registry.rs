@@ -112,8 +112,8 @@ impl Registry {
 /// Refuses a session that would not fit in the memory the system reports
 /// available (Linux `MemAvailable`; elsewhere no check).
 pub fn check_memory(width: usize, height: usize) -> Result<(), ApiError> {
-    let needed = (width * height) as u64 * SESSION_BYTES_PER_PIXEL;
-    match available_bytes() {
+    let needed = (width as u64 * height as u64).saturating_mul(SESSION_BYTES_PER_PIXEL);
+    match crate::io::available_memory() {
         Some(avail) if needed > avail => Err(ApiError::Memory {
             width,
             height,
@@ -122,13 +122,6 @@ pub fn check_memory(width: usize, height: usize) -> Result<(), ApiError> {
         }),
         _ => Ok(()),
     }
-}
-
-fn available_bytes() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024)
 }
 
 /// 128 random bits as hex (from the standard library's randomly keyed
@@ -166,7 +159,7 @@ mod tests {
 
     #[test]
     fn a_session_larger_than_memory_is_refused() {
-        if available_bytes().is_none() {
+        if crate::io::available_memory().is_none() {
             eprintln!("skipped: no /proc/meminfo here");
             return;
         }

@@ -7,11 +7,39 @@
 use super::error::ApiError;
 use super::view::View;
 use axum::body::Bytes;
-use axum::extract::rejection::BytesRejection;
+use axum::extract::path::ErrorKind;
+use axum::extract::rejection::{BytesRejection, PathRejection};
+use axum::extract::{FromRequestParts, Path};
+use axum::http::request::Parts;
 use axum::http::{HeaderMap, StatusCode, header};
 use serde_json::Value;
 
 type Api<T> = Result<T, ApiError>;
+
+/// The one parameter of a route's path (`{id}`, `{index}`, `{*path}`),
+/// percent-decoded; one that is not UTF-8 is a 400 naming the parameter
+/// (axum's own rejection would be plain text).
+pub struct PathParam(pub String);
+
+impl<S: Send + Sync> FromRequestParts<S> for PathParam {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &S) -> Api<PathParam> {
+        match Path::<String>::from_request_parts(parts, state).await {
+            Ok(Path(v)) => Ok(PathParam(v)),
+            Err(PathRejection::FailedToDeserializePathParams(e)) => {
+                let field = match e.kind() {
+                    ErrorKind::InvalidUtf8InPathParam { key }
+                    | ErrorKind::ParseErrorAtKey { key, .. }
+                    | ErrorKind::DeserializeError { key, .. } => key.clone(),
+                    _ => "$".into(),
+                };
+                Err(ApiError::malformed(field, e.body_text()))
+            }
+            Err(e) => Err(ApiError::malformed("$", e.body_text())),
+        }
+    }
+}
 
 /// A JSON body (empty allowed), with its media type checked.
 pub fn json_body(

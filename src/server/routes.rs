@@ -25,14 +25,14 @@
 
 use super::editor::{Handle, Reply, Task};
 use super::error::ApiError;
-use super::request::{self, json_body};
+use super::request::{self, PathParam, json_body};
 use super::{App, DbState, assets, output};
 use crate::database::Database;
 use crate::io::Format;
 use axum::Router;
 use axum::body::Bytes;
 use axum::extract::rejection::BytesRejection;
-use axum::extract::{DefaultBodyLimit, Path, RawQuery, Request, State};
+use axum::extract::{DefaultBodyLimit, RawQuery, Request, State};
 use axum::http::{HeaderMap, Method, StatusCode, header};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
@@ -76,7 +76,7 @@ async fn guard(State(app): State<Arc<App>>, req: Request, next: Next) -> Respons
     // await below (the body is not Sync).
     let host = header_text(req.headers(), header::HOST).unwrap_or_default();
     let origin = header_text(req.headers(), header::ORIGIN);
-    if !app.hosts.is_empty() && !app.hosts.contains(&host) {
+    if !app.hosts.contains(&host) {
         return ApiError::Forbidden(format!(
             "Host {host:?} is not this server: open it as http://{}/",
             app.hosts[0]
@@ -117,7 +117,7 @@ async fn index() -> Response {
     asset_response("index.html")
 }
 
-async fn asset(Path(path): Path<String>) -> Response {
+async fn asset(PathParam(path): PathParam) -> Response {
     asset_response(&path)
 }
 
@@ -232,7 +232,7 @@ async fn create(
     }
 }
 
-async fn state(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api {
+async fn state(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
     let h = app.registry.get(&id)?;
     let latest = h
         .latest()
@@ -244,7 +244,7 @@ async fn state(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api {
 
 async fn put_scene(
     State(app): State<Arc<App>>,
-    Path(id): Path<String>,
+    PathParam(id): PathParam,
     RawQuery(raw): RawQuery,
     headers: HeaderMap,
     body: Result<Bytes, BytesRejection>,
@@ -268,17 +268,17 @@ async fn put_scene(
     .await
 }
 
-async fn undo(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api {
+async fn undo(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
     reply(app.registry.get(&id)?.submit(Task::Undo)).await
 }
 
-async fn redo(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api {
+async fn redo(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
     reply(app.registry.get(&id)?.submit(Task::Redo)).await
 }
 
 async fn put_view(
     State(app): State<Arc<App>>,
-    Path(id): Path<String>,
+    PathParam(id): PathParam,
     headers: HeaderMap,
     body: Result<Bytes, BytesRejection>,
 ) -> Api {
@@ -288,12 +288,12 @@ async fn put_view(
     reply(h.submit(Task::View(view))).await
 }
 
-async fn ping(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<StatusCode> {
+async fn ping(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<StatusCode> {
     app.registry.get(&id)?.touch();
     Ok(StatusCode::NO_CONTENT)
 }
 
-async fn close(State(app): State<Arc<App>>, Path(id): Path<String>) -> Api<StatusCode> {
+async fn close(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<StatusCode> {
     match app.registry.close(&id) {
         true => Ok(StatusCode::NO_CONTENT),
         false => Err(ApiError::NoSession(id)),

@@ -198,7 +198,9 @@ async function save() {
   try {
     const r = await ed.api.save();
     $('status-error').textContent = '';
-    $('status-main').textContent = `saved ${r.path}`;
+    // Keep the last edit's numbers on the status line beside the news.
+    status();
+    $('status-main').textContent = `saved ${r.path} · ${$('status-main').textContent}`;
   } catch (e) {
     ed.error(e);
   }

@@ -220,9 +220,10 @@ export class Panel {
   inspector() {
     const ed = this.ed, t = ed.tools, s = t.sel, doc = ed.doc;
     if (!s) {
-      const n = (k) => (doc[k] || []).length;
+      const count = (list, what) => `${(list || []).length} ${what}${(list || []).length === 1 ? '' : 's'}`;
+      const strokes = (layer) => layer && layer.strokes;
       return [h('h3', {}, 'Scene'), h('p', { class: 'note' },
-        `${n('points')} points, ${n('curves')} curves, ${n('pastes')} pastes; ${((doc.types && doc.types.strokes) || []).length} type strokes, ${((doc.freeze && doc.freeze.strokes) || []).length} freeze strokes. Click a control to edit it.`)];
+        `${count(doc.points, 'point')}, ${count(doc.curves, 'curve')}, ${count(doc.pastes, 'paste')}; ${count(strokes(doc.types), 'type stroke')}, ${count(strokes(doc.freeze), 'freeze stroke')}. Click a control to edit it.`)];
     }
     const del = (label) => h('div', { class: 'buttons' }, h('button', { onclick: () => t.remove() }, label));
     if (s.kind === 'point') {

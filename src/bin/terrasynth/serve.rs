@@ -17,8 +17,9 @@ pub struct Args {
     /// file the server writes). Without it, designs are downloaded.
     #[arg(long)]
     scene: Option<PathBuf>,
-    /// Address to listen on. Loopback by default: anything else lets other
-    /// machines edit (and read) your terrain.
+    /// Address to listen on: a loopback address (127.0.0.1 or [::1]) and a
+    /// port. Others are refused: the editor has no login, so other machines
+    /// must not reach it (forward a port with ssh instead).
     #[arg(long, default_value = "127.0.0.1:8080")]
     bind: SocketAddr,
     /// Size of a new design, WxH (a scene file's own size wins).
@@ -36,12 +37,6 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
-    if !a.bind.ip().is_loopback() {
-        eprintln!(
-            "warning: listening on {}: other machines can reach this editor",
-            a.bind
-        );
-    }
     let config = Config {
         bind: a.bind,
         database: a.db.map(DbSource::File),
