@@ -35,6 +35,9 @@ fn info_page_and_assets() {
             .starts_with("text/html")
     );
     assert!(String::from_utf8_lossy(&page.body).contains("/assets/js/main.js"));
+    // Nothing from elsewhere: the browser may load only this server's files.
+    let policy = page.header("content-security-policy").unwrap();
+    assert!(policy.starts_with("default-src 'self';"), "{policy}");
     for asset in ["editor.css", "js/main.js", "js/tools.js", "js/panel.js"] {
         let r = http::get(a, &format!("/assets/{asset}"));
         assert_eq!(r.status, 200, "{asset}");

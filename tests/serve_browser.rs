@@ -168,14 +168,7 @@ fn a_design_session_in_chromium() {
         rt.block_on(design(&c, &server, &shots))
     }));
     let _ = rt.block_on(c.close());
-    let Steps {
-        h0,
-        h_frozen,
-        h_before_second,
-        h_second,
-        h_final,
-        type_name,
-    } = outcome.unwrap_or_else(|p| std::panic::resume_unwind(p));
+    let s = outcome.unwrap_or_else(|p| std::panic::resume_unwind(p));
 
     // The saved scene has exactly the design's controls.
     let text = std::fs::read(&scene_path).expect("the scene was saved");
@@ -207,7 +200,7 @@ fn a_design_session_in_chromium() {
         1,
         "{saved}"
     );
-    assert_eq!(saved["types"]["strokes"][0]["type"], type_name, "{saved}");
+    assert_eq!(saved["types"]["strokes"][0]["type"], s.type_name, "{saved}");
     assert_eq!(
         saved["freeze"]["strokes"].as_array().unwrap().len(),
         1,
@@ -216,11 +209,11 @@ fn a_design_session_in_chromium() {
 
     // Frozen pixels kept their heights through every edit, bit for bit.
     let frozen = scene.freeze_raster().unwrap().unwrap();
-    let (moved, total) = changed(&h_frozen, &h_final, |x, y| frozen[y * SIZE + x]);
+    let (moved, total) = changed(&s.h_frozen, &s.h_final, |x, y| frozen[y * SIZE + x]);
     assert!(total > 200, "the freeze stroke covers {total} pixels");
     assert_eq!(moved, 0, "{moved} of {total} frozen pixels changed");
     assert_eq!(
-        changed(&h0, &h_frozen, |_, _| true).0,
+        changed(&s.h0, &s.h_frozen, |_, _| true).0,
         0,
         "freezing alone changed heights"
     );
@@ -232,16 +225,25 @@ fn a_design_session_in_chromium() {
             free(x, y) && (x as f64 + 0.5 - q.0).hypot(y as f64 + 0.5 - q.1) <= r
         }
     };
-    let (n, t) = changed(&h0, &h_final, near((120.0, 80.0), 8.0));
+    let (n, t) = changed(&s.h0, &s.h_final, near((120.0, 80.0), 8.0));
     assert!(n * 10 > t * 9, "around the point {n} of {t} pixels changed");
-    let (n, t) = changed(&h0, &h_final, near((130.0, 130.0), 6.0));
+    let (n, t) = changed(&s.h0, &s.h_final, near((130.0, 130.0), 6.0));
     assert!(n * 10 > t * 9, "on the curve {n} of {t} pixels changed");
-    let (n, t) = changed(&h0, &h_final, near((190.0, 180.0), 6.0));
+    let (n, t) = changed(&s.h0, &s.h_final, near((190.0, 180.0), 6.0));
     assert!(n * 2 > t, "under the type stroke {n} of {t} pixels changed");
+    // The point holds the terrain at its height (the paper's point
+    // constraint), within a tenth of the exemplars' relief.
+    let at = (p.at.y as usize) * SIZE + p.at.x as usize;
+    let missed = (s.h_final[at] as f64 - p.height_m).abs();
+    eprintln!(
+        "the point asks {} m and got {} m",
+        p.height_m, s.h_final[at]
+    );
+    assert!(missed < 250.0, "the point missed its height by {missed} m");
     // Undo took the second point's raise away again.
     let site = 60 * SIZE + 200;
-    let raise = h_second[site] - h_before_second[site];
-    let left = h_final[site] - h_before_second[site];
+    let raise = s.h_second[site] - s.h_before_second[site];
+    let left = s.h_final[site] - s.h_before_second[site];
     assert!(
         raise > 50.0,
         "the second point raised its site by {raise} m"

@@ -68,14 +68,7 @@ fn paint<'a, T: Copy + Send + Sync>(
 
 /// Distance from `p` to the segment `a`–`b` (a point when they coincide).
 fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let d = b - a;
-    let len2 = d.length_squared();
-    let u = if len2 > 0.0 {
-        ((p - a).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + d * u)
+    p.distance(a + (b - a) * crate::synth::control::curve::segments::closest_param(p, a, b))
 }
 
 impl Scene {

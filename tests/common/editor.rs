@@ -62,8 +62,8 @@ pub fn put_scene(addr: SocketAddr, s: &str, d: &Value, commit: bool) -> Response
     http::put(addr, &format!("/api/sessions/{s}/scene?commit={commit}"), d)
 }
 
-/// `r` is a JSON error with this status that names `field`.
-pub fn expect_error(r: &Response, status: u16, field: &str) {
+/// `r` is a JSON error with this status that names `field`; its message.
+pub fn expect_error(r: &Response, status: u16, field: &str) -> String {
     assert_eq!(
         r.status,
         status,
@@ -71,5 +71,7 @@ pub fn expect_error(r: &Response, status: u16, field: &str) {
         String::from_utf8_lossy(&r.body)
     );
     assert_eq!(r.error_field(), field, "{}", r.json());
-    assert!(!r.json()["error"]["message"].as_str().unwrap().is_empty());
+    let message = r.json()["error"]["message"].as_str().unwrap().to_string();
+    assert!(!message.is_empty());
+    message
 }

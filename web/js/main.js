@@ -13,6 +13,9 @@ const $ = (id) => document.getElementById(id);
 window.__errors = [];
 window.addEventListener('error', (e) => window.__errors.push(String(e.message)));
 window.addEventListener('unhandledrejection', (e) => window.__errors.push(String(e.reason)));
+// The server allows only its own files (Content-Security-Policy): anything
+// else the page tried to load is an error too.
+document.addEventListener('securitypolicyviolation', (e) => window.__errors.push(`blocked ${e.blockedURI} (${e.violatedDirective})`));
 
 export const ed = {
   api: new Api(),
@@ -147,6 +150,8 @@ function scheduleHeights() {
     if (ed.api.busy()) return scheduleHeights();
     try {
       ed.heights = await ed.api.heights();
+      // The cross-section draws the terrain from these samples.
+      if (ed.panel.profile) ed.panel.profile.draw();
     } catch (e) {
       /* next frame retries */
     }
