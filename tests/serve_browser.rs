@@ -123,6 +123,17 @@ async fn design(c: &Client, server: &Running, shots: &Path) -> Steps {
     shot(c, shots, "07-saved").await;
     let errors = js(c, "return window.__errors || []").await;
     assert_eq!(errors, json!([]), "the page logged errors");
+    // Nothing named from elsewhere (a CDN): what the page itself refers to,
+    // and everything it loaded, is this server's.
+    let foreign = js(
+        c,
+        "const own = (u) => !u || u.startsWith(location.origin + '/') || /^(blob|data):/.test(u);
+         return [...document.querySelectorAll('[src],[href]')].map((e) => e.src || e.href)
+           .concat(performance.getEntriesByType('resource').map((r) => r.name))
+           .filter((u) => !own(u));",
+    )
+    .await;
+    assert_eq!(foreign, json!([]), "the page refers to other servers");
     let latency = js(c, "return window.terrasynth.latency").await;
     eprintln!("in-browser edit → preview (ms): {latency}");
     let h_final = heights(addr, &session);
