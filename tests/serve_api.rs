@@ -276,7 +276,9 @@ fn previews_tiles_heights_and_exports() {
     );
 
     let hf = heights(a, &id);
-    let hb = http::get(a, &format!("/api/sessions/{id}/heights")).body;
+    let hr = http::get(a, &format!("/api/sessions/{id}/heights"));
+    assert_eq!(hr.header("x-revision"), Some(rev.to_string().as_str()));
+    let hb = hr.body;
     let word = |k: usize| u32::from_le_bytes(hb[4 * k..4 * k + 4].try_into().unwrap());
     assert_eq!((word(0), word(1), word(2)), (N as u32, N as u32, 1));
     assert_eq!(

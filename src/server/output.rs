@@ -129,7 +129,8 @@ pub async fn tile(
 const HEIGHTS_SIDE: usize = 512;
 
 pub async fn heights(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<Response> {
-    let hf = latest(&app, &id)?.heightfield;
+    let l = latest(&app, &id)?;
+    let hf = l.heightfield;
     let stride = hf.width().max(hf.height()).div_ceil(HEIGHTS_SIDE);
     let (w, h) = (hf.width().div_ceil(stride), hf.height().div_ceil(stride));
     let mut out = Vec::with_capacity(12 + 4 * w * h);
@@ -141,7 +142,17 @@ pub async fn heights(State(app): State<Arc<App>>, PathParam(id): PathParam) -> A
             out.extend_from_slice(&hf.get(x * stride, y * stride).to_le_bytes());
         }
     }
-    Ok(([(header::CONTENT_TYPE, "application/octet-stream")], out).into_response())
+    Ok((
+        [
+            (header::CONTENT_TYPE, "application/octet-stream".to_string()),
+            (
+                header::HeaderName::from_static("x-revision"),
+                l.revision.to_string(),
+            ),
+        ],
+        out,
+    )
+        .into_response())
 }
 
 /// File extension of a writable format.

@@ -12,7 +12,7 @@
 //! | `PUT /api/sessions/{id}/view` | `{"contours", "types", "range"}` → frame |
 //! | `GET /api/sessions/{id}/preview.png` | the last frame's preview |
 //! | `GET /api/sessions/{id}/tile.png?revision=N` | the part of the preview frame N changed (header `x-rect: x0,y0,x1,y1`) |
-//! | `GET /api/sessions/{id}/heights` | binary: u32 width, u32 height, u32 stride, then f32 metres (≤ 512² samples) |
+//! | `GET /api/sessions/{id}/heights` | binary: u32 width, u32 height, u32 stride, then f32 metres (≤ 512² samples); header `x-revision` |
 //! | `GET /api/sessions/{id}/export?format=exr[&sidecar=true]` | a download (any writable format, or `preview`) |
 //! | `POST /api/sessions/{id}/save` | writes the `--scene` file → `{"path"}` |
 //! | `POST /api/sessions/{id}/ping`, `…/close` | keep alive; free the slot |

@@ -123,10 +123,12 @@ pub async fn wait_for(c: &Client, what: &str, script: &str, secs: u64) {
     }
 }
 
-/// Waits for a frame newer than `rev` with nothing in flight.
+/// Waits for a frame newer than `rev` with nothing in flight, and for the
+/// page's height samples (cursor readout, cross-sections) to be that
+/// frame's.
 pub async fn settled(c: &Client, rev: i64) {
     let script = format!(
-        "return !!window.terrasynth && window.terrasynth.revision > {rev} && !window.terrasynth.api.busy()"
+        "const ed = window.terrasynth; return !!ed && ed.revision > {rev} && !ed.api.busy() && !!ed.heights && ed.heights.revision >= ed.revision"
     );
     wait_for(c, &format!("a frame after revision {rev}"), &script, 90).await;
 }

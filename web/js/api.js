@@ -132,10 +132,13 @@ export class Api {
     return createImageBitmap(await (await check(res)).blob());
   }
 
+  /** The last frame's height samples and the revision they belong to. */
   async heights() {
-    const buf = await (await check(await fetch(this.url('/heights'), { cache: 'no-store' }))).arrayBuffer();
+    const res = await check(await fetch(this.url('/heights'), { cache: 'no-store' }));
+    const buf = await res.arrayBuffer();
     const head = new Uint32Array(buf, 0, 3);
-    return { w: head[0], h: head[1], stride: head[2], data: new Float32Array(buf, 12) };
+    const revision = Number(res.headers.get('x-revision'));
+    return { w: head[0], h: head[1], stride: head[2], data: new Float32Array(buf, 12), revision };
   }
 
   ping() {
