@@ -50,11 +50,16 @@ fn bench(c: &mut Criterion) {
 
     let mut g = c.benchmark_group("correct");
     g.sample_size(20);
+    let p = CorrectParams {
+        px: 0,
+        py: 0,
+        prior: correct::DEFAULT_PRIOR,
+    };
     g.bench_function("cpu/1024", |b| {
-        b.iter(|| correct::correct(&atlas, black_box(&l0), &CorrectParams { px: 0, py: 0 }))
+        b.iter(|| correct::correct(&atlas, black_box(&l0), Some(&l1), &p))
     });
     g.bench_function("scalar/1024", |b| {
-        b.iter(|| correct::scalar::correct(&atlas, black_box(&l0), &CorrectParams { px: 0, py: 0 }))
+        b.iter(|| correct::scalar::correct(&atlas, black_box(&l0), Some(&l1), &p))
     });
     g.finish();
 

@@ -18,13 +18,19 @@ struct CorrectParams {
     level: u32,
     // Types of the database (length of `seed_counts`).
     type_count: u32,
-    pad0: u32,
+    // Height prior weight P (CorrectParams::prior).
+    prior: u32,
     // Only pixels in [x0, x1) × [y0, y1) are corrected (Guide::window); with
     // F_COHERENCE the others take the previous result.
     x0: u32,
     y0: u32,
     x1: u32,
     y1: u32,
+    // The level above (the prior's anchor), when has_parent is 1.
+    parent_width: u32,
+    has_parent: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 const F_TARGETS: u32 = 1u;
@@ -58,6 +64,12 @@ struct GuideCell {
     pad0: i32,
 }
 @group(0) @binding(7) var<storage, read> guide: array<GuideCell>;
+// The parent level's offsets V (a placeholder when has_parent is 0).
+@group(0) @binding(8) var<storage, read> parent_v: array<i32>;
+
+// The pixel's Prior::v (set once per invocation in `main`; every score of
+// the pixel reads it, like the `prior` argument of the Rust scores).
+var<private> prior_v: i32;
 
 // correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT;
 // types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; blend::MAX_ERROR.
@@ -70,7 +82,7 @@ const MODE1_BIAS: i32 = -32768;
 const MAX_ERROR: i32 = 16777216;
 
 // correct::CLAMP.
-const CLAMP: i32 = 11584;
+const CLAMP: i32 = 9459;
 
 // correct::DIAGONALS.
 const DIAGONALS = array<vec2<i32>, 4>(
@@ -140,11 +152,15 @@ fn score_with(
         d[k] = ns[k] - 3 * m;
         sum1 += d[k].x;
     }
-    var h = div_floor(sum1 + 6, 12);
+    // Prior::optimal and Prior::cost.
+    let w = i32(p.prior);
+    let den = 12 + 3 * w;
+    var h = div_floor(sum1 + 3 * w * prior_v + den / 2, den);
     if (fixed) {
         h = fixed_h;
     }
-    var s = 0u;
+    let rp = clamp(3 * (h - prior_v), -CLAMP, CLAMP);
+    var s = p.prior * u32(rp * rp);
     for (var k = 0; k < 4; k++) {
         let r1 = clamp(d[k].x - 3 * h, -CLAMP, CLAMP);
         s += u32(r1 * r1);
@@ -335,6 +351,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = i32(ux);
     let y = i32(uy);
+    // Prior::at.
+    prior_v = 0;
+    if (p.has_parent != 0u) {
+        prior_v = parent_v[(uy / 2u) * p.parent_width + ux / 2u];
+    }
 
     var diag = DIAGONALS;
     var ns: array<vec4<i32>, 4>;

@@ -1,6 +1,7 @@
-// Stage `reconstruct`: the mirror of src/synth/stages/reconstruct.rs —
-// bilinear E⁰ at S⁰ plus V⁰, in database units with 8 fractional bits.
-// The weighted sum of four u16 heights stays below 2^32 (a u32).
+// Stage `reconstruct`: the mirror of src/synth/stages/reconstruct.rs — each
+// level-0 pixel the mean of its 3×3 neighbours' predictions
+// E⁰(round(S(n)) − Δ) + V(n), in database units with 8 fractional bits
+// (sum of at most nine predictions, then floor division by their count).
 
 struct ReconstructParams {
     width: u32,
@@ -23,9 +24,9 @@ fn atlas_index(x: i32, y: i32) -> u32 {
     return u32(c.base + y * i32(c.stride) + x);
 }
 
-fn height(x: i32, y: i32) -> u32 {
+fn height(x: i32, y: i32) -> i32 {
     let i = atlas_index(x, y);
-    return (heights[i >> 1u] >> ((i & 1u) * 16u)) & 0xFFFFu;
+    return i32((heights[i >> 1u] >> ((i & 1u) * 16u)) & 0xFFFFu);
 }
 
 @compute @workgroup_size(8, 8)
@@ -33,16 +34,23 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= p.width || gid.y >= p.height) {
         return;
     }
-    let i = gid.y * p.width + gid.x;
-    let s = state_s[i];
-    let x0 = s.x >> FRAC_BITS;
-    let y0 = s.y >> FRAC_BITS;
-    let fx = u32(s.x & (ONE - 1));
-    let fy = u32(s.y & (ONE - 1));
-    let one = u32(ONE);
-    let top = height(x0, y0) * (one - fx) + height(x0 + 1, y0) * fx;
-    let bottom = height(x0, y0 + 1) * (one - fx) + height(x0 + 1, y0 + 1) * fx;
-    // >> (2·FRAC_BITS − HEIGHT_FRAC_BITS), truncating.
-    let v = (top * (one - fy) + bottom * fy) >> 8u;
-    out[i] = i32(v) + (state_v[i] << 8u);
+    let x = i32(gid.x);
+    let y = i32(gid.y);
+    var sum = 0;
+    var count = 0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let nx = x + dx;
+            let ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= i32(p.width) || ny >= i32(p.height)) {
+                continue;
+            }
+            let n = u32(ny) * p.width + u32(nx);
+            let s = state_s[n];
+            let e = height(round_fixed(s.x) - dx, round_fixed(s.y) - dy);
+            sum += (e + state_v[n]) << 8u;
+            count += 1;
+        }
+    }
+    out[gid.y * p.width + gid.x] = div_floor(sum, count);
 }

@@ -22,7 +22,8 @@ use terrasynth::synth::control::UNCONSTRAINED;
 use terrasynth::synth::control::blend::{MAX_TOL, Target};
 use terrasynth::synth::fixed::{Coord, FRAC_BITS};
 use terrasynth::synth::stages::correct::{
-    self as correct, ALL_TYPES, Coherence, CorrectParams, Guide, SUBPASSES, W_FREE, scalar,
+    self as correct, ALL_TYPES, Coherence, CorrectParams, DEFAULT_PRIOR, Guide, PRIORS, SUBPASSES,
+    W_FREE, scalar,
 };
 use terrasynth::synth::stages::reduce_types::reduce_types;
 use terrasynth::synth::stages::reduce_weights::reduce_weights;
@@ -287,19 +288,20 @@ fn check_guided(
     gpu: &Gpu,
     atlas: &AtlasLevel<'_>,
     level: usize,
-    st: &State,
+    (st, parent): (&State, Option<&State>),
     p: &CorrectParams,
     g: &Guide<'_>,
     what: &str,
 ) {
     let gs = gpu.upload(copy(st)).unwrap();
+    let gp = parent.map(|pa| gpu.upload(copy(pa)).unwrap());
     let gg = gpu.upload_guide(g, st.width, st.height).unwrap();
-    gpu.correct_guided(&gs, level, p, &gg);
+    gpu.correct_guided(&gs, gp.as_ref(), level, p, &gg);
     let (gc, gv) = gpu.download(&gs).unwrap();
     let cpu = copy(st);
-    correct::correct_guided(atlas, &cpu, p, g);
+    correct::correct_guided(atlas, &cpu, parent, p, g);
     let oracle = copy(st);
-    scalar::correct_guided(atlas, &oracle, p, g);
+    scalar::correct_guided(atlas, &oracle, parent, p, g);
     assert_eq!(
         (oracle.coords(), oracle.offsets()),
         (cpu.coords(), cpu.offsets()),
@@ -405,7 +407,11 @@ proptest! {
             window,
         };
         let (px, py) = SUBPASSES[sub];
-        check_guided(gpu, a, level, &st, &CorrectParams { px, py }, &g, &format!("random {w}×{h} level {level} flags {flags}"));
+        let parent = random_state(a, w.div_ceil(2), h.div_ceil(2), &bits, 0x5EED);
+        let prior = PRIORS[bits[5] as usize % PRIORS.len()];
+        let p = CorrectParams { px, py, prior };
+        let what = format!("random {w}×{h} level {level} flags {flags} prior {prior}");
+        check_guided(gpu, a, level, (&st, Some(&parent)), &p, &g, &what);
     }
 }
 
@@ -491,10 +497,19 @@ fn guided_correct_matches_on_real_guides() {
         .filter(|m| m.level <= l && !m.coords.is_empty())
     {
         let i = maps.level;
-        let st = State::new(maps.width, maps.height);
-        for k in 0..maps.width * maps.height {
-            st.set(k, maps.coords[k], maps.offsets[k]);
-        }
+        let from = |m: &terrasynth::synth::LevelMaps| {
+            let st = State::new(m.width, m.height);
+            for k in 0..m.width * m.height {
+                st.set(k, m.coords[k], m.offsets[k]);
+            }
+            st
+        };
+        let st = from(maps);
+        let parent = out
+            .levels
+            .get(i + 1)
+            .filter(|m| !m.coords.is_empty())
+            .map(from);
         let lg = &guides.levels[i];
         let r = &f1.levels[i][0];
         let g = Guide {
@@ -520,8 +535,12 @@ fn guided_correct_matches_on_real_guides() {
                     gpu,
                     &atlas[i],
                     i,
-                    &st,
-                    &CorrectParams { px, py },
+                    (&st, parent.as_ref()),
+                    &CorrectParams {
+                        px,
+                        py,
+                        prior: DEFAULT_PRIOR,
+                    },
                     g,
                     &format!("real guide, frame {frame}, level {i}, subpass {s}"),
                 );

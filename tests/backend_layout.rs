@@ -159,11 +159,15 @@ fn parameter_structs_match_their_wgsl_declarations() {
             flags,
             level,
             type_count,
-            pad0,
+            prior,
             x0,
             y0,
             x1,
-            y1
+            y1,
+            parent_width,
+            has_parent,
+            pad0,
+            pad1
         })
     );
     assert_eq!(

@@ -16,7 +16,7 @@ use terrasynth::database::{self, BuildOptions, Database, default, layout::MARGIN
 use terrasynth::progress::Silent;
 use terrasynth::synth::atlas::AtlasLevel;
 use terrasynth::synth::fixed::{Coord, FRAC_BITS};
-use terrasynth::synth::stages::correct::{CorrectParams, SUBPASSES, scalar};
+use terrasynth::synth::stages::correct::{CorrectParams, DEFAULT_PRIOR, PRIORS, SUBPASSES, scalar};
 use terrasynth::synth::stages::upsample_jitter::{Step, UpsampleParams};
 use terrasynth::synth::state::State;
 use terrasynth::synth::{Params, Synthesizer};
@@ -127,14 +127,21 @@ fn random_state(atlas: &AtlasLevel<'_>, w: usize, h: usize, bits: &[u32]) -> Sta
 
 /// Runs one subpass on the GPU, the CPU (SIMD + scalar frame) and the scalar
 /// oracle from the same state; all three must agree.
-fn check_correct(pair: &Pair<'_>, level: usize, st: &State, p: &CorrectParams, what: &str) {
+fn check_correct(
+    pair: &Pair<'_>,
+    level: usize,
+    (st, parent): (&State, Option<&State>),
+    p: &CorrectParams,
+    what: &str,
+) {
     let g = pair.gpu.upload(copy(st)).unwrap();
-    pair.gpu.correct(&g, level, p);
+    let gp = parent.map(|pa| pair.gpu.upload(copy(pa)).unwrap());
+    pair.gpu.correct(&g, gp.as_ref(), level, p);
     let gpu = pair.gpu.download(&g).unwrap();
     let cpu_st = copy(st);
-    pair.cpu().correct(&cpu_st, level, p);
+    pair.cpu().correct(&cpu_st, parent, level, p);
     let oracle = copy(st);
-    scalar::correct(&pair.atlas[level], &oracle, p);
+    scalar::correct(&pair.atlas[level], &oracle, parent, p);
     assert_eq!(
         (oracle.coords(), oracle.offsets()),
         (cpu_st.coords(), cpu_st.offsets()),
@@ -193,13 +200,18 @@ proptest! {
     #[test]
     fn correct_matches_on_random_states(
         w in 2usize..48, h in 2usize..48, level_pick in 0usize..8, sub in 0usize..4,
+        prior in prop::sample::select(PRIORS.to_vec()), with_parent in any::<bool>(),
         bits in prop::collection::vec(any::<u32>(), 64),
     ) {
         let Some(pair) = default_pair() else { return Ok(()) };
         let level = level_pick % pair.atlas.len();
         let st = random_state(&pair.atlas[level], w, h, &bits);
+        let rev: Vec<u32> = bits.iter().rev().copied().collect();
+        let parent = random_state(&pair.atlas[level], w.div_ceil(2), h.div_ceil(2), &rev);
         let (px, py) = SUBPASSES[sub];
-        check_correct(pair, level, &st, &CorrectParams { px, py }, &format!("random {w}x{h} level {level}"));
+        let p = CorrectParams { px, py, prior };
+        let what = format!("random {w}x{h} level {level} prior {prior}");
+        check_correct(pair, level, (&st, with_parent.then_some(&parent)), &p, &what);
     }
 
     #[test]
@@ -257,10 +269,20 @@ fn check_real_states(db: &Database, ctx: Arc<Context>, (w, h): (usize, usize), s
     let l = db.level_count() - 1;
     for maps in out.levels.iter().filter(|m| !m.coords.is_empty()) {
         let st = state_from(maps.width, maps.height, &maps.coords, &maps.offsets);
+        let parent = out
+            .levels
+            .get(maps.level + 1)
+            .filter(|m| !m.coords.is_empty());
+        let parent = parent.map(|m| state_from(m.width, m.height, &m.coords, &m.offsets));
         if maps.level <= l {
             for (k, &(px, py)) in SUBPASSES.iter().enumerate() {
                 let what = format!("real state, level {}, subpass {k}", maps.level);
-                check_correct(&pair, maps.level, &st, &CorrectParams { px, py }, &what);
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: DEFAULT_PRIOR,
+                };
+                check_correct(&pair, maps.level, (&st, parent.as_ref()), &p, &what);
             }
         }
         if maps.level >= 1 && maps.level <= l {

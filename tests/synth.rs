@@ -3,10 +3,12 @@
 
 use proptest::prelude::*;
 use std::sync::OnceLock;
+use terrasynth::database::layout::MARGIN;
 use terrasynth::database::{Database, default};
 use terrasynth::progress::Silent;
+use terrasynth::synth::atlas::AtlasLevel;
 use terrasynth::synth::fixed::{FRAC_BITS, round};
-use terrasynth::synth::{Params, Synthesizer};
+use terrasynth::synth::{Params, Synthesizer, coarse};
 
 fn db() -> &'static Database {
     static DB: OnceLock<Database> = OnceLock::new();
@@ -115,7 +117,7 @@ fn the_start_exemplar_dominates_the_result() {
     for start in 0..3 {
         let params = Params {
             keep_levels: true,
-            start_exemplar: start,
+            start_exemplar: Some(start),
             ..Params::default()
         };
         let out = Synthesizer::new(db(), params)
@@ -130,6 +132,51 @@ fn the_start_exemplar_dominates_the_result() {
             used[e.expect("inside an exemplar")] += 1;
         }
         assert!(used[start] > 256 * 256 / 2, "start {start}: {used:?}");
+    }
+}
+
+#[test]
+fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
+    // The coarse start draws block origins uniformly over every exemplar's
+    // block positions, so each exemplar's share of the blocks follows its
+    // share of the positions (its area), within sampling noise.
+    let l = db().level_count() - 1;
+    let atlas = AtlasLevel::new(db(), l);
+    let bits = coarse::block_bits(&atlas, None);
+    assert!(bits >= 1, "the default exemplars leave room for blocks");
+    let span = (1u32 << bits) - 1;
+    let positions: Vec<f64> = atlas
+        .level
+        .layout
+        .rects
+        .iter()
+        .map(|r| {
+            let c = atlas.columns[r.x0 as usize];
+            let nx = (c.max_x - c.min_x + 1) as u32 - span;
+            let ny = (c.max_y - MARGIN as i32 + 1) as u32 - span;
+            f64::from(nx * ny)
+        })
+        .collect();
+    let total: f64 = positions.iter().sum();
+    let n = 120;
+    let start = coarse::blocks(&atlas, None, n << (l + bits), n << (l + bits), (l, bits), 5);
+    let mut used = vec![0usize; positions.len()];
+    for i in 0..n * n {
+        let c = start.s(i);
+        let e = atlas
+            .level
+            .layout
+            .exemplar_at(atlas.level.columns, round(c.x) as u32, round(c.y) as u32)
+            .expect("a block origin lies inside an exemplar");
+        used[e] += 1;
+    }
+    for (e, (&u, &p)) in used.iter().zip(&positions).enumerate() {
+        let (got, want) = (u as f64 / (n * n) as f64, p / total);
+        // Binomial standard deviation at n² = 14400 draws is < 0.005.
+        assert!(
+            (got - want).abs() < 0.02,
+            "exemplar {e}: share {got:.3}, area share {want:.3} ({used:?})"
+        );
     }
 }
 
@@ -149,7 +196,7 @@ fn bad_parameters_are_refused() {
             ..Params::default()
         },
         Params {
-            start_exemplar: 3,
+            start_exemplar: Some(3),
             ..Params::default()
         },
     ] {

@@ -10,7 +10,7 @@ use terrasynth::synth::atlas::AtlasLevel;
 use terrasynth::synth::control::Target;
 use terrasynth::synth::fixed::Coord;
 use terrasynth::synth::stages::correct::{
-    self, ALL_TYPES, Coherence, CorrectParams, Guide, SUBPASSES, scalar,
+    self, ALL_TYPES, Coherence, CorrectParams, DEFAULT_PRIOR, Guide, PRIORS, SUBPASSES, scalar,
 };
 use terrasynth::synth::state::State;
 use terrasynth::synth::{Params, Synthesizer};
@@ -28,24 +28,34 @@ fn state_from(w: usize, h: usize, coords: &[Coord], offsets: &[i32]) -> State {
     st
 }
 
-/// Runs one subpass both ways on copies of a state; asserts equal bytes.
-fn assert_paths_agree(atlas: &AtlasLevel<'_>, st: &State, what: &str) {
-    assert_guided_paths_agree(atlas, st, &Guide::NONE, what)
+/// Runs one subpass both ways on copies of a state, for every height prior
+/// weight; asserts equal bytes.
+fn assert_paths_agree(atlas: &AtlasLevel<'_>, st: &State, parent: Option<&State>, what: &str) {
+    assert_guided_paths_agree(atlas, st, parent, &Guide::NONE, what)
 }
 
 /// [`assert_paths_agree`] under control inputs.
-fn assert_guided_paths_agree(atlas: &AtlasLevel<'_>, st: &State, g: &Guide<'_>, what: &str) {
-    for &(px, py) in &SUBPASSES {
-        let p = CorrectParams { px, py };
+fn assert_guided_paths_agree(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    parent: Option<&State>,
+    g: &Guide<'_>,
+    what: &str,
+) {
+    for (&(px, py), &prior) in SUBPASSES
+        .iter()
+        .flat_map(|s| PRIORS.iter().map(move |p| (s, p)))
+    {
+        let p = CorrectParams { px, py, prior };
         let fast = state_from(st.width, st.height, &st.coords(), &st.offsets());
         let slow = state_from(st.width, st.height, &st.coords(), &st.offsets());
-        correct::correct_guided(atlas, &fast, &p, g);
-        scalar::correct_guided(atlas, &slow, &p, g);
+        correct::correct_guided(atlas, &fast, parent, &p, g);
+        scalar::correct_guided(atlas, &slow, parent, &p, g);
         let (fc, sc) = (fast.coords(), slow.coords());
         let (fo, so) = (fast.offsets(), slow.offsets());
         if let Some(i) = (0..fc.len()).find(|&i| fc[i] != sc[i] || fo[i] != so[i]) {
             panic!(
-                "{what}, subpass ({px},{py}): pixel ({}, {}) fast {:?}/{} vs scalar {:?}/{}",
+                "{what}, subpass ({px},{py}), prior {prior}: pixel ({}, {}) fast {:?}/{} vs scalar {:?}/{}",
                 i % st.width,
                 i / st.width,
                 fc[i],
@@ -69,10 +79,24 @@ fn fast_and_scalar_correction_agree_on_real_states() {
         .unwrap();
     let coarsest = db().level_count() - 1;
     let mut checked = 0;
-    for maps in out.levels.iter().filter(|m| m.level <= coarsest) {
+    for (i, maps) in out
+        .levels
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m.level <= coarsest)
+    {
         let atlas = AtlasLevel::new(db(), maps.level);
         let st = state_from(maps.width, maps.height, &maps.coords, &maps.offsets);
-        assert_paths_agree(&atlas, &st, &format!("level {}", maps.level));
+        let parent = out
+            .levels
+            .get(i + 1)
+            .map(|p| state_from(p.width, p.height, &p.coords, &p.offsets));
+        assert_paths_agree(
+            &atlas,
+            &st,
+            parent.as_ref(),
+            &format!("level {}", maps.level),
+        );
         checked += 1;
     }
     assert!(checked >= 3, "only {checked} levels checked");
@@ -114,6 +138,12 @@ fn random_state(atlas: &AtlasLevel<'_>, w: usize, h: usize, seed: u64) -> State 
     st
 }
 
+/// The level above a `w × h` random state, whose offsets (the height
+/// prior's anchor) range as widely as the state's.
+fn random_parent(atlas: &AtlasLevel<'_>, w: usize, h: usize, seed: u64) -> State {
+    random_state(atlas, w.div_ceil(2), h.div_ceil(2), seed ^ 0x5EED)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
@@ -126,7 +156,9 @@ proptest! {
     ) {
         let atlas = AtlasLevel::new(db(), level);
         let st = random_state(&atlas, w, h, seed);
-        assert_paths_agree(&atlas, &st, &format!("random {w}x{h} at level {level}"));
+        let parent = random_parent(&atlas, w, h, seed);
+        let parent = (seed % 3 != 0).then_some(&parent);
+        assert_paths_agree(&atlas, &st, parent, &format!("random {w}x{h} at level {level}"));
     }
 }
 
@@ -211,7 +243,9 @@ proptest! {
             allowed: (which & 4 != 0).then_some(&allowed[..]),
             window: (which & 8 != 0).then_some(window),
         };
-        assert_guided_paths_agree(&atlas, &st, &g, &format!("guided {which:04b} {w}x{h} at level {level}"));
+        let parent = random_parent(&atlas, w, h, seed);
+        let what = format!("guided {which:04b} {w}x{h} at level {level}");
+        assert_guided_paths_agree(&atlas, &st, Some(&parent), &g, &what);
     }
 }
 
@@ -222,9 +256,13 @@ fn controls_change_the_result_as_intended() {
     let atlas = AtlasLevel::new(db(), 1);
     let (w, h) = (40, 30);
     let st = random_state(&atlas, w, h, 5);
-    let p = CorrectParams { px: 0, py: 0 };
+    let p = CorrectParams {
+        px: 0,
+        py: 0,
+        prior: DEFAULT_PRIOR,
+    };
     let plain = state_from(w, h, &st.coords(), &st.offsets());
-    correct::correct(&atlas, &plain, &p);
+    correct::correct(&atlas, &plain, None, &p);
     // A far-away target with zero tolerance moves every corrected offset.
     let targets = vec![
         Target {
@@ -238,7 +276,7 @@ fn controls_change_the_result_as_intended() {
         targets: Some(&targets),
         ..Guide::NONE
     };
-    correct::correct_guided(&atlas, &pulled, &p, &g);
+    correct::correct_guided(&atlas, &pulled, None, &p, &g);
     for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
         assert!(
             pulled.offsets()[i] > plain.offsets()[i] + 10_000,
@@ -251,7 +289,7 @@ fn controls_change_the_result_as_intended() {
         window: Some([10, 4, 20, 12]),
         ..Guide::NONE
     };
-    correct::correct_guided(&atlas, &windowed, &p, &g);
+    correct::correct_guided(&atlas, &windowed, None, &p, &g);
     for y in 0..h {
         for x in 0..w {
             let i = y * w + x;
@@ -277,7 +315,7 @@ fn controls_change_the_result_as_intended() {
         }),
         ..Guide::NONE
     };
-    correct::correct_guided(&atlas, &frozen, &p, &g);
+    correct::correct_guided(&atlas, &frozen, None, &p, &g);
     for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
         assert_eq!(
             (frozen.coords()[i], frozen.offsets()[i]),

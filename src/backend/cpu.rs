@@ -41,8 +41,8 @@ impl Backend for Cpu<'_, '_> {
         upsample_jitter::upsample_jitter(parent, child, atlas, p);
     }
 
-    fn correct(&self, st: &State, level: usize, p: &CorrectParams) {
-        correct::correct(&self.atlas[level], st, p);
+    fn correct(&self, st: &State, parent: Option<&State>, level: usize, p: &CorrectParams) {
+        correct::correct(&self.atlas[level], st, parent, p);
     }
 
     fn upload_guide<'g>(
@@ -55,8 +55,15 @@ impl Backend for Cpu<'_, '_> {
         Ok(*g)
     }
 
-    fn correct_guided(&self, st: &State, level: usize, p: &CorrectParams, g: &correct::Guide<'_>) {
-        correct::correct_guided(&self.atlas[level], st, p, g);
+    fn correct_guided(
+        &self,
+        st: &State,
+        parent: Option<&State>,
+        level: usize,
+        p: &CorrectParams,
+        g: &correct::Guide<'_>,
+    ) {
+        correct::correct_guided(&self.atlas[level], st, parent, p, g);
     }
 
     fn reconstruct(&self, st: &State) -> Result<Vec<i32>, BackendError> {

@@ -105,12 +105,19 @@ pub struct CorrectUniform {
     pub level: u32,
     /// Types of the database (`AtlasLevel::seed_counts.len()`).
     pub type_count: u32,
-    pub pad0: u32,
+    /// `CorrectParams::prior`.
+    pub prior: u32,
     /// `Guide::window` (the whole level without one).
     pub x0: u32,
     pub y0: u32,
     pub x1: u32,
     pub y1: u32,
+    /// The parent level's width, and whether there is one (the prior's
+    /// anchor).
+    pub parent_width: u32,
+    pub has_parent: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }
 
 /// `GuideCell` of `kernels/correct.wgsl`: one pixel's control inputs of

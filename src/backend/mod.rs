@@ -78,8 +78,16 @@ pub trait Backend {
         level: usize,
         p: &UpsampleParams,
     );
-    /// One subpass of stage `correct` at database level `level`, in place.
-    fn correct(&self, st: &Self::State, level: usize, p: &CorrectParams);
+    /// One subpass of stage `correct` at database level `level`, in place;
+    /// `parent` is the level above (the height prior's anchor), none at the
+    /// coarsest corrected level.
+    fn correct(
+        &self,
+        st: &Self::State,
+        parent: Option<&Self::State>,
+        level: usize,
+        p: &CorrectParams,
+    );
     /// Moves the control inputs of one pass over a `width × height` level
     /// to the backend (the CPU borrows them as they are).
     fn upload_guide<'g>(
@@ -94,6 +102,7 @@ pub trait Backend {
     fn correct_guided(
         &self,
         st: &Self::State,
+        parent: Option<&Self::State>,
         level: usize,
         p: &CorrectParams,
         g: &Self::Guide<'_>,

@@ -144,14 +144,14 @@ impl SceneEdits {
             }
         }
         let count = db.meta().exemplars.len();
-        if scene.start_exemplar >= count {
+        if let Some(e) = scene.start_exemplar.filter(|&e| e >= count) {
             return Err(invalid(
                 "start_exemplar",
-                scene.start_exemplar.to_string(),
+                e.to_string(),
                 format!("an exemplar index in 0..={}", count - 1),
             ));
         }
-        let cell = db.meta().exemplars[scene.start_exemplar].cell_size_m;
+        let cell = db.meta().exemplars[scene.start_exemplar.unwrap_or(0)].cell_size_m;
         let mut edits = Vec::new();
         let mut next = Applied::default();
 

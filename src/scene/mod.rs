@@ -18,7 +18,7 @@
 //!   "seed": 7,                          // 0..=4294967295
 //!   "jitter": 0.4,                      // optional, 0..=4 texels
 //!   "passes": 2,                        // optional, 0..=16
-//!   "start_exemplar": 0,                // optional, an exemplar index of the database
+//!   "start_exemplar": 0,                // optional, an exemplar index of the database; absent = every exemplar (synth::Params::start_exemplar)
 //!   "points": [{
 //!     "id": "peak",                     // optional, unique; default "points[i]"
 //!     "at": [300, 200],
@@ -96,7 +96,7 @@ pub struct Scene {
     pub seed: u32,
     pub jitter: f64,
     pub passes: u32,
-    pub start_exemplar: usize,
+    pub start_exemplar: Option<usize>,
     pub points: Vec<PointSpec>,
     pub curves: Vec<CurveItem>,
     pub junctions: Vec<JunctionHeight>,

@@ -314,8 +314,8 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         None => 2,
     };
     let start_exemplar = match m.get("start_exemplar") {
-        Some(v) => r.integer(v, "start_exemplar", 65535)? as usize,
-        None => 0,
+        Some(v) => Some(r.integer(v, "start_exemplar", 65535)? as usize),
+        None => None,
     };
     let mut ids = Vec::new();
 

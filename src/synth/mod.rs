@@ -14,6 +14,7 @@
 //! with the same bytes.
 
 pub mod atlas;
+pub mod coarse;
 pub mod control;
 pub mod fixed;
 pub mod session;
@@ -24,6 +25,7 @@ use crate::backend::{Backend, BackendError, Choice, Stage, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
+use coarse::Start;
 use control::Target;
 use fixed::{Coord, FRAC_BITS};
 use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
@@ -33,15 +35,6 @@ use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
-/// With jitter, synthesis starts this many levels above the database's
-/// coarsest level L, from hash-chosen exemplar positions (see
-/// `Synthesizer::initial`): level L starts as a mosaic of 2^b × 2^b blocks.
-pub const COARSE_BLOCK_BITS: usize = 2;
-
-/// Hash salt of the coarse start positions (kept apart from the jitter's
-/// `hash4(seed, level, x, y)`, whose level is always < 2^16).
-const COARSE_SALT: u32 = 0xC0A5_0000;
-
 /// Synthesis settings (paper defaults).
 #[derive(Debug, Clone)]
 pub struct Params {
@@ -49,8 +42,16 @@ pub struct Params {
     pub jitter: f64,
     /// Correction passes per level (paper: 2), each of four subpasses.
     pub passes: u32,
-    /// Exemplar whose centre initialises the coarsest level.
-    pub start_exemplar: usize,
+    /// The exemplar synthesis starts from: its blocks make the coarse start
+    /// (see [`coarse`]), or without jitter its centre; the output takes its
+    /// cell size. `None`: blocks from every exemplar in proportion to its
+    /// area (each terrain type by its share of the database), exemplar 0's
+    /// centre without jitter, and exemplar 0's cell size.
+    pub start_exemplar: Option<usize>,
+    /// Height prior weight P of the correction (one of
+    /// `stages::correct::PRIORS`; 0 is the paper's pure relative height
+    /// matching). See the `correct` stage's module docs.
+    pub prior: u32,
     /// Keep every level's S and V in the result, for inspection.
     pub keep_levels: bool,
 }
@@ -60,7 +61,8 @@ impl Default for Params {
         Params {
             jitter: 0.4,
             passes: 2,
-            start_exemplar: 0,
+            start_exemplar: None,
+            prior: stages::correct::DEFAULT_PRIOR,
             keep_levels: false,
         }
     }
@@ -74,6 +76,8 @@ pub enum SynthError {
     Jitter(f64),
     #[error("passes {0} is invalid: expected 0..=16")]
     Passes(u32),
+    #[error("height prior {0} is invalid: expected one of {list:?}", list = stages::correct::PRIORS)]
+    Prior(u32),
     #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
     StartExemplar { index: usize, count: usize },
     #[error(transparent)]
@@ -248,12 +252,12 @@ impl<'db> Synthesizer<'db> {
         if params.passes > 16 {
             return Err(SynthError::Passes(params.passes));
         }
+        if !stages::correct::PRIORS.contains(&params.prior) {
+            return Err(SynthError::Prior(params.prior));
+        }
         let count = db.meta().exemplars.len();
-        if params.start_exemplar >= count {
-            return Err(SynthError::StartExemplar {
-                index: params.start_exemplar,
-                count,
-            });
+        if let Some(index) = params.start_exemplar.filter(|&i| i >= count) {
+            return Err(SynthError::StartExemplar { index, count });
         }
         let atlas = (0..db.level_count())
             .map(|i| AtlasLevel::new(db, i))
@@ -416,7 +420,7 @@ impl<'db> Synthesizer<'db> {
         control: Option<&Control<'_>>,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         let t0 = Instant::now();
-        let (top, l, mut timings) = self.plan(width, height)?;
+        let (start, top, l, mut timings) = self.plan(width, height)?;
         let mut kept = Vec::new();
         let mut frames = control.filter(|c| c.record).map(|_| Frames {
             levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
@@ -425,7 +429,10 @@ impl<'db> Synthesizer<'db> {
         // wall clock measures it; with one, stages queue back to back.
         let device_clock = b.has_device_clock();
         b.device_times()?; // forget times of earlier calls
-        let mut state = b.upload(self.initial(width, height, top, seed))?;
+        let mut state = b.upload(self.initial(width, height, start, seed))?;
+        // The level above, kept through this level's correction: its
+        // offsets anchor the height prior (`correct` module docs).
+        let mut parent: Option<B::State> = None;
         // Bounds of the pixels of the level above that differ from the
         // previous frame (restricted re-synthesis only).
         let mut changed_parent: Option<[usize; 4]> = None;
@@ -434,11 +441,12 @@ impl<'db> Synthesizer<'db> {
             if level < top {
                 let t = Instant::now();
                 let child = b.alloc(w, h)?;
-                b.upsample_jitter(&state, &child, level, &self.upsample_params(seed, level));
+                let p = self.upsample_params(seed, level, start);
+                b.upsample_jitter(&state, &child, level, &p);
                 if !device_clock {
                     b.finish()?;
                 }
-                state = child;
+                parent = Some(std::mem::replace(&mut state, child));
                 timings.levels[level].upsample = t.elapsed();
             }
             if level <= l {
@@ -447,14 +455,19 @@ impl<'db> Synthesizer<'db> {
                     None => {
                         for _pass in 0..self.params.passes {
                             for &(px, py) in &SUBPASSES {
-                                b.correct(&state, level, &CorrectParams { px, py });
+                                let p = CorrectParams {
+                                    px,
+                                    py,
+                                    prior: self.params.prior,
+                                };
+                                b.correct(&state, parent.as_ref(), level, &p);
                             }
                         }
                     }
                     Some(c) => {
                         changed_parent = self.correct_level(
                             b,
-                            &state,
+                            (&state, parent.as_ref()),
                             (level, w, h),
                             c,
                             changed_parent,
@@ -518,7 +531,7 @@ impl<'db> Synthesizer<'db> {
     fn correct_level<B: Backend>(
         &self,
         b: &B,
-        state: &B::State,
+        (state, parent): (&B::State, Option<&B::State>),
         (level, w, h): (usize, usize, usize),
         c: &Control<'_>,
         changed_parent: Option<[usize; 4]>,
@@ -554,7 +567,12 @@ impl<'db> Synthesizer<'db> {
             };
             let g = b.upload_guide(&guide, w, h)?;
             for &(px, py) in &SUBPASSES {
-                b.correct_guided(state, level, &CorrectParams { px, py }, &g);
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: self.params.prior,
+                };
+                b.correct_guided(state, parent, level, &p, &g);
             }
             let is_last = pass + 1 == self.params.passes as usize;
             if frames.is_some() || (is_last && window.is_some()) {
@@ -582,12 +600,22 @@ impl<'db> Synthesizer<'db> {
 
     /// Output cell size, metres (the start exemplar's).
     pub fn cell_size_m(&self) -> f64 {
-        self.db.meta().exemplars[self.params.start_exemplar].cell_size_m
+        self.db.meta().exemplars[self.start()].cell_size_m
     }
 
-    /// The levels a `width × height` synthesis runs: the coarsest synthesized
-    /// level `top`, the database's coarsest level L, and empty timings.
-    fn plan(&self, width: usize, height: usize) -> Result<(usize, usize, Timings), SynthError> {
+    /// The start exemplar, or exemplar 0 (see [`Params::start_exemplar`]).
+    fn start(&self) -> usize {
+        self.params.start_exemplar.unwrap_or(0)
+    }
+
+    /// The levels a `width × height` synthesis runs: how it starts, the
+    /// coarsest synthesized level `top`, the database's coarsest level L,
+    /// and empty timings.
+    fn plan(
+        &self,
+        width: usize,
+        height: usize,
+    ) -> Result<(Start, usize, usize, Timings), SynthError> {
         crate::heightfield::check_dims(width, height)?;
         let m = top_level(width, height);
         let l = self.coarsest();
@@ -595,37 +623,42 @@ impl<'db> Synthesizer<'db> {
             levels: vec![LevelTiming::default(); m + 1],
             ..Default::default()
         };
-        // With jitter, levels above `top` would only be a spread-out copy of
-        // the start exemplar; they are skipped (see `initial`).
-        let top = if self.jitter > 0 {
-            m.min(l + COARSE_BLOCK_BITS)
-        } else {
-            m
-        };
-        Ok((top, l, timings))
+        let start = Start::choose(
+            self.jitter > 0,
+            m,
+            l,
+            &self.atlas[l],
+            self.params.start_exemplar,
+        );
+        Ok((start, start.top(m, l), l, timings))
     }
 
-    /// Parameters of the upsampling into level `level`.
-    fn upsample_params(&self, seed: u32, level: usize) -> UpsampleParams {
+    /// Parameters of the upsampling into level `level`. Above L the levels
+    /// only spread the start (no jitter: blocks stay verbatim, see
+    /// [`coarse`]); jitter begins at L.
+    fn upsample_params(&self, seed: u32, level: usize, start: Start) -> UpsampleParams {
+        let l = self.coarsest();
         UpsampleParams {
             seed,
             level: level as u32,
-            jitter: self.jitter,
-            step: self.step(level, self.coarsest()),
+            jitter: if level > l { 0 } else { self.jitter },
+            step: self.step(level, l, start),
         }
     }
 
     /// How level `level` is made from the one above.
-    fn step(&self, level: usize, l: usize) -> Step {
+    fn step(&self, level: usize, l: usize, start: Start) -> Step {
         if level < l {
             Step::Pyramid
-        } else if level > l {
+        } else if level > l || matches!(start, Start::Blocks { .. }) {
+            // Blocks fit their exemplar's interior, so entering L needs no
+            // wrap (jitter moves a texel by less than half).
             Step::Virtual {
                 shift: (level - l) as u32,
             }
         } else {
             let c = &self.atlas[l].columns;
-            let r = self.atlas[l].level.layout.rects[self.params.start_exemplar];
+            let r = self.atlas[l].level.layout.rects[self.start()];
             let col = c[r.x0 as usize];
             Step::Wrap {
                 min_x: col.min_x,
@@ -636,71 +669,20 @@ impl<'db> Synthesizer<'db> {
         }
     }
 
-    /// The coarsest synthesized level, `top`.
-    ///
-    /// Without jitter (the reproduction property): level M holds the start
-    /// exemplar's centre, spread so that each level halves the spacing — at
-    /// level ≤ L an exact copy of the centre, tiled toroidally when the
-    /// output is larger than the exemplar.
-    ///
-    /// With jitter, an output larger than the exemplars would otherwise be
-    /// that tiled copy plus sub-texel jitter: above level L there is no data
-    /// to correct with, so the paper's jitter cannot create variety there and
-    /// the tiles stay visible as a repeating pattern. Instead each pixel of
-    /// level `top = L + COARSE_BLOCK_BITS` starts at a hash-chosen position
-    /// of the start exemplar (the fully jittered coarse level of Lefebvre &
-    /// Hoppe 2005), so level L begins as a mosaic of small exemplar blocks
-    /// that its correction passes assemble into exemplar-like patches.
-    ///
-    /// Computed on the host for every backend and uploaded — it is tiny
-    /// (⌈W/2^(L+b)⌉ × ⌈H/2^(L+b)⌉ pixels: 16 × 16 for 4096² with L = 6; 2 × 2
-    /// without jitter) — so it has no kernel mirror.
-    fn initial(&self, width: usize, height: usize, top: usize, seed: u32) -> State {
-        let l = self.coarsest();
-        let at = top.min(l);
-        let r = self.atlas[at].level.layout.rects[self.params.start_exemplar];
-        let (w, h) = level_size(width, height, top);
-        let st = State::new(w, h);
-        if self.jitter > 0 && top > l {
-            // Level-L texel ranges whose whole 2^b block stays inside the
-            // exemplar interior (b = top − L).
-            let span = (1i32 << (top - l)) - 1;
-            let col = self.atlas[l].columns[r.x0 as usize];
-            let (x0, y0) = (col.min_x, crate::database::layout::MARGIN as i32);
-            let nx = (col.max_x - span - x0 + 1).max(1) as u32;
-            let ny = (col.max_y - span - y0 + 1).max(1) as u32;
-            for y in 0..h {
-                for x in 0..w {
-                    let hash = crate::hash::hash4(seed, COARSE_SALT, x as u32, y as u32);
-                    let tx = x0 + crate::hash::below(hash, nx) as i32;
-                    let ty = y0 + crate::hash::below(crate::hash::pcg(hash), ny) as i32;
-                    st.set(y * w + x, Coord::from_texel(tx, ty), 0);
-                }
+    /// The coarsest synthesized level `top` (see [`coarse`]).
+    fn initial(&self, width: usize, height: usize, start: Start, seed: u32) -> State {
+        let (m, l) = (top_level(width, height), self.coarsest());
+        match start {
+            Start::Blocks { bits } => {
+                let from = self.params.start_exemplar;
+                coarse::blocks(&self.atlas[l], from, width, height, (l, bits), seed)
             }
-            return st;
-        }
-        let m = top;
-        let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
-        for y in 0..h {
-            for x in 0..w {
-                // Offset from the level's centre, in half texels of level m.
-                let (hx, hy) = (2 * x as i32 + 1 - w as i32, 2 * y as i32 + 1 - h as i32);
-                let to_fixed = |half: i32| -> i32 {
-                    if m > l {
-                        // In level-L units: a level-m texel is 2^(m−L) of them.
-                        (half << FRAC_BITS) << (m - l - 1)
-                    } else {
-                        half << (FRAC_BITS - 1)
-                    }
-                };
-                let s = Coord {
-                    x: (cx << FRAC_BITS) + to_fixed(hx),
-                    y: (cy << FRAC_BITS) + to_fixed(hy),
-                };
-                st.set(y * w + x, s, 0);
+            Start::Centre => {
+                let top = start.top(m, l);
+                let a = &self.atlas[top.min(l)];
+                coarse::centre(a, self.start(), width, height, top, l)
             }
         }
-        st
     }
 
     /// Level-0 fixed-point heights → metres, cropped to the requested size
@@ -713,7 +695,7 @@ impl<'db> Synthesizer<'db> {
         height: usize,
     ) -> Result<Heightfield, SynthError> {
         let q = self.db.quantization();
-        let cell = self.db.meta().exemplars[self.params.start_exemplar].cell_size_m;
+        let cell = self.cell_size_m();
         let scale = q.scale_m / (1 << HEIGHT_FRAC_BITS) as f64;
         Ok(Heightfield::from_fn(width, height, cell, |x, y| {
             (q.offset_m + scale * fixed[y * stride + x] as f64) as f32
@@ -721,8 +703,9 @@ impl<'db> Synthesizer<'db> {
     }
 
     /// Synthesis memory per output pixel: the finest level's state, the
-    /// level above it (alive during upsampling), the fixed-point heights and
-    /// the output heightfield.
+    /// level above it (alive during upsampling and correction, where its
+    /// offsets anchor the height prior), the fixed-point heights and the
+    /// output heightfield.
     pub fn bytes_per_pixel(width: usize, height: usize) -> f64 {
         let (w0, h0) = level_size(width, height, 0);
         let (w1, h1) = level_size(width, height, 1);

@@ -258,7 +258,22 @@ impl<'db> Session<'db> {
         let (out, frames) =
             self.synth
                 .run_with(self.width, self.height, self.seed, &guides, prev, true)?;
-        let hf = out.heightfield;
+        let mut hf = out.heightfield;
+        if let (Some(f), Some(old)) = (&self.controls.freeze, &self.last) {
+            // Frozen pixels keep the heights the user froze. Their S and V
+            // are kept by the weights, but reconstruct averages each pixel
+            // with its 3×3 neighbours' predictions, so a frozen pixel beside
+            // an edited one would still move by a share of the new join.
+            for ((h, o), _) in hf
+                .data_mut()
+                .iter_mut()
+                .zip(old.data())
+                .zip(f)
+                .filter(|(_, f)| **f)
+            {
+                *h = *o;
+            }
+        }
         let change = self.last.as_ref().map(|old| change(old, &hf));
         self.frames = frames;
         self.guides = Some(guides);

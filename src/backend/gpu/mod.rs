@@ -608,14 +608,14 @@ impl Backend for Gpu {
         );
     }
 
-    fn correct(&self, st: &GpuState, level: usize, p: &CorrectParams) {
+    fn correct(&self, st: &GpuState, parent: Option<&GpuState>, level: usize, p: &CorrectParams) {
         let none = GpuGuide {
             level: level as u32,
             window: None,
             flags: 0,
             cells: None,
         };
-        self.correct_guided(st, level, p, &none);
+        self.correct_guided(st, parent, level, p, &none);
     }
 
     fn upload_guide(
@@ -666,7 +666,14 @@ impl Backend for Gpu {
         })
     }
 
-    fn correct_guided(&self, st: &GpuState, level: usize, p: &CorrectParams, g: &GpuGuide) {
+    fn correct_guided(
+        &self,
+        st: &GpuState,
+        parent: Option<&GpuState>,
+        level: usize,
+        p: &CorrectParams,
+        g: &GpuGuide,
+    ) {
         let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, st.width, st.height]);
         let mut u = CorrectUniform {
             width: st.width as u32,
@@ -675,10 +682,13 @@ impl Backend for Gpu {
             py: p.py,
             level: g.level,
             type_count: self.levels[level].type_count,
+            prior: p.prior,
             x0: x0 as u32,
             y0: y0 as u32,
             x1: x1.min(st.width) as u32,
             y1: y1.min(st.height) as u32,
+            parent_width: parent.map_or(0, |pa| pa.width as u32),
+            has_parent: parent.is_some() as u32,
             ..Default::default()
         };
         u.flags = g.flags;
@@ -697,6 +707,7 @@ impl Backend for Gpu {
                 &l.similar,
                 &l.type_data,
                 g.cells.as_ref().unwrap_or(&self.placeholder),
+                parent.map_or(&self.placeholder, |pa| &pa.v),
             ],
             (
                 groups(class(st.width, p.px)),

@@ -34,9 +34,16 @@ pub struct Args {
     /// Correction passes per level.
     #[arg(long, default_value_t = 2)]
     passes: u32,
-    /// Exemplar (index) whose centre the synthesis starts from.
-    #[arg(long, default_value_t = 0)]
-    start_exemplar: usize,
+    /// Exemplar (index) the synthesis starts from: its blocks make the
+    /// coarse structure and the output takes its cell size. Default: blocks
+    /// from every exemplar by area, exemplar 0's cell size.
+    #[arg(long)]
+    start_exemplar: Option<usize>,
+    /// Height prior P of the correction: 0 (the paper's pure relative
+    /// height matching), 1, 2, 4 or 8. Higher keeps candidates nearer the
+    /// altitude the coarser level chose (more relief, less drift).
+    #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
+    height_prior: u32,
     /// Where the stages run: cpu, gpu (WGSL on Vulkan; `--features gpu`
     /// builds) or auto (the GPU if there is one). Same output bytes on each.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -108,6 +115,7 @@ pub fn run(a: Args) -> CliResult {
         jitter: a.jitter,
         passes: a.passes,
         start_exemplar: a.start_exemplar,
+        prior: a.height_prior,
         keep_levels: a.coords.is_some(),
     };
     let mut synth = Synthesizer::new(&db, params)?;

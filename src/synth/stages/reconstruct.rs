@@ -1,15 +1,28 @@
-//! Stage `reconstruct`: heights from E⁰ at S⁰ (bilinear) plus V⁰.
+//! Stage `reconstruct`: level-0 heights from E⁰, S⁰ and V⁰ — each pixel the
+//! mean of what its 3×3 neighbourhood predicts for it.
+//!
+//! Neighbour n (at offset Δ from p) predicts `E⁰(round(S(n)) − Δ) + V(n)`:
+//! the height its own patch continues with at p. Inside a coherent patch
+//! all nine predictions are the same exemplar texel, so the output is the
+//! exemplar's heights exactly — crisp, as real terrain is. Where patches
+//! meet, the predictions of both sides are averaged over two or three
+//! pixels, which hides the joins (single-pixel pits and steps, the repeated
+//! or skipped texels of jittered coordinates) without blurring anything
+//! else. The paper samples E⁰ bilinearly at the fractional S⁰ instead; at
+//! the finest level every pixel carries a random fraction of jitter, so
+//! that low-passed the whole terrain (measured on the shared DEMs: the
+//! Laplacian's spread 2–6× off the exemplar's) while leaving the joins'
+//! pits (≈ 2× the exemplar's count) in place.
 //!
 //! The kernel output is an i32 height in database units with 8 fractional
-//! bits (bit-exact on CPU and GPU); conversion to metres is a CPU-side
-//! `offset + scale · value / 256` (DESIGN §6 rule 5).
-//!
-//! Bilinear weights have [`FRAC_BITS`] bits; the weighted sum of four u16
-//! heights is at most 65535 · 2^16 < 2^32 (a u32), then shifted down by 8
-//! (truncating) to keep 8 fractional bits.
+//! bits (bit-exact on CPU and GPU): the sum of the predictions (each
+//! `(E⁰ + V) << 8`, nine at most: |sum| < 2^31 for |V| < 2^22) divided by
+//! their count with floor division. Neighbours outside the level do not
+//! predict. Conversion to metres is a CPU-side `offset + scale · value / 256`
+//! (DESIGN §6 rule 5).
 
 use crate::synth::atlas::AtlasLevel;
-use crate::synth::fixed::{FRAC_BITS, ONE};
+use crate::synth::fixed::{div_floor, round};
 use crate::synth::state::State;
 use rayon::prelude::*;
 
@@ -18,19 +31,27 @@ pub const HEIGHT_FRAC_BITS: u32 = 8;
 
 /// Heights of level 0, row-major, in units × 2^8.
 pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
-    let w = st.width;
-    let mut out = vec![0i32; st.width * st.height];
+    let (w, h) = (st.width, st.height);
+    let mut out = vec![0i32; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, o) in row.iter_mut().enumerate() {
-            let i = y * w + x;
-            let s = st.s(i);
-            let (x0, y0) = (s.x >> FRAC_BITS, s.y >> FRAC_BITS);
-            let (fx, fy) = ((s.x & (ONE - 1)) as u32, (s.y & (ONE - 1)) as u32);
-            let e = |dx: i32, dy: i32| heights[atlas.index(x0 + dx, y0 + dy)] as u32;
-            let top = e(0, 0) * (ONE as u32 - fx) + e(1, 0) * fx;
-            let bottom = e(0, 1) * (ONE as u32 - fx) + e(1, 1) * fx;
-            let v = (top * (ONE as u32 - fy) + bottom * fy) >> (2 * FRAC_BITS - HEIGHT_FRAC_BITS);
-            *o = v as i32 + (st.v(i) << HEIGHT_FRAC_BITS);
+            let (mut sum, mut count) = (0i32, 0i32);
+            for dy in -1..=1i32 {
+                for dx in -1..=1i32 {
+                    let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+                    if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                        continue;
+                    }
+                    let n = ny as usize * w + nx as usize;
+                    let s = st.s(n);
+                    // S(n) is interior (two texels from every exemplar
+                    // edge), so the texel one step away is in its exemplar.
+                    let e = heights[atlas.index(round(s.x) - dx, round(s.y) - dy)] as i32;
+                    sum += (e + st.v(n)) << HEIGHT_FRAC_BITS;
+                    count += 1;
+                }
+            }
+            *o = div_floor(sum, count);
         }
     });
     out

@@ -4,15 +4,15 @@
 //! against.
 
 use super::{
-    ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, SEED_SALT, SEEDS_PER_ALLOWED_TYPE,
-    W_FREE, weigh,
+    ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, Prior, SEED_SALT,
+    SEEDS_PER_ALLOWED_TYPE, W_FREE, weigh,
 };
 use crate::database::appearance::{MODE1_BIAS, unpack_texel};
 use crate::database::types::SEEDS_PER_TYPE;
 use crate::hash::{below, hash4};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::control::blend::nudge;
-use crate::synth::fixed::{Coord, FRAC_BITS, div_floor, round};
+use crate::synth::fixed::{Coord, FRAC_BITS, round};
 use crate::synth::state::State;
 use rayon::prelude::*;
 
@@ -43,8 +43,15 @@ fn add_texel(acc: &mut [i32; 4], t: u64, v: i32) {
 
 /// Score (×κ) and optimal offset of candidate texel (qx, qy).
 #[inline(always)]
-fn score(atlas: &AtlasLevel<'_>, ns: &Neighbourhood, qx: i32, qy: i32, kappa: u32) -> (u32, i32) {
-    score_with(atlas, ns, qx, qy, kappa, None)
+fn score(
+    atlas: &AtlasLevel<'_>,
+    ns: &Neighbourhood,
+    qx: i32,
+    qy: i32,
+    kappa: u32,
+    prior: Prior,
+) -> (u32, i32) {
+    score_with(atlas, ns, qx, qy, kappa, None, prior)
 }
 
 /// [`score`] with the offset fixed to `fixed` when given (a coherent
@@ -57,6 +64,7 @@ fn score_with(
     qy: i32,
     kappa: u32,
     fixed: Option<i32>,
+    prior: Prior,
 ) -> (u32, i32) {
     let mut d = [[0i32; 4]; 4];
     let mut sum1 = 0;
@@ -67,8 +75,8 @@ fn score_with(
         }
         sum1 += d[k][0];
     }
-    let h = fixed.unwrap_or_else(|| div_floor(sum1 + 6, 12));
-    let mut s = 0u32;
+    let h = fixed.unwrap_or_else(|| prior.optimal(sum1));
+    let mut s = prior.cost(h);
     for dk in &d {
         let r1 = (dk[0] - 3 * h).clamp(-CLAMP, CLAMP);
         s += (r1 * r1) as u32;
@@ -130,8 +138,14 @@ fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> Neighbour {
 
 /// Corrects one pixel; returns its new coordinate and offset.
 #[inline(always)]
-pub fn correct_pixel(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> (Coord, i32) {
-    correct_pixel_guided(atlas, st, x, y, &Guide::NONE)
+pub fn correct_pixel(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    x: i32,
+    y: i32,
+    prior: Prior,
+) -> (Coord, i32) {
+    correct_pixel_guided(atlas, st, x, y, &Guide::NONE, prior)
 }
 
 /// The best candidate so far: cost, coordinate, offset, and its texel
@@ -163,6 +177,7 @@ pub fn correct_pixel_guided(
     x: i32,
     y: i32,
     g: &Guide<'_>,
+    prior: Prior,
 ) -> (Coord, i32) {
     let mut ns: Neighbourhood = [[0; 4]; 4];
     for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
@@ -191,11 +206,11 @@ pub fn correct_pixel_guided(
                 (0, s, v, None)
             } else if w >= W_FREE {
                 // Unweighted: the coordinate, re-fitted and nudged.
-                let (sc, hh) = score(atlas, &ns, q.0, q.1, 1);
+                let (sc, hh) = score(atlas, &ns, q.0, q.1, 1, prior);
                 (weigh(sc, w), s, hh, Some(q))
             } else {
                 // Coherent: the previous result as is, at a discount.
-                let (sc, _) = score_with(atlas, &ns, q.0, q.1, 1, Some(v));
+                let (sc, _) = score_with(atlas, &ns, q.0, q.1, 1, Some(v), prior);
                 (weigh(sc, w), s, v, None)
             };
         }
@@ -221,7 +236,7 @@ pub fn correct_pixel_guided(
             let c1 = atlas.clamp_interior(u.0, u.1);
             if admits(c1) {
                 any = true;
-                let (sc, hh) = score(atlas, &ns, c1.0, c1.1, 1);
+                let (sc, hh) = score(atlas, &ns, c1.0, c1.1, 1, prior);
                 if sc < best.0 {
                     *best = (sc, place(c1), hh, Some(c1));
                 }
@@ -230,7 +245,7 @@ pub fn correct_pixel_guided(
             let c2 = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
             if admits(c2) {
                 any = true;
-                let (sc, hh) = score(atlas, &ns, c2.0, c2.1, 2);
+                let (sc, hh) = score(atlas, &ns, c2.0, c2.1, 2, prior);
                 if sc < best.0 {
                     *best = (sc, place(c2), hh, Some(c2));
                 }
@@ -252,7 +267,7 @@ pub fn correct_pixel_guided(
                 let hash = hash4(SEED_SALT | g.level, salt, x as u32, y as u32);
                 let c = list[below(hash, count) as usize];
                 let q = ((c & 0xFFFF) as i32, (c >> 16) as i32);
-                let (sc, hh) = score(atlas, &ns, q.0, q.1, 1);
+                let (sc, hh) = score(atlas, &ns, q.0, q.1, 1, prior);
                 if sc < best.0 {
                     best = (sc, Coord::from_texel(q.0, q.1), hh, Some(q));
                 }
@@ -274,12 +289,18 @@ pub fn correct_pixel_guided(
 }
 
 /// Runs one subpass in place with the reference path only.
-pub fn correct(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams) {
-    correct_guided(atlas, st, p, &Guide::NONE)
+pub fn correct(atlas: &AtlasLevel<'_>, st: &State, parent: Option<&State>, p: &CorrectParams) {
+    correct_guided(atlas, st, parent, p, &Guide::NONE)
 }
 
 /// [`correct`] with control inputs (the oracle of `super::correct_guided`).
-pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: &Guide<'_>) {
+pub fn correct_guided(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    parent: Option<&State>,
+    p: &CorrectParams,
+    g: &Guide<'_>,
+) {
     super::keep_outside(st, p, g);
     let (w, h) = (st.width, st.height);
     let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, w, h]);
@@ -289,7 +310,8 @@ pub fn correct_guided(atlas: &AtlasLevel<'_>, st: &State, p: &CorrectParams, g: 
         .filter(|&y| y >= y0)
         .for_each(|y| {
             for x in (p.px as usize..x1.min(w)).step_by(2).filter(|&x| x >= x0) {
-                let (s, v) = correct_pixel_guided(atlas, st, x as i32, y as i32, g);
+                let prior = Prior::at(p.prior, parent, x, y);
+                let (s, v) = correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
                 st.set(y * w + x, s, v);
             }
         });

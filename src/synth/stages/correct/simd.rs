@@ -21,10 +21,10 @@
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 
-use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, W_FREE, scalar, weigh};
+use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, Prior, W_FREE, scalar, weigh};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::control::blend::nudge;
-use crate::synth::fixed::{Coord, FRAC_BITS, div_floor, round};
+use crate::synth::fixed::{Coord, FRAC_BITS, round};
 use crate::synth::state::State;
 use wide::{i16x8, i32x8};
 
@@ -72,30 +72,40 @@ struct Neighbourhood {
 
 /// Score (×κ) and optimal offset of the candidate whose texel index is
 /// `q` in an exemplar of row stride `s` (same arithmetic as the scalar
-/// `score`).
+/// `score`; the prior's weight P is a constant, so its closed form divides
+/// by a constant).
 #[inline(always)]
-fn score(app: &[u64], ns: &Neighbourhood, q: i32, s: i32, kappa: u32) -> (u32, i32) {
-    score_with(app, ns, q, s, kappa, None)
+fn score<const P: u32>(
+    app: &[u64],
+    ns: &Neighbourhood,
+    q: i32,
+    s: i32,
+    kappa: u32,
+    vp: i32,
+) -> (u32, i32) {
+    score_with::<P>(app, ns, q, s, kappa, None, vp)
 }
 
 /// [`score`] with the offset fixed to `fixed` when given (a coherent
 /// previous result keeps its own offset).
 #[inline(always)]
-fn score_with(
+fn score_with<const P: u32>(
     app: &[u64],
     ns: &Neighbourhood,
     q: i32,
     s: i32,
     kappa: u32,
     fixed: Option<i32>,
+    vp: i32,
 ) -> (u32, i32) {
+    let prior = Prior { weight: P, v: vp };
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
     let m01 = i32x8::from_i16x8(pair(app, q - s - 1, q - s + 1));
     let m23 = i32x8::from_i16x8(pair(app, q + s - 1, q + s + 1));
     let d01 = ns.ns01 - (m01 + m01 + m01);
     let d23 = ns.ns23 - (m23 + m23 + m23);
     let (a, b) = (d01.to_array(), d23.to_array());
-    let h = fixed.unwrap_or_else(|| div_floor(a[0] + a[4] + b[0] + b[4] + 6, 12));
+    let h = fixed.unwrap_or_else(|| prior.optimal(a[0] + a[4] + b[0] + b[4]));
     let h3 = 3 * h;
     let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
     // Clamping after the saturating narrowing equals clamping before it
@@ -109,7 +119,8 @@ fn score_with(
     let s = (sums[0] as u32)
         .wrapping_add(sums[1] as u32)
         .wrapping_add(sums[2] as u32)
-        .wrapping_add(sums[3] as u32);
+        .wrapping_add(sums[3] as u32)
+        .wrapping_add(prior.cost(h));
     (s * kappa, h)
 }
 
@@ -133,9 +144,10 @@ struct Pending {
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of row `y`, all at least two
 /// texels inside the level, writing each result as it is found.
-pub fn correct_span(
+pub fn correct_span<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
+    parent: Option<&State>,
     y: usize,
     x0: usize,
     x1: usize,
@@ -145,7 +157,7 @@ pub fn correct_span(
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
-        correct_chunk(atlas, st, y, a, b, &mut grid, g);
+        correct_chunk::<P>(atlas, st, parent, y, a, b, &mut grid, g);
         a = b;
     }
 }
@@ -153,9 +165,11 @@ pub fn correct_span(
 /// One chunk `[x0, x1)` of a span. Reading the neighbours up front is safe:
 /// a subpass reads only pixels of other parity classes (which it never
 /// writes), and each pixel's own coordinate before the pixel is written.
-fn correct_chunk(
+#[allow(clippy::too_many_arguments)]
+fn correct_chunk<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
+    parent: Option<&State>,
     y: usize,
     x0: usize,
     x1: usize,
@@ -184,13 +198,15 @@ fn correct_chunk(
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
             let i = y * w + x0 + 2 * k;
+            let prior = Prior::at(P, parent, x0 + 2 * k, y);
             // Type-constrained pixels take the scalar path (rejection and
             // seeding live there; they are few and at coarse levels).
             let (s, v) = match g.allowed {
                 Some(a) if a[i] != ALL_TYPES => {
-                    scalar::correct_pixel_guided(atlas, st, (x0 + 2 * k) as i32, y as i32, g)
+                    let (x, y) = ((x0 + 2 * k) as i32, y as i32);
+                    scalar::correct_pixel_guided(atlas, st, x, y, g, prior)
                 }
-                _ => decide(atlas, st, grid, 2 * k + 2, i, &ring[k % RING], g),
+                _ => decide::<P>(atlas, st, grid, 2 * k + 2, i, &ring[k % RING], g, prior.v),
             };
             st.set(i, s, v);
         }
@@ -259,7 +275,8 @@ fn gather(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize, out: &
 /// neighbourhood; returns the winner's coordinate (with the fraction of
 /// the neighbour it came from) and optimal offset.
 #[inline(always)]
-fn decide(
+#[allow(clippy::too_many_arguments)]
+fn decide<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
     grid: &[[Tap; GRID_COLS]; 5],
@@ -267,6 +284,7 @@ fn decide(
     pixel: usize,
     p: &Pending,
     g: &Guide<'_>,
+    vp: i32,
 ) -> (Coord, i32) {
     let app = atlas.level.appearance;
     // N_S (eq. 5–6): per diagonal δ, g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a
@@ -310,8 +328,9 @@ fn decide(
         // Unweighted: the coordinate, re-fitted and nudged like any other;
         // coherent: the previous result as is.
         let free = w >= W_FREE;
-        let (sc, h_prev) = score_with(app, ns, idx, col.stride as i32, 1, (!free).then_some(v));
-        let (cost, i, hh) = best_of(app, ns, p, weigh(sc, w));
+        let fixed = (!free).then_some(v);
+        let (sc, h_prev) = score_with::<P>(app, ns, idx, col.stride as i32, 1, fixed, vp);
+        let (cost, i, hh) = best_of::<P>(app, ns, p, weigh(sc, w), vp);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -320,7 +339,7 @@ fn decide(
         }
         return finish(atlas, st, pixel, p, (cost, i, hh), g);
     }
-    let winner = best_of(app, ns, p, u32::MAX);
+    let winner = best_of::<P>(app, ns, p, u32::MAX, vp);
     finish(atlas, st, pixel, p, winner, g)
 }
 
@@ -340,10 +359,16 @@ fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>)
 /// The best gathered candidate whose cost is below `bar`:
 /// (cost, index, optimal offset), index `usize::MAX` if none is.
 #[inline(always)]
-fn best_of(app: &[u64], ns: &Neighbourhood, p: &Pending, bar: u32) -> (u32, usize, i32) {
+fn best_of<const P: u32>(
+    app: &[u64],
+    ns: &Neighbourhood,
+    p: &Pending,
+    bar: u32,
+    vp: i32,
+) -> (u32, usize, i32) {
     let mut best = (bar, usize::MAX, 0i32);
     for (i, c) in p.cands[..p.count].iter().enumerate() {
-        let (sc, hh) = score(app, ns, c.idx, c.stride, c.kappa);
+        let (sc, hh) = score::<P>(app, ns, c.idx, c.stride, c.kappa, vp);
         if sc < best.0 {
             best = (sc, i, hh);
         }

@@ -1,0 +1,187 @@
+//! The coarse start: the state synthesis begins from, above or at the
+//! database's coarsest level L.
+//!
+//! **Without jitter** (the reproduction property): level M holds the start
+//! exemplar's centre, spread so that each level halves the spacing — at
+//! level ≤ L an exact copy of the centre, tiled toroidally when the output
+//! is larger than the exemplar.
+//!
+//! **With jitter**, level `L + b` starts as one hash-chosen position per
+//! pixel — a *block* of 2^b × 2^b texels at level L — from any exemplar,
+//! with probability proportional to how many block positions it has (so
+//! every exemplar, and every terrain type, is drawn by its area). The levels
+//! above L only spread each block (children at `S + (c << shift)`, no
+//! jitter), so level L begins as a mosaic of verbatim exemplar blocks; from
+//! L down the paper's jitter and correction rearrange them.
+//!
+//! Why blocks, and why as large as the exemplars allow (b = ⌊log₂⌋ of the
+//! smallest exemplar interior side at L): pixel-based correction can join
+//! patches but cannot create large-scale structure. A mosaic of many small
+//! blocks (the fully jittered coarse level of Lefebvre & Hoppe 2005, which
+//! this crate used with b = 2) has no structure above the block size, and
+//! its joins — blocks from different altitudes side by side — are what the
+//! correction then levels: measured on the shared DEMs, level L kept 55–65 %
+//! of the exemplar's height spread and the output 55–70 % of its relief.
+//! Large blocks keep the exemplars' massifs and valley networks; the output
+//! still differs from any exemplar below the block scale (coherent patches
+//! at level 0 average ~100 pixels), and outputs larger than the exemplars
+//! get more blocks rather than a tiled copy.
+//!
+//! Computed on the host for every backend and uploaded: it is tiny
+//! (⌈W/2^(L+b)⌉ × ⌈H/2^(L+b)⌉ pixels), so it has no kernel mirror. Every
+//! choice is a hash of the seed and the block's absolute position
+//! (DESIGN §6), so any window of a terrain starts from the same blocks.
+
+use crate::database::layout::MARGIN;
+use crate::hash::{below, hash4};
+use crate::synth::atlas::AtlasLevel;
+use crate::synth::fixed::{Coord, FRAC_BITS};
+use crate::synth::state::{State, level_size};
+
+/// Hash salt of the block positions (kept apart from the jitter's
+/// `hash4(seed, level, x, y)`, whose level is always < 2^16).
+const COARSE_SALT: u32 = 0xC0A5_0000;
+
+/// How a synthesis starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Start {
+    /// The start exemplar's centre at level M (no jitter, or no room for a
+    /// block above L).
+    Centre,
+    /// Verbatim blocks of 2^bits level-L texels at level L + bits.
+    Blocks { bits: usize },
+}
+
+impl Start {
+    /// The start of an output whose coarsest level is `m`, for a database
+    /// whose coarsest level `l` is `atlas_l`: blocks (from exemplar `from`,
+    /// or every exemplar) when there is jitter and room above L, else the
+    /// centre.
+    pub fn choose(
+        jittered: bool,
+        m: usize,
+        l: usize,
+        atlas_l: &AtlasLevel<'_>,
+        from: Option<usize>,
+    ) -> Start {
+        let bits = block_bits(atlas_l, from).min(m.saturating_sub(l));
+        if jittered && bits > 0 {
+            Start::Blocks { bits }
+        } else {
+            Start::Centre
+        }
+    }
+
+    /// The coarsest synthesized level.
+    pub fn top(self, m: usize, l: usize) -> usize {
+        match self {
+            Start::Centre => m,
+            Start::Blocks { bits } => l + bits,
+        }
+    }
+}
+
+/// Inclusive interior bounds `[x0, x1] × [y0, y1]` of exemplar `from`, or
+/// of every exemplar, of a level, in atlas texels.
+fn interiors<'a>(
+    a: &'a AtlasLevel<'_>,
+    from: Option<usize>,
+) -> impl Iterator<Item = (i32, i32, i32, i32)> + 'a {
+    let rects = &a.level.layout.rects;
+    let rects = match from {
+        Some(e) => &rects[e..=e],
+        None => &rects[..],
+    };
+    rects.iter().map(|r| {
+        let c = a.columns[r.x0 as usize];
+        (c.min_x, c.max_x, MARGIN as i32, c.max_y)
+    })
+}
+
+/// The largest b such that a 2^b block fits the interior of exemplar
+/// `from` (or of every exemplar) at level L.
+pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
+    let side = interiors(a, from)
+        .map(|(x0, x1, y0, y1)| (x1 - x0 + 1).min(y1 - y0 + 1))
+        .min()
+        .unwrap_or(1)
+        .max(1);
+    side.ilog2() as usize
+}
+
+/// Level `L + bits` of a `width × height` output: each pixel a block origin
+/// drawn uniformly from every block position of exemplar `from` (or of
+/// every exemplar) at L.
+pub fn blocks(
+    a: &AtlasLevel<'_>,
+    from: Option<usize>,
+    width: usize,
+    height: usize,
+    (l, bits): (usize, usize),
+    seed: u32,
+) -> State {
+    let span = (1i32 << bits) - 1;
+    // Block origins per exemplar: x in [x0, x1 − span], y in [y0, y1 − span].
+    let ranges: Vec<(i32, i32, u32, u32)> = interiors(a, from)
+        .map(|(x0, x1, y0, y1)| {
+            let nx = (x1 - span - x0 + 1).max(0) as u32;
+            let ny = (y1 - span - y0 + 1).max(0) as u32;
+            (x0, y0, nx, ny)
+        })
+        .collect();
+    let total: u32 = ranges.iter().map(|&(_, _, nx, ny)| nx * ny).sum();
+    let (w, h) = level_size(width, height, l + bits);
+    let st = State::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            let hash = hash4(seed, COARSE_SALT, x as u32, y as u32);
+            let mut k = below(hash, total);
+            for &(x0, y0, nx, ny) in &ranges {
+                if k < nx * ny {
+                    let (tx, ty) = (x0 + (k % nx) as i32, y0 + (k / nx) as i32);
+                    st.set(y * w + x, Coord::from_texel(tx, ty), 0);
+                    break;
+                }
+                k -= nx * ny;
+            }
+        }
+    }
+    st
+}
+
+/// Level `top` of a `width × height` output without blocks: the centre of
+/// exemplar `e` at the level `min(top, l)` of `a`, spread so that each level
+/// halves the spacing (in level-L units above L).
+pub fn centre(
+    a: &AtlasLevel<'_>,
+    e: usize,
+    width: usize,
+    height: usize,
+    top: usize,
+    l: usize,
+) -> State {
+    let r = a.level.layout.rects[e];
+    let (w, h) = level_size(width, height, top);
+    let st = State::new(w, h);
+    let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
+    for y in 0..h {
+        for x in 0..w {
+            // Offset from the level's centre, in half texels of level top.
+            let (hx, hy) = (2 * x as i32 + 1 - w as i32, 2 * y as i32 + 1 - h as i32);
+            let to_fixed = |half: i32| -> i32 {
+                if top > l {
+                    // In level-L units: a level-top texel is 2^(top−L) of them.
+                    (half << FRAC_BITS) << (top - l - 1)
+                } else {
+                    half << (FRAC_BITS - 1)
+                }
+            };
+            let s = Coord {
+                x: (cx << FRAC_BITS) + to_fixed(hx),
+                y: (cy << FRAC_BITS) + to_fixed(hy),
+            };
+            st.set(y * w + x, s, 0);
+        }
+    }
+    st
+}
