@@ -12,6 +12,7 @@ pub mod backend;
 pub mod blend;
 pub mod database;
 pub mod error;
+pub mod eval;
 pub mod fill;
 pub mod georef;
 pub mod hash;

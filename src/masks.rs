@@ -6,10 +6,11 @@
 //! - **slope**: degrees from the steepest of the central differences
 //!   (Horn's 3×3 would smooth more; central differences keep single-cell
 //!   gullies), `value = round(degrees × 255 / 90)`;
-//! - **flow accumulation**: D8 (O'Callaghan & Mark 1984): every cell sends
-//!   itself and what it received to its steepest lower neighbour (drop over
-//!   distance, diagonals at √2 cells), cells taken from the highest down, so
-//!   one pass suffices; pits keep their water (no depression filling).
+//! - **flow accumulation**: D8 (O'Callaghan & Mark 1984; the one `eval`
+//!   measures drainage with, [`crate::eval::drainage::d8_area`]): every cell
+//!   sends itself and what it received to its steepest lower neighbour (drop
+//!   over distance, diagonals at √2 cells); pits keep their water (no
+//!   depression filling); edge cells drain into the grid like any other.
 //!   `value = round(255 × ln(cells) / ln(all cells))`, so a single cell is
 //!   0 and a river draining the whole grid 255;
 //! - **types**: [`crate::procedural::types::TypeMask::classify`] (ridge,
@@ -19,6 +20,7 @@
 //!   the relief where not rock, A wet ground where flow accumulation is in
 //!   its top quarter.
 
+use crate::eval::drainage::{Edges, d8_area};
 use crate::heightfield::Heightfield;
 use rayon::prelude::*;
 
@@ -47,50 +49,6 @@ pub fn slope_degrees(hf: &Heightfield) -> Vec<f32> {
     out
 }
 
-/// D8 flow accumulation in cells (each cell counts itself).
-pub fn flow_accumulation(hf: &Heightfield) -> Vec<u32> {
-    let (w, h) = (hf.width(), hf.height());
-    let d = hf.data();
-    let mut order: Vec<u32> = (0..(w * h) as u32).collect();
-    // Highest first; ties by index so the order is deterministic.
-    order.par_sort_unstable_by(|&a, &b| d[b as usize].total_cmp(&d[a as usize]).then(a.cmp(&b)));
-    let mut acc = vec![1u32; w * h];
-    for &i in &order {
-        let i = i as usize;
-        let (x, y) = ((i % w) as isize, (i / w) as isize);
-        let mut best = (0.0f32, usize::MAX);
-        for (dx, dy) in [
-            (-1, -1),
-            (0, -1),
-            (1, -1),
-            (-1, 0),
-            (1, 0),
-            (-1, 1),
-            (0, 1),
-            (1, 1),
-        ] {
-            let (nx, ny) = (x + dx, y + dy);
-            if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                continue;
-            }
-            let j = ny as usize * w + nx as usize;
-            let dist = if dx != 0 && dy != 0 {
-                std::f32::consts::SQRT_2
-            } else {
-                1.0
-            };
-            let drop = (d[i] - d[j]) / dist;
-            if drop > best.0 {
-                best = (drop, j);
-            }
-        }
-        if best.1 != usize::MAX {
-            acc[best.1] = acc[best.1].saturating_add(acc[i]);
-        }
-    }
-    acc
-}
-
 /// The masks of one heightfield, as 8-bit samples (RGBA for `splat`).
 pub struct Masks {
     pub slope: Vec<u8>,
@@ -101,7 +59,7 @@ pub struct Masks {
 /// Computes slope, flow and (when asked) splat masks.
 pub fn compute(hf: &Heightfield, splat: bool) -> Masks {
     let slope = slope_degrees(hf);
-    let acc = flow_accumulation(hf);
+    let acc = d8_area(hf, Edges::Inside);
     let log_all = ((hf.len() as f32).ln()).max(f32::MIN_POSITIVE);
     let flow_f: Vec<f32> = acc.iter().map(|&a| (a as f32).ln() / log_all).collect();
     let to_u8 = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -173,7 +131,7 @@ mod tests {
             (x as f32 - 4.0).abs() * 2.0 + (9 - y) as f32 * 0.1
         })
         .unwrap();
-        let acc = flow_accumulation(&v);
+        let acc = d8_area(&v, Edges::Inside);
         assert_eq!(acc[9 * 9 + 4], 90, "the outlet drains the whole grid");
         assert_eq!(acc[0], 1, "a corner receives nothing");
         let m = compute(&v, true);

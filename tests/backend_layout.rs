@@ -165,9 +165,9 @@ fn parameter_structs_match_their_wgsl_declarations() {
             x1,
             y1,
             parent_width,
+            parent_height,
             has_parent,
-            pad0,
-            pad1
+            pad0
         })
     );
     assert_eq!(

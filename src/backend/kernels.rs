@@ -112,12 +112,12 @@ pub struct CorrectUniform {
     pub y0: u32,
     pub x1: u32,
     pub y1: u32,
-    /// The parent level's width, and whether there is one (the prior's
+    /// The parent level's size, and whether there is one (the prior's
     /// anchor).
     pub parent_width: u32,
+    pub parent_height: u32,
     pub has_parent: u32,
     pub pad0: u32,
-    pub pad1: u32,
 }
 
 /// `GuideCell` of `kernels/correct.wgsl`: one pixel's control inputs of

@@ -8,13 +8,11 @@
 //! never reuses a stale cache. A cache that fails to load is rebuilt; a
 //! cache that cannot be written only costs a rebuild next time.
 
-use super::{BuildOptions, Database, DbError, ExemplarInput, build, file::FORMAT_VERSION};
+pub use super::cache::BUILD_REVISION;
+use super::{BuildOptions, Database, DbError, ExemplarInput, build, cache};
 use crate::io::{self, Format, ReadOptions, TypeMask};
 use crate::progress::Progress;
 use std::path::{Path, PathBuf};
-
-/// Bump when the build algorithm changes its output (PatchMatch, PCA…).
-pub const BUILD_REVISION: u32 = 1;
 
 struct Embedded {
     name: &'static str,
@@ -85,17 +83,12 @@ pub fn build_default(progress: &dyn Progress) -> Result<Database, DbError> {
 
 /// Where the default database is cached in `dir`.
 pub fn cache_path(dir: &Path) -> PathBuf {
-    let mut h = crc32fast::Hasher::new();
-    for e in &EMBEDDED {
-        for part in [e.dem, e.sidecar, e.mask, e.names] {
-            h.update(&(part.len() as u64).to_le_bytes());
-            h.update(part);
-        }
-    }
-    h.update(env!("CARGO_PKG_VERSION").as_bytes());
-    h.update(&FORMAT_VERSION.to_le_bytes());
-    h.update(&BUILD_REVISION.to_le_bytes());
-    dir.join(format!("default-{:08x}.tsdb", h.finalize()))
+    let key = cache::key(
+        EMBEDDED
+            .iter()
+            .flat_map(|e| [e.dem, e.sidecar, e.mask, e.names]),
+    );
+    dir.join(format!("default-{key:08x}.tsdb"))
 }
 
 /// `$TERRASYNTH_CACHE_DIR`, else `$XDG_CACHE_HOME/terrasynth`, else
@@ -116,16 +109,7 @@ pub fn cache_dir() -> PathBuf {
 /// building and caching it if needed. Returns the database and whether it
 /// was just built.
 pub fn load_or_build(dir: &Path, progress: &dyn Progress) -> Result<(Database, bool), DbError> {
-    let path = cache_path(dir);
-    if let Ok(db) = Database::load(&path) {
-        return Ok((db, false));
-    }
-    let db = build_default(progress)?;
-    if std::fs::create_dir_all(dir).is_ok() {
-        // A cache we cannot write only means building again next time.
-        let _ = db.save(&path);
-    }
-    Ok((db, true))
+    cache::load_or_build(&cache_path(dir), || build_default(progress))
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@
 
 pub mod appearance;
 mod build;
+pub mod cache;
 pub mod default;
 pub mod error;
 pub mod file;

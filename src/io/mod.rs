@@ -29,6 +29,7 @@
 
 mod asc;
 mod atomic;
+pub mod coords_map;
 pub mod engine;
 mod error;
 mod exr;
@@ -47,6 +48,7 @@ pub mod type_mask;
 pub mod wkt;
 
 pub use atomic::write_atomic;
+pub use coords_map::CoordsMap;
 pub use error::{FormatError, IoError};
 pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
 pub use ground::GridReport;

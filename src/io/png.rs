@@ -106,6 +106,64 @@ pub(super) fn encode16(
     })
 }
 
+/// Decodes a PNG that must have one colour type and bit depth (the masks
+/// and maps the project writes itself, read back): its raw samples as PNG
+/// stores them (16-bit big-endian), `width × height × bytes per pixel`
+/// bytes. Sizes are checked before the buffer is allocated; anything else
+/// is refused as `what`, naming the `supported` layout.
+pub(super) fn decode_raw(
+    bytes: &[u8],
+    (color, depth): (png::ColorType, png::BitDepth),
+    what: &'static str,
+    supported: &'static str,
+) -> Result<(usize, usize, Vec<u8>), FormatError> {
+    let mut decoder = png::Decoder::new(Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::IDENTITY);
+    let mut reader = decoder
+        .read_info()
+        .map_err(|e| FormatError::Corrupt(format!("not a readable PNG: {e}")))?;
+    let info = reader.info();
+    let (w, h) = (info.width as usize, info.height as usize);
+    if info.color_type != color || info.bit_depth != depth {
+        return Err(FormatError::Unsupported {
+            what,
+            found: format!("{:?} {}-bit", info.color_type, info.bit_depth as u8),
+            supported,
+        });
+    }
+    check_dims(w, h)?;
+    let pixel = color.samples() as u64 * depth as u64 / 8;
+    check_justified(w, h, pixel, bytes.len(), DEFLATE_RATIO)?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| FormatError::Corrupt("PNG output size overflows".into()))?;
+    let mut buf = vec![0u8; size];
+    reader
+        .next_frame(&mut buf)
+        .map_err(|e| FormatError::Corrupt(format!("corrupt PNG data: {e}")))?;
+    buf.truncate(w * h * pixel as usize);
+    Ok((w, h, buf))
+}
+
+/// A PNG of raw samples laid out as [`decode_raw`] returns them.
+pub(super) fn encode_raw(
+    width: usize,
+    height: usize,
+    (color, depth): (png::ColorType, png::BitDepth),
+    raw: &[u8],
+) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
+    enc.set_color(color);
+    enc.set_depth(depth);
+    enc.set_compression(png::Compression::Fast);
+    let mut w = enc.write_header().expect("writing to a Vec cannot fail");
+    w.write_image_data(raw)
+        .expect("the buffer matches the header");
+    drop(w);
+    out
+}
+
 fn png_error(e: png::DecodingError) -> FormatError {
     match e {
         png::DecodingError::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {

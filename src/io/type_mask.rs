@@ -9,8 +9,10 @@
 
 use super::{FormatError, IoError, write_atomic};
 use std::collections::BTreeMap;
-use std::io::Cursor;
 use std::path::Path;
+
+/// The PNG's colour type and depth.
+const LAYOUT: (png::ColorType, png::BitDepth) = (png::ColorType::Grayscale, png::BitDepth::Eight);
 
 /// Index meaning "no type".
 pub const NO_TYPE: u8 = 255;
@@ -92,37 +94,12 @@ impl TypeMask {
 
     /// Decodes the PNG and, if given, the names JSON.
     pub fn decode(png_bytes: &[u8], names_json: Option<&[u8]>) -> Result<TypeMask, FormatError> {
-        let mut decoder = png::Decoder::new(Cursor::new(png_bytes));
-        decoder.set_transformations(png::Transformations::IDENTITY);
-        let mut reader = decoder
-            .read_info()
-            .map_err(|e| FormatError::Corrupt(format!("not a readable PNG: {e}")))?;
-        let info = reader.info();
-        let (w, h) = (info.width as usize, info.height as usize);
-        if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Eight {
-            return Err(FormatError::Unsupported {
-                what: "type mask PNG",
-                found: format!("{:?} {}-bit", info.color_type, info.bit_depth as u8),
-                supported: "8-bit greyscale, one type index per pixel",
-            });
-        }
-        crate::heightfield::check_dims(w, h)?;
-        // Deflate cannot compress better than ~1032:1.
-        if (w as u64) * (h as u64) > png_bytes.len() as u64 * 1032 + 4096 {
-            return Err(FormatError::SizeNotJustified {
-                width: w as u64,
-                height: h as u64,
-                file_len: png_bytes.len() as u64,
-            });
-        }
-        let size = reader
-            .output_buffer_size()
-            .ok_or_else(|| FormatError::Corrupt("PNG output size overflows".into()))?;
-        let mut buf = vec![0u8; size];
-        reader
-            .next_frame(&mut buf)
-            .map_err(|e| FormatError::Corrupt(format!("corrupt PNG data: {e}")))?;
-        buf.truncate(w * h);
+        let (w, h, buf) = super::png::decode_raw(
+            png_bytes,
+            LAYOUT,
+            "type mask PNG",
+            "8-bit greyscale, one type index per pixel",
+        )?;
         let mut mask = TypeMask::new(w, h, buf)?;
         if let Some(json) = names_json {
             mask.names = parse_names(json)?;
@@ -157,15 +134,7 @@ impl TypeMask {
 
     /// The PNG bytes (8-bit greyscale).
     pub fn encode_png(&self) -> Vec<u8> {
-        let mut out = Vec::new();
-        let mut enc = png::Encoder::new(&mut out, self.width as u32, self.height as u32);
-        enc.set_color(png::ColorType::Grayscale);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut w = enc.write_header().expect("writing to a Vec cannot fail");
-        w.write_image_data(&self.indices)
-            .expect("the buffer matches the header");
-        drop(w);
-        out
+        super::png::encode_raw(self.width, self.height, LAYOUT, &self.indices)
     }
 
     /// The names JSON in the shared layout: `dem`, `types`, `present`,

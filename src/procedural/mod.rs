@@ -22,7 +22,7 @@ pub mod creep;
 pub mod error;
 pub mod fbm;
 pub mod fluvial;
-mod grid;
+pub(crate) mod grid;
 pub mod hydraulic;
 pub mod math;
 pub mod noise;

@@ -15,8 +15,11 @@
 //! exemplars' range this way), an optional type-colour overlay, and hatched
 //! grey where there is no data.
 
+pub mod compose;
 pub mod contours;
+pub mod coords;
 mod error;
+pub mod font;
 pub mod overlay;
 pub mod prepare;
 pub mod resample;
@@ -24,7 +27,9 @@ pub mod shade;
 pub mod tint;
 pub mod types;
 
+pub use compose::side_by_side;
 pub use contours::Contours;
+pub use coords::coords_preview;
 pub use error::RenderError;
 pub use overlay::{Canvas, Marker};
 pub use prepare::{Prepared, RenderInfo, prepare};

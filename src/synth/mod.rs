@@ -18,6 +18,7 @@ pub mod coarse;
 pub mod control;
 pub mod fixed;
 pub mod session;
+pub mod source_map;
 pub mod stages;
 pub mod state;
 

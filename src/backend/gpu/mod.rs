@@ -688,6 +688,7 @@ impl Backend for Gpu {
             x1: x1.min(st.width) as u32,
             y1: y1.min(st.height) as u32,
             parent_width: parent.map_or(0, |pa| pa.width as u32),
+            parent_height: parent.map_or(0, |pa| pa.height as u32),
             has_parent: parent.is_some() as u32,
             ..Default::default()
         };

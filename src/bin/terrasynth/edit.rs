@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::scene::{Scene, SceneEdits, overlay};
 use terrasynth::synth::session::Session;
+use terrasynth::synth::source_map::source_map;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -42,13 +43,14 @@ pub fn synth_scene(
     overlay: bool,
     backend: BackendArg,
     engine: Option<EngineArg>,
+    coords: (Option<&Path>, Option<&Path>),
 ) -> CliResult {
     let scene_path = scene;
     let scene = Scene::read(scene_path)?;
     let mut inputs = vec![scene_path];
     inputs.extend(scene.database.as_deref());
     // The output's sidecar (X.json) must never replace the scene (X.json).
-    crate::synth::check_outputs(&[Some(output), preview], &inputs)?;
+    crate::synth::check_outputs(&[Some(output), preview, coords.0, coords.1], &inputs)?;
     // An editing session keeps every pass of every level (about three
     // times the state of one synthesis).
     crate::synth::check_synthesis_memory(scene.width, scene.height, 3.0)?;
@@ -83,6 +85,17 @@ pub fn synth_scene(
         let img = overlay::preview(&frame.heightfield, &scene, &edits, db.type_names(), overlay)?;
         terrasynth::render::write_png(p, &img)?;
         eprintln!("wrote {}", p.display());
+    }
+    if coords.0.is_some() || coords.1.is_some() {
+        // The last pass of level 0 is what reconstruction read.
+        let l0 = session
+            .frames()
+            .and_then(|f| f.levels.first())
+            .and_then(|l| l.last())
+            .ok_or("no level-0 coordinates: the scene runs 0 correction passes")?;
+        let stride = terrasynth::synth::state::level_size(scene.width, scene.height, 0).0;
+        let map = source_map(&l0.coords, stride, scene.width, scene.height, &db);
+        crate::synth::write_coords(&map, &db, coords)?;
     }
     Ok(())
 }

@@ -5,6 +5,7 @@ mod bench;
 mod convert;
 mod db;
 mod edit;
+mod eval;
 mod generate;
 mod info;
 mod masks;
@@ -13,6 +14,7 @@ mod render;
 #[cfg(feature = "serve")]
 mod serve;
 mod sketch;
+mod suite;
 mod synth;
 
 use clap::{Parser, Subcommand};
@@ -57,6 +59,10 @@ enum Command {
     /// paint and drag constraints and see the terrain change.
     #[cfg(feature = "serve")]
     Serve(serve::Args),
+    /// Measure how real a synthesis is against a real DEM (descriptor
+    /// distances, realism ratio, type usage), or run the realism protocol
+    /// over a folder of DEMs (--suite).
+    Eval(eval::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -77,6 +83,7 @@ fn main() -> ExitCode {
         Command::Sketch(a) => sketch::run(a),
         #[cfg(feature = "serve")]
         Command::Serve(a) => serve::run(a),
+        Command::Eval(a) => eval::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,8 +3,10 @@
 use crate::CliResult;
 use crate::args::{BackendArg, EngineArg, load_database, parse_size, select_backend, write_output};
 use std::path::{Path, PathBuf};
-use terrasynth::io;
+use terrasynth::database::Database;
+use terrasynth::io::{self, CoordsMap};
 use terrasynth::render::{self, RenderOptions};
+use terrasynth::synth::source_map::source_map;
 use terrasynth::synth::{Params, Synthesizer};
 
 #[derive(clap::Args)]
@@ -24,10 +26,15 @@ pub struct Args {
     /// Also write a shaded-relief preview PNG.
     #[arg(long)]
     preview: Option<PathBuf>,
-    /// Also write the finest level's exemplar coordinates as a PNG
-    /// (red = x, green = y within the exemplar, blue = which exemplar; paper Fig. 3).
+    /// Also write where every output pixel was drawn from, exactly: a 16-bit
+    /// RGB PNG, R = x and G = y of the source texel within its exemplar,
+    /// B = the exemplar's index (`db info` order). `eval --coords` reads it.
     #[arg(long)]
     coords: Option<PathBuf>,
+    /// Also write a picture of the coordinates for a person (8-bit: red = x,
+    /// green = y within the exemplar, blue = which exemplar; paper Fig. 3).
+    #[arg(long)]
+    coords_preview: Option<PathBuf>,
     /// Jitter amplitude r in texels (paper default 0.4; 0 reproduces the exemplar).
     #[arg(long, default_value_t = 0.4)]
     jitter: f64,
@@ -51,7 +58,7 @@ pub struct Args {
     /// A scene file (see data/scenes/): its database, size, seed and
     /// controls replace --db, --size, --seed, --jitter, --passes and
     /// --start-exemplar; the preview shows the controls.
-    #[arg(long, conflicts_with_all = ["db", "coords"])]
+    #[arg(long, conflicts_with = "db")]
     scene: Option<PathBuf>,
     /// With --scene: a preview without the controls drawn on it.
     #[arg(long, requires = "scene")]
@@ -101,11 +108,17 @@ pub fn run(a: Args) -> CliResult {
             !a.no_overlay,
             a.backend,
             a.engine,
+            (a.coords.as_deref(), a.coords_preview.as_deref()),
         );
     }
     let inputs: Vec<&Path> = a.db.as_deref().into_iter().collect();
     check_outputs(
-        &[Some(&a.output), a.preview.as_deref(), a.coords.as_deref()],
+        &[
+            Some(&a.output),
+            a.preview.as_deref(),
+            a.coords.as_deref(),
+            a.coords_preview.as_deref(),
+        ],
         &inputs,
     )?;
     let (w, h) = a.size;
@@ -116,7 +129,7 @@ pub fn run(a: Args) -> CliResult {
         passes: a.passes,
         start_exemplar: a.start_exemplar,
         prior: a.height_prior,
-        keep_levels: a.coords.is_some(),
+        keep_levels: a.coords.is_some() || a.coords_preview.is_some(),
     };
     let mut synth = Synthesizer::new(&db, params)?;
     select_backend(&mut synth, a.backend)?;
@@ -136,36 +149,32 @@ pub fn run(a: Args) -> CliResult {
         render::write_png(p, &preview.image)?;
         eprintln!("wrote {}", p.display());
     }
-    if let Some(p) = &a.coords {
-        let l0 = &result.levels[0];
-        let level = db.level(0);
-        let mut img = image::RgbaImage::new(w as u32, h as u32);
-        for y in 0..h {
-            for x in 0..w {
-                let c = l0.coords[y * l0.width + x];
-                let (tx, ty) = (
-                    c.x >> terrasynth::synth::fixed::FRAC_BITS,
-                    c.y >> terrasynth::synth::fixed::FRAC_BITS,
-                );
-                let e = level
-                    .layout
-                    .exemplar_at(level.columns, tx as u32, ty as u32)
-                    .unwrap_or(0);
-                let r = level.layout.rects[e];
-                let n = level.layout.rects.len().max(2) - 1;
-                img.put_pixel(
-                    x as u32,
-                    y as u32,
-                    image::Rgba([
-                        ((tx as u32 - r.x0) * 255 / r.width.max(1)) as u8,
-                        (ty as u32 * 255 / r.height.max(1)) as u8,
-                        (e * 255 / n) as u8,
-                        255,
-                    ]),
-                );
-            }
-        }
-        render::write_png(p, &img)?;
+    if let Some(l0) = result.levels.first() {
+        let paths = (a.coords.as_deref(), a.coords_preview.as_deref());
+        write_coords(&source_map(&l0.coords, l0.width, w, h, &db), &db, paths)?;
+    }
+    Ok(())
+}
+
+/// Writes where every pixel of a synthesis was drawn from: the exact map
+/// and/or its picture.
+pub fn write_coords(
+    map: &CoordsMap,
+    db: &Database,
+    (exact, picture): (Option<&Path>, Option<&Path>),
+) -> CliResult {
+    if let Some(p) = exact {
+        map.write(p)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = picture {
+        let sizes: Vec<(u32, u32)> = db
+            .meta()
+            .exemplars
+            .iter()
+            .map(|e| (e.width, e.height))
+            .collect();
+        render::write_png(p, &render::coords_preview(map, &sizes))?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

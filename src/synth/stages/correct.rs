@@ -13,8 +13,8 @@
 //!
 //! Beyond the paper, a **height prior** (weight P, [`CorrectParams::prior`])
 //! adds `P·(3(h − V_parent))²` to every score, where `V_parent` is the
-//! offset the pixel's parent at the level above chose (what eq. 2 copied
-//! into the pixel before this level's passes). The paper's h is free — a
+//! offset the level above chose around the pixel, interpolated to it
+//! ([`parent_v`]). The paper's h is free — a
 //! candidate from any altitude matches at the mean height of its
 //! neighbourhood — so heights are fitted relative to the neighbours only,
 //! and every join between patches pulls both sides towards their mean,
@@ -77,6 +77,32 @@ pub const PRIORS: [u32; 5] = [0, 1, 2, 4, 8];
 /// shared DEMs: relief 75–95 % of the exemplar's instead of 55–70 %).
 pub const DEFAULT_PRIOR: u32 = 4;
 
+/// The parent's offset at child pixel (x, y), interpolated bilinearly
+/// (weights 9, 3, 3, 1 of 16 from the parent under it and the three nearest
+/// it, clamped at the level's edges; rounded to nearest, ties up).
+///
+/// Why not the parent under the pixel: V is piecewise constant per parent,
+/// so in flat regions — where every candidate fits and the prior alone sets
+/// h — a nearest-parent anchor carries the coarse level's steps down to
+/// level 0 as faint squares (seen in the sea of the shared DEMs).
+#[inline(always)]
+pub fn parent_v(pa: &State, x: usize, y: usize) -> i32 {
+    let (px, py) = (x / 2, y / 2);
+    let near = |c: usize, odd: bool, n: usize| {
+        if odd {
+            (c + 1).min(n - 1)
+        } else {
+            c.saturating_sub(1)
+        }
+    };
+    let (qx, qy) = (
+        near(px, x % 2 == 1, pa.width),
+        near(py, y % 2 == 1, pa.height),
+    );
+    let v = |x: usize, y: usize| pa.v(y * pa.width + x);
+    (9 * v(px, py) + 3 * v(qx, py) + 3 * v(px, qy) + v(qx, qy) + 8) >> 4
+}
+
 /// One pixel's height prior: its weight P and the parent's offset V it
 /// pulls the optimal h towards (see the module docs).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -90,7 +116,7 @@ impl Prior {
     /// the coarsest corrected level, whose start has V = 0).
     #[inline(always)]
     pub fn at(weight: u32, parent: Option<&State>, x: usize, y: usize) -> Prior {
-        let v = parent.map_or(0, |pa| pa.v((y / 2) * pa.width + x / 2));
+        let v = parent.map_or(0, |pa| parent_v(pa, x, y));
         Prior { weight, v }
     }
 
