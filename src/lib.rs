@@ -26,6 +26,8 @@ pub mod progress;
 pub mod render;
 pub mod resample;
 pub mod scene;
+#[cfg(feature = "serve")]
+pub mod server;
 pub mod synth;
 
 pub use error::{Error, Result, SizeError};

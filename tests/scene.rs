@@ -42,7 +42,7 @@ fn a_valid_scene_parses_to_what_it_says() {
     assert_eq!(s.curves[1].spec.widgets[1].slope_deg, [-30.0, -20.0]);
     assert_eq!(s.curves[1].spec.widgets[1].reach_px, [8.0, 9.0]);
     assert_eq!(s.junctions[0].height_m, 450.0);
-    assert!(matches!(&s.types, Some(TypePaint::Strokes(v)) if v[0].0 == "hills"));
+    assert!(matches!(&s.types, Some(TypePaint::Strokes(v)) if v[0].0.as_deref() == Some("hills")));
     assert!(matches!(&s.freeze, Some(Freeze::Strokes(v)) if v.len() == 1));
     assert_eq!(s.pastes[0].source, PasteSource::Exemplar(1));
     assert_eq!(s.pastes[0].delta_m, -50.0);
@@ -318,4 +318,81 @@ fn fuzz_corpus_and_example_scenes_replay_cleanly() {
         }
     }
     assert!(n >= 10 && valid >= 3, "{n} inputs, {valid} valid");
+}
+
+#[test]
+fn eraser_strokes_paint_back_to_unconstrained_and_thaw() {
+    let names: Vec<String> = ["sea", "flat", "hills"].map(String::from).to_vec();
+    let mut v = base();
+    v["types"]["strokes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"erase": true, "points": [[25, 10]], "radius_px": 3}));
+    v["freeze"]["strokes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"erase": true, "points": [[100, 80]], "radius_px": 2}));
+    let s = parse(&v).unwrap();
+    assert!(matches!(&s.types, Some(TypePaint::Strokes(t)) if t[1].0.is_none()));
+    let r = s.type_raster(&names).unwrap().unwrap();
+    assert_eq!(r[10 * 128 + 25], 255, "erased");
+    assert_eq!(r[10 * 128 + 35], 2, "still painted beside the eraser");
+    let f = s.freeze_raster().unwrap().unwrap();
+    assert!(!f[80 * 128 + 100], "thawed");
+    assert!(f[80 * 128 + 104], "still frozen beside the eraser");
+    // An eraser has no type, and `erase` is a boolean.
+    v["types"]["strokes"][1]["type"] = json!("hills");
+    assert_eq!(parse(&v).unwrap_err().path, "types.strokes[1].type");
+    let mut v = base();
+    v["freeze"]["strokes"][0]["erase"] = json!("yes");
+    assert_eq!(parse(&v).unwrap_err().path, "freeze.strokes[0].erase");
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+
+    /// The stroke painter (segment capsules, rows in parallel) paints what
+    /// the definition says: a pixel takes the last stroke that comes within
+    /// its radius of the pixel's centre.
+    #[test]
+    fn stroke_rasters_follow_the_definition(
+        strokes in proptest::collection::vec(
+            (proptest::collection::vec((-10.0f64..70.0, -10.0f64..50.0), 1..6), 0.5f64..9.0, proptest::bool::ANY),
+            1..6,
+        )
+    ) {
+        let (w, h) = (61usize, 43usize);
+        let list: Vec<Value> = strokes
+            .iter()
+            .map(|(pts, r, erase)| {
+                let pts: Vec<[f64; 2]> = pts.iter().map(|&(x, y)| [x.clamp(0.0, w as f64), y.clamp(0.0, h as f64)]).collect();
+                json!({"erase": erase, "points": pts, "radius_px": r})
+            })
+            .collect();
+        let v = json!({"size": [w, h], "seed": 1, "freeze": {"strokes": list}});
+        let s = parse(&v).unwrap();
+        let got = s.freeze_raster().unwrap().unwrap();
+        let Some(Freeze::Strokes(parsed)) = &s.freeze else { panic!() };
+        for y in 0..h {
+            for x in 0..w {
+                let p = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                let mut want = false;
+                for (frozen, st) in parsed {
+                    let d = if st.points.len() == 1 {
+                        p.distance(st.points[0])
+                    } else {
+                        st.points.windows(2).map(|s| {
+                            let d = s[1] - s[0];
+                            let t = if d.length_squared() > 0.0 { ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
+                            p.distance(s[0] + d * t)
+                        }).fold(f64::INFINITY, f64::min)
+                    };
+                    if d <= st.radius_px {
+                        want = *frozen;
+                    }
+                }
+                proptest::prop_assert_eq!(got[y * w + x], want, "pixel ({}, {})", x, y);
+            }
+        }
+    }
 }

@@ -1,10 +1,12 @@
 //! Fuzzes the scene-file parser, then builds the curves of small scenes
-//! (junction search, distance fields and envelopes on hostile geometry).
+//! (junction search, distance fields and envelopes on hostile geometry)
+//! and paints their type and freeze strokes (never their image forms,
+//! which would read files).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use terrasynth::scene::Scene;
+use terrasynth::scene::{Freeze, Scene, TypePaint};
 use terrasynth::synth::control::curve::{FieldCache, build};
 
 fuzz_target!(|data: &[u8]| {
@@ -19,5 +21,11 @@ fuzz_target!(|data: &[u8]| {
             .all(|c| c.spec.widgets.iter().all(|w| w.reach_px[0] <= 64.0 && w.reach_px[1] <= 64.0));
     if small {
         let _ = build(&scene.curve_specs(), &scene.junctions, 10.0, &FieldCache::new());
+        if matches!(scene.types, Some(TypePaint::Strokes(_))) {
+            let _ = scene.type_raster(&["ridge".into(), "slope".into()]);
+        }
+        if matches!(scene.freeze, Some(Freeze::Strokes(_))) {
+            let _ = scene.freeze_raster();
+        }
     }
 });

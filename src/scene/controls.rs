@@ -35,6 +35,17 @@ struct Applied {
     types: Option<Vec<u8>>,
     freeze: Option<Vec<bool>>,
     pastes: Vec<PasteSpec>,
+    /// The stroke forms the rasters came from: an editor sends a scene per
+    /// mouse move, and repainting every stroke of a large terrain each time
+    /// would cost more than the edit. (Image forms are always read again:
+    /// the file may have changed.)
+    type_strokes: Option<TypePaint>,
+    freeze_strokes: Option<Freeze>,
+}
+
+/// A stroke form (not an image), which fully determines its raster.
+fn strokes<T: Clone>(v: &Option<T>, is_strokes: impl Fn(&T) -> bool) -> Option<T> {
+    v.as_ref().filter(|t| is_strokes(t)).cloned()
 }
 
 /// Turns a sequence of scenes into session edits.
@@ -46,7 +57,17 @@ pub struct SceneEdits {
     applied: Applied,
     curves: Vec<(String, Arc<Curve>)>,
     junctions: Vec<Junction>,
+    /// The last curves built and what they were built from.
+    built: Option<BuiltCurves>,
 }
+
+/// Curve specs and junction heights, and the curves and junctions built
+/// from them.
+type BuiltCurves = (
+    (Vec<CurveSpec>, Vec<JunctionHeight>),
+    Vec<Arc<Curve>>,
+    Vec<Junction>,
+);
 
 impl SceneEdits {
     pub fn new() -> SceneEdits {
@@ -66,6 +87,12 @@ impl SceneEdits {
     /// The curves of the last scene (with their ids), for overlays.
     pub fn curves(&self) -> &[(String, Arc<Curve>)] {
         &self.curves
+    }
+
+    /// The painted type raster of the last scene (database indices, 255 =
+    /// unconstrained), if it paints any.
+    pub fn type_raster(&self) -> Option<&[u8]> {
+        self.applied.types.as_deref()
     }
 
     /// The junctions of the last scene.
@@ -147,24 +174,29 @@ impl SceneEdits {
             edits.push(Edit::SetConstraint(id, Arc::new(c)));
         }
 
-        // Curves, built together for their junctions.
-        let (built, junctions) =
-            curve::build(&scene.curve_specs(), &scene.junctions, cell, &self.cache).map_err(
-                |e| {
-                    let path = match &e {
-                        curve::CurveError::TooFewPoints { curve, .. }
-                        | curve::CurveError::ZeroLength { curve }
-                        | curve::CurveError::NoWidget { curve }
-                        | curve::CurveError::Value { curve, .. }
-                        | curve::CurveError::TooLarge { curve, .. }
-                        | curve::CurveError::TooLong { curve, .. } => format!("curves[{curve}]"),
-                        _ => "junctions".to_string(),
-                    };
-                    err(&path, e.into())
-                },
-            )?;
+        // Curves, built together for their junctions (again only when a
+        // curve or junction changed: building smooths every envelope).
+        let input = (scene.curve_specs(), scene.junctions.clone());
+        let (built, junctions) = if self.built.as_ref().is_some_and(|b| b.0 == input) {
+            let b = self.built.as_ref().expect("checked");
+            (b.1.clone(), b.2.clone())
+        } else {
+            let (c, j) = curve::build(&input.0, &input.1, cell, &self.cache).map_err(|e| {
+                let path = match &e {
+                    curve::CurveError::TooFewPoints { curve, .. }
+                    | curve::CurveError::ZeroLength { curve }
+                    | curve::CurveError::NoWidget { curve }
+                    | curve::CurveError::Value { curve, .. }
+                    | curve::CurveError::TooLarge { curve, .. }
+                    | curve::CurveError::TooLong { curve, .. } => format!("curves[{curve}]"),
+                    _ => "junctions".to_string(),
+                };
+                err(&path, e.into())
+            })?;
+            (c.into_iter().map(Arc::new).collect::<Vec<_>>(), j)
+        };
         let mut curves = Vec::with_capacity(built.len());
-        for (k, (item, c)) in scene.curves.iter().zip(built).enumerate() {
+        for (k, (item, c)) in scene.curves.iter().zip(built.iter().cloned()).enumerate() {
             let key = CurveKey {
                 spec: item.spec.clone(),
                 junctions: junctions
@@ -173,7 +205,6 @@ impl SceneEdits {
                     .map(|j| (j.at, j.height_m))
                     .collect(),
             };
-            let c = Arc::new(c);
             if self.applied.curves.get(&item.id) != Some(&key) {
                 let id = self.id(&item.id);
                 edits.push(Edit::SetConstraint(id, c.clone() as Arc<dyn Constraint>));
@@ -197,11 +228,21 @@ impl SceneEdits {
         edits.extend(removals.into_iter().map(Edit::RemoveConstraint));
 
         // Type paint and freezing.
-        next.types = scene.type_raster(db.type_names())?;
+        next.type_strokes = strokes(&scene.types, |t| matches!(t, TypePaint::Strokes(_)));
+        next.types = match &next.type_strokes {
+            Some(t) if self.applied.type_strokes.as_ref() == Some(t) => self.applied.types.clone(),
+            _ => scene.type_raster(db.type_names())?,
+        };
         if next.types != self.applied.types {
             edits.push(Edit::PaintTypes(next.types.clone()));
         }
-        next.freeze = scene.freeze_raster()?;
+        next.freeze_strokes = strokes(&scene.freeze, |f| matches!(f, Freeze::Strokes(_)));
+        next.freeze = match &next.freeze_strokes {
+            Some(f) if self.applied.freeze_strokes.as_ref() == Some(f) => {
+                self.applied.freeze.clone()
+            }
+            _ => scene.freeze_raster()?,
+        };
         if next.freeze != self.applied.freeze {
             edits.push(Edit::Freeze(next.freeze.clone()));
         }
@@ -232,7 +273,8 @@ impl SceneEdits {
         self.first.get_or_insert_with(|| scene.clone());
         self.applied = next;
         self.curves = curves;
-        self.junctions = junctions;
+        self.junctions = junctions.clone();
+        self.built = Some((input, built, junctions));
         Ok(edits)
     }
 

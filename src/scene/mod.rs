@@ -41,8 +41,9 @@
 //!   "junctions": [{ "at": [412, 518], "height_m": 700 }],  // optional: set the height of the automatic junction within 4 px
 //!   "types": { "image": "types.png" },  // optional: an 8-bit index image of the scene's size, names in types.json beside it (the `*_types.png/json` layout); 255 = unconstrained
 //!   "types": { "strokes": [{ "type": "mountains", "points": [[100, 100], [300, 120]], "radius_px": 40 }] },  // or: painted strokes with database type names; later strokes paint over earlier ones
+//!   "types": { "strokes": [{ "erase": true, "points": [[120, 110]], "radius_px": 10 }] },  // a stroke may erase instead (back to unconstrained; no "type" then)
 //!   "freeze": { "mask": "freeze.png" },  // optional: an 8-bit image of the scene's size, non-zero = frozen
-//!   "freeze": { "strokes": [{ "points": [[50, 50]], "radius_px": 30 }] },  // or: strokes
+//!   "freeze": { "strokes": [{ "points": [[50, 50]], "radius_px": 30 }] },  // or: strokes ("erase": true unfreezes)
 //!   "pastes": [{
 //!     "id": "dome",                     // optional, unique; default "pastes[i]"
 //!     "source": "exemplar",             // "terrain" (the synthesized result) or "exemplar"
@@ -134,8 +135,10 @@ pub struct Stroke {
 pub enum TypePaint {
     /// An index image (resolved path) with names beside it.
     Image(PathBuf),
-    /// Strokes with type names, painted in order.
-    Strokes(Vec<(String, Stroke)>),
+    /// Strokes with type names, painted in order; `None` is an eraser
+    /// (paints "unconstrained"), so an editor's brush and eraser both stay
+    /// a list of strokes that later ones paint over.
+    Strokes(Vec<(Option<String>, Stroke)>),
 }
 
 /// Frozen regions.
@@ -143,7 +146,8 @@ pub enum TypePaint {
 pub enum Freeze {
     /// A mask image (resolved path); non-zero = frozen.
     Mask(PathBuf),
-    Strokes(Vec<Stroke>),
+    /// Strokes painted in order: `true` freezes, `false` (an eraser) thaws.
+    Strokes(Vec<(bool, Stroke)>),
 }
 
 /// Where a paste copies from.

@@ -202,6 +202,15 @@ impl Reader<'_> {
         })
     }
 
+    /// A stroke's optional `"erase"` flag (default false).
+    fn erase(&self, m: &Map<String, Value>, path: &str) -> R<bool> {
+        match m.get("erase") {
+            None => Ok(false),
+            Some(Value::Bool(b)) => Ok(*b),
+            Some(v) => Err(self.invalid(&join(path, "erase"), v, "true or false")),
+        }
+    }
+
     fn stroke(&self, m: &Map<String, Value>, path: &str, size: (f64, f64)) -> R<Stroke> {
         let pts = self.array(
             self.required(m, path, "points", "an array of [x, y] points")?,
@@ -507,13 +516,25 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
                         .enumerate()
                     {
                         let path = format!("types.strokes[{i}]");
-                        let o = r.object(st, &path, &["type", "points", "radius_px"])?;
-                        let name = r.string(
-                            r.required(o, &path, "type", "a type name of the database")?,
-                            &join(&path, "type"),
-                            "a type name",
-                        )?;
-                        out.push((name.to_string(), r.stroke(o, &path, (fw, fh))?));
+                        let o = r.object(st, &path, &["type", "erase", "points", "radius_px"])?;
+                        let name = if r.erase(o, &path)? {
+                            if let Some(t) = o.get("type") {
+                                return Err(r.invalid(
+                                    &join(&path, "type"),
+                                    t,
+                                    "no type on an eraser stroke (\"erase\": true)",
+                                ));
+                            }
+                            None
+                        } else {
+                            let name = r.string(
+                                r.required(o, &path, "type", "a type name of the database")?,
+                                &join(&path, "type"),
+                                "a type name",
+                            )?;
+                            Some(name.to_string())
+                        };
+                        out.push((name, r.stroke(o, &path, (fw, fh))?));
                     }
                     TypePaint::Strokes(out)
                 }
@@ -542,8 +563,8 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
                         .enumerate()
                     {
                         let path = format!("freeze.strokes[{i}]");
-                        let o = r.object(st, &path, &["points", "radius_px"])?;
-                        out.push(r.stroke(o, &path, (fw, fh))?);
+                        let o = r.object(st, &path, &["erase", "points", "radius_px"])?;
+                        out.push((!r.erase(o, &path)?, r.stroke(o, &path, (fw, fh))?));
                     }
                     Freeze::Strokes(out)
                 }

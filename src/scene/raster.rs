@@ -12,51 +12,63 @@ pub fn stroke_mask(width: usize, height: usize, strokes: &[&Stroke]) -> Vec<bool
     mask
 }
 
-/// Paints `value` of each stroke, in order, onto `out` (rows in parallel).
+/// Paints `value` of each stroke, in order, onto `out` (rows in parallel):
+/// a pixel takes the value of the last stroke whose polyline comes within
+/// its radius of the pixel's centre. Each row visits only the segments
+/// whose capsule (bounding box grown by the radius) crosses it, and only
+/// the columns of that box, so an editor that repaints every stroke of a
+/// scene on every edit pays for the strokes' area, not the image's.
 fn paint<'a, T: Copy + Send + Sync>(
     width: usize,
     strokes: impl Iterator<Item = (&'a Stroke, T)>,
     out: &mut [T],
 ) {
-    let strokes: Vec<(&Stroke, T)> = strokes.collect();
+    // Per segment (a one-point stroke is one degenerate segment): its ends,
+    // the stroke's radius and value, and its capsule's bounds.
+    struct Seg<T> {
+        a: DVec2,
+        b: DVec2,
+        r: f64,
+        value: T,
+        lo: DVec2,
+        hi: DVec2,
+    }
+    let segs: Vec<Seg<T>> = strokes
+        .flat_map(|(s, value)| {
+            let pairs: Vec<(DVec2, DVec2)> = if s.points.len() == 1 {
+                vec![(s.points[0], s.points[0])]
+            } else {
+                s.points.windows(2).map(|w| (w[0], w[1])).collect()
+            };
+            let r = s.radius_px;
+            pairs.into_iter().map(move |(a, b)| Seg {
+                a,
+                b,
+                r,
+                value,
+                lo: a.min(b) - DVec2::splat(r),
+                hi: a.max(b) + DVec2::splat(r),
+            })
+        })
+        .collect();
     out.par_chunks_mut(width).enumerate().for_each(|(j, row)| {
         let y = j as f64 + 0.5;
-        for (s, value) in &strokes {
-            let (lo, hi) = s
-                .points
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-                    (a.min(p.y), b.max(p.y))
-                });
-            if y < lo - s.radius_px || y > hi + s.radius_px {
-                continue;
-            }
-            for (i, slot) in row.iter_mut().enumerate() {
-                let p = DVec2::new(i as f64 + 0.5, y);
-                if distance_to_polyline(p, &s.points) <= s.radius_px {
-                    *slot = *value;
+        for s in segs.iter().filter(|s| y >= s.lo.y && y <= s.hi.y) {
+            // Pixel centres i + 0.5 in [lo.x, hi.x].
+            let x0 = (s.lo.x - 0.5).ceil().max(0.0) as usize;
+            let x1 = ((s.hi.x - 0.5).floor() + 1.0).clamp(0.0, width as f64) as usize;
+            for (i, slot) in row.iter_mut().enumerate().take(x1).skip(x0) {
+                if segment_distance(DVec2::new(i as f64 + 0.5, y), s.a, s.b) <= s.r {
+                    *slot = s.value;
                 }
             }
         }
     });
 }
 
-fn distance_to_polyline(p: DVec2, pts: &[DVec2]) -> f64 {
-    if pts.len() == 1 {
-        return p.distance(pts[0]);
-    }
-    pts.windows(2)
-        .map(|w| {
-            let d = w[1] - w[0];
-            let len2 = d.length_squared();
-            let u = if len2 > 0.0 {
-                ((p - w[0]).dot(d) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            p.distance(w[0] + d * u)
-        })
-        .fold(f64::INFINITY, f64::min)
+/// Distance from `p` to the segment `a`–`b` (a point when they coincide).
+fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    p.distance(a + (b - a) * crate::synth::control::curve::segments::closest_param(p, a, b))
 }
 
 impl Scene {
@@ -92,7 +104,11 @@ impl Scene {
             Some(TypePaint::Strokes(strokes)) => {
                 let mut values = Vec::with_capacity(strokes.len());
                 for (i, (name, s)) in strokes.iter().enumerate() {
-                    values.push((s, index_of(name, format!("types.strokes[{i}].type"))?));
+                    let value = match name {
+                        Some(name) => index_of(name, format!("types.strokes[{i}].type"))?,
+                        None => NO_TYPE,
+                    };
+                    values.push((s, value));
                 }
                 let mut out = vec![NO_TYPE; w * h];
                 paint(w, values.into_iter(), &mut out);
@@ -117,11 +133,11 @@ impl Scene {
     pub fn freeze_raster(&self) -> Result<Option<Vec<bool>>, SceneError> {
         match &self.freeze {
             None => Ok(None),
-            Some(Freeze::Strokes(s)) => Ok(Some(stroke_mask(
-                self.width,
-                self.height,
-                &s.iter().collect::<Vec<_>>(),
-            ))),
+            Some(Freeze::Strokes(s)) => {
+                let mut out = vec![false; self.width * self.height];
+                paint(self.width, s.iter().map(|(v, s)| (s, *v)), &mut out);
+                Ok(Some(out))
+            }
             Some(Freeze::Mask(path)) => {
                 // An 8-bit greyscale PNG, like a type mask; any value ≠ 0 freezes.
                 let mask = TypeMask::read(path).map_err(|e| self.err("freeze.mask", e.into()))?;

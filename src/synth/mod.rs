@@ -180,7 +180,7 @@ pub struct PassResult {
 }
 
 /// The union of two optional bounds.
-fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
+pub(crate) fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
     match (a, b) {
         (Some(a), Some(b)) => Some([
             a[0].min(b[0]),

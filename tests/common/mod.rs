@@ -1,9 +1,15 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+#[cfg(feature = "serve")]
+pub mod browser;
 pub mod dem;
+#[cfg(feature = "serve")]
+pub mod editor;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+#[cfg(feature = "serve")]
+pub mod http;
 
 use terrasynth::io::Format;
 use terrasynth::{Georef, Heightfield};

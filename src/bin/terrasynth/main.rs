@@ -11,6 +11,8 @@ mod info;
 mod masks;
 mod progress;
 mod render;
+#[cfg(feature = "serve")]
+mod serve;
 mod sketch;
 mod suite;
 mod synth;
@@ -53,6 +55,10 @@ enum Command {
     Generate(generate::Args),
     /// Turn a ridge/valley sketch into terrain made of real DEM patches.
     Sketch(sketch::Args),
+    /// The interactive editor: a web page on this machine where you sketch,
+    /// paint and drag constraints and see the terrain change.
+    #[cfg(feature = "serve")]
+    Serve(serve::Args),
     /// Measure how real a synthesis is against a real DEM (descriptor
     /// distances, realism ratio, type usage), or run the realism protocol
     /// over a folder of DEMs (--suite).
@@ -75,6 +81,8 @@ fn main() -> ExitCode {
         Command::Edit(a) => edit::run(a),
         Command::Generate(a) => generate::run(a),
         Command::Sketch(a) => sketch::run(a),
+        #[cfg(feature = "serve")]
+        Command::Serve(a) => serve::run(a),
         Command::Eval(a) => eval::run(a),
     };
     match result {

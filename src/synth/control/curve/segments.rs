@@ -23,6 +23,19 @@ pub struct Hit {
     pub dist: f64,
 }
 
+/// The parameter (0..=1) of the point of segment `a`–`b` closest to `p`;
+/// 0 when the segment is a single point.
+#[inline]
+pub fn closest_param(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let d = b - a;
+    let len2 = d.length_squared();
+    if len2 > 0.0 {
+        ((p - a).dot(d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
 /// Segments bucketed on a grid.
 #[derive(Debug, Clone)]
 pub struct Segments {
@@ -115,17 +128,11 @@ impl Segments {
     #[inline]
     pub fn project(&self, k: u32, p: DVec2) -> Hit {
         let (a, b) = (self.a[k as usize], self.b[k as usize]);
-        let d = b - a;
-        let len2 = d.length_squared();
-        let u = if len2 > 0.0 {
-            ((p - a).dot(d) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
+        let u = closest_param(p, a, b);
         Hit {
             seg: k,
             u,
-            dist: p.distance(a + d * u),
+            dist: p.distance(a + (b - a) * u),
         }
     }
 

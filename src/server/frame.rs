@@ -1,0 +1,340 @@
+//! The state an editor thread owns: the [`Session`], the scene and
+//! document as last applied, the undo history, the preview it patches, and
+//! how to turn a task into a frame (edits of the session, or a new session
+//! when a document cannot be an edit of it).
+
+use super::doc::{Policy, rebuild_reason};
+use super::editor::{Reply, Task};
+use super::error::ApiError;
+use super::history::History;
+use super::view::{Style, View, encode_rect, overlay};
+use crate::database::Database;
+use crate::heightfield::Heightfield;
+use crate::scene::{Scene, SceneEdits};
+use crate::synth::session::{Frame, Session};
+use crate::synth::union;
+use image::RgbaImage;
+use serde_json::{Value, json};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Milliseconds with 0.01 resolution.
+fn ms(d: Duration) -> f64 {
+    (d.as_secs_f64() * 1e5).round() / 100.0
+}
+
+/// Where the time of one frame went.
+#[derive(Debug, Default, Clone, Copy)]
+struct Timing {
+    edits: Duration,
+    synth: Duration,
+    render: Duration,
+}
+
+/// The session and everything around it, owned by the thread.
+pub struct Editor {
+    db: &'static Database,
+    policy: Arc<Policy>,
+    style: Arc<Style>,
+    session: Session<'static>,
+    edits: SceneEdits,
+    scene: Scene,
+    doc: Value,
+    pub history: History,
+    view: View,
+    pub revision: u64,
+    pub heightfield: Arc<Heightfield>,
+    /// The preview, kept to patch: a frame re-renders only where it changed.
+    pub image: RgbaImage,
+    /// The painted type raster the preview shows.
+    types: Option<Vec<u8>>,
+    /// This frame's changed part of the preview: its rectangle and PNG.
+    pub tile: Option<([usize; 4], Arc<Vec<u8>>)>,
+    /// The last frame's change and timing, and why it rebuilt (if it did).
+    changed: Option<(usize, Option<[usize; 4]>)>,
+    timing: Timing,
+    rebuilt: Option<&'static str>,
+    /// A failed `Session::apply` after `SceneEdits` moved on: the next
+    /// document starts a new session.
+    stale: bool,
+}
+
+impl Editor {
+    pub fn new(
+        db: &'static Database,
+        policy: Arc<Policy>,
+        style: Arc<Style>,
+        doc: Value,
+        scene: Scene,
+    ) -> Result<Editor, ApiError> {
+        let (session, edits, frame, timing) = start(db, &scene)?;
+        let mut ed = Editor {
+            db,
+            policy,
+            style,
+            session,
+            edits,
+            history: History::new(doc.clone()),
+            doc,
+            scene,
+            view: View::default(),
+            revision: 0,
+            heightfield: Arc::new(frame.heightfield),
+            image: RgbaImage::new(0, 0),
+            types: None,
+            tile: None,
+            changed: None,
+            timing,
+            rebuilt: None,
+            stale: false,
+        };
+        ed.render(true)?;
+        Ok(ed)
+    }
+
+    pub fn run(&mut self, task: Task, waited: Duration) -> Reply {
+        let t = Instant::now();
+        let with_doc = !matches!(task, Task::Scene { .. });
+        match task {
+            Task::Scene { doc, scene, commit } => {
+                self.show(doc.clone(), *scene)?;
+                if commit {
+                    self.history.commit(doc);
+                }
+            }
+            Task::Undo | Task::Redo => {
+                let undo = matches!(task, Task::Undo);
+                let doc = match undo {
+                    true => self.history.undo().cloned(),
+                    false => self.history.redo().cloned(),
+                };
+                let Some(doc) = doc else {
+                    return Err(ApiError::invalid(
+                        "$",
+                        format!("nothing to {}", if undo { "undo" } else { "redo" }),
+                    ));
+                };
+                let applied = self
+                    .policy
+                    .check_value(&doc)
+                    .and_then(|scene| self.show(doc, scene));
+                if let Err(e) = applied {
+                    // Keep the cursor on what is shown.
+                    match undo {
+                        true => self.history.redo(),
+                        false => self.history.undo(),
+                    };
+                    return Err(e);
+                }
+            }
+            Task::View(v) => {
+                self.view = v;
+                self.changed = Some((0, None));
+                self.timing = Timing::default();
+                self.rebuilt = None;
+                self.render(true)?;
+            }
+        }
+        self.revision += 1;
+        Ok(self.frame_reply(Some(waited), t.elapsed(), with_doc))
+    }
+
+    /// Applies a checked document: as edits of the session, or in a new
+    /// session when it cannot be an edit (see [`rebuild_reason`]).
+    fn show(&mut self, doc: Value, scene: Scene) -> Result<(), ApiError> {
+        self.rebuilt = match self.stale {
+            true => Some("the previous edit failed"),
+            false => rebuild_reason(&self.scene, &scene),
+        };
+        if self.rebuilt.is_some() {
+            // The new session is built beside the old one (a new size is
+            // checked as a new tab's is).
+            super::registry::check_memory(scene.width, scene.height)?;
+            let (session, edits, frame, timing) = start(self.db, &scene)?;
+            self.session = session;
+            self.edits = edits;
+            self.stale = false;
+            self.timing = timing;
+            self.changed = Some(change_of(&self.heightfield, &frame.heightfield));
+            self.heightfield = Arc::new(frame.heightfield);
+        } else {
+            let t = Instant::now();
+            let list = self.edits.edits(&scene, self.db)?;
+            self.timing.edits = t.elapsed();
+            if list.is_empty() {
+                self.timing.synth = Duration::ZERO;
+                self.changed = Some((0, None));
+            } else {
+                let frame = self.session.apply(list).map_err(|e| {
+                    self.stale = true;
+                    ApiError::invalid("$", e.to_string())
+                })?;
+                self.timing.synth = frame.time;
+                self.changed = frame.change.map(|c| (c.pixels, c.bounds));
+                self.heightfield = Arc::new(frame.heightfield);
+            }
+        }
+        self.scene = scene;
+        self.doc = doc;
+        self.render(self.rebuilt.is_some())
+    }
+
+    /// Updates the preview: the whole of it (`whole`, or when it is
+    /// scaled), else only where heights or painted types changed, grown by
+    /// the `shade` stage's one-pixel reach.
+    fn render(&mut self, whole: bool) -> Result<(), ApiError> {
+        let t = Instant::now();
+        let fail = |e: String| ApiError::Internal(format!("rendering the preview failed: {e}"));
+        let types = self.edits.type_raster().map(<[u8]>::to_vec);
+        let (w, h) = (self.heightfield.width(), self.heightfield.height());
+        let heights = self.changed.and_then(|(_, b)| b).map(|b| {
+            [
+                b[0].saturating_sub(1),
+                b[1].saturating_sub(1),
+                (b[2] + 1).min(w),
+                (b[3] + 1).min(h),
+            ]
+        });
+        let painted = if self.view.types {
+            type_change(self.types.as_deref(), types.as_deref(), w)
+        } else {
+            None
+        };
+        let rect = union(heights, painted);
+        // Painted types mute the tint everywhere: when the first type is
+        // painted or the last erased, the whole preview changes.
+        let whole = whole || (self.view.types && self.types.is_some() != types.is_some());
+        let full = [
+            0,
+            0,
+            self.image.width() as usize,
+            self.image.height() as usize,
+        ];
+        let rect = match rect {
+            _ if whole || self.image.width() == 0 => {
+                self.image = self
+                    .style
+                    .render(&self.heightfield, types.as_deref(), self.view)
+                    .map_err(fail)?;
+                Some([
+                    0,
+                    0,
+                    self.image.width() as usize,
+                    self.image.height() as usize,
+                ])
+            }
+            None => None,
+            Some(r) => {
+                let done = self
+                    .style
+                    .render_window(
+                        &self.heightfield,
+                        types.as_deref(),
+                        self.view,
+                        &mut self.image,
+                        r,
+                    )
+                    .map_err(fail)?;
+                if done {
+                    Some(r)
+                } else {
+                    self.image = self
+                        .style
+                        .render(&self.heightfield, types.as_deref(), self.view)
+                        .map_err(fail)?;
+                    Some(full)
+                }
+            }
+        };
+        self.tile = match rect {
+            Some(r) => Some((r, Arc::new(encode_rect(&self.image, r).map_err(fail)?))),
+            None => None,
+        };
+        self.types = types;
+        self.timing.render = t.elapsed();
+        Ok(())
+    }
+
+    pub fn frame_reply(&self, waited: Option<Duration>, total: Duration, with_doc: bool) -> Value {
+        let stats = self.heightfield.stats();
+        let (undo, redo) = self.history.counts();
+        let mut reply = json!({
+            "revision": self.revision,
+            "size": [self.scene.width, self.scene.height],
+            "seed": self.scene.seed,
+            "history": {"undo": undo, "redo": redo},
+            "timing_ms": {
+                "queued": waited.map(ms).unwrap_or(0.0),
+                "edits": ms(self.timing.edits),
+                "synth": ms(self.timing.synth),
+                "render": ms(self.timing.render),
+                "total": ms(total),
+            },
+            "changed": self.changed.map(|(pixels, bounds)| json!({"pixels": pixels, "bounds": bounds})),
+            "rebuilt": self.rebuilt,
+            "heights_m": stats.map(|s| json!({"min": s.min, "max": s.max})),
+            "overlay": overlay(&self.edits, &self.scene),
+            "view": self.view,
+            "tile": self.tile.as_ref().map(|(rect, _)| json!({"revision": self.revision, "rect": rect})),
+        });
+        if with_doc {
+            reply["scene"] = self.doc.clone();
+        }
+        reply
+    }
+}
+
+/// A new session on `scene`, with its first frame.
+fn start(
+    db: &'static Database,
+    scene: &Scene,
+) -> Result<(Session<'static>, SceneEdits, Frame, Timing), ApiError> {
+    let mut edits = SceneEdits::new();
+    let t = Instant::now();
+    let list = edits.edits(scene, db)?;
+    let edits_time = t.elapsed();
+    let mut session = Session::new(
+        db,
+        SceneEdits::params(scene),
+        scene.width,
+        scene.height,
+        scene.seed,
+    )
+    .map_err(|e| ApiError::invalid("$", e.to_string()))?;
+    let frame = session
+        .apply(list)
+        .map_err(|e| ApiError::invalid("$", e.to_string()))?;
+    let timing = Timing {
+        edits: edits_time,
+        synth: frame.time,
+        render: Duration::ZERO,
+    };
+    Ok((session, edits, frame, timing))
+}
+
+/// Bounds of the pixels whose painted type differs (`None` = nothing
+/// painted, all 255).
+fn type_change(old: Option<&[u8]>, new: Option<&[u8]>, width: usize) -> Option<[usize; 4]> {
+    let at = |m: Option<&[u8]>, k: usize| m.map_or(255, |m| m[k]);
+    let n = old.or(new)?.len();
+    let mut b: Option<[usize; 4]> = None;
+    for k in (0..n).filter(|&k| at(old, k) != at(new, k)) {
+        let (x, y) = (k % width, k / width);
+        b = union(b, Some([x, y, x + 1, y + 1]));
+    }
+    b
+}
+
+/// Pixels that differ between two heightfields (all when sizes differ).
+fn change_of(old: &Heightfield, new: &Heightfield) -> (usize, Option<[usize; 4]>) {
+    if (old.width(), old.height()) != (new.width(), new.height()) {
+        return (new.len(), Some([0, 0, new.width(), new.height()]));
+    }
+    let n = old
+        .data()
+        .iter()
+        .zip(new.data())
+        .filter(|(a, b)| a.to_bits() != b.to_bits())
+        .count();
+    (n, (n > 0).then_some([0, 0, new.width(), new.height()]))
+}

@@ -1,0 +1,77 @@
+//! Starting the editor's server in a test (on 127.0.0.1, an ephemeral
+//! port, the embedded default database built once per test binary) and
+//! the API calls the HTTP tests share.
+
+use super::http::{self, Response};
+use serde_json::{Value, json};
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::OnceLock;
+use terrasynth::database::{Database, default};
+use terrasynth::progress::Silent;
+use terrasynth::server::{self, Config, DbSource, Running};
+
+pub fn database() -> &'static Database {
+    static DB: OnceLock<&'static Database> = OnceLock::new();
+    DB.get_or_init(|| Box::leak(Box::new(default::build_default(&Silent).unwrap())))
+}
+
+/// A running server, ready (database loaded).
+pub fn serve(size: usize, scene: Option<PathBuf>, max_sessions: usize) -> Running {
+    let running = server::start(Config {
+        bind: SocketAddr::from(([127, 0, 0, 1], 0)),
+        database: Some(DbSource::Loaded(database())),
+        scene,
+        size: (size, size),
+        seed: 3,
+        max_sessions,
+        ..Config::default()
+    })
+    .expect("the server starts");
+    running.wait_ready().expect("the database loads");
+    running
+}
+
+/// The session's heights (an r32 export: little-endian f32, row-major).
+pub fn heights(addr: SocketAddr, session: &str) -> Vec<f32> {
+    let r = http::get(addr, &format!("/api/sessions/{session}/export?format=r32"));
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+    r.body
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+/// The side of the API tests' terrains.
+pub const N: usize = 64;
+
+/// The document a new session of [`serve`]`(N, None, _)` shows.
+pub fn doc() -> Value {
+    json!({"version": 1, "size": [N, N], "seed": 3, "points": [], "curves": []})
+}
+
+/// A new session: its id and first frame.
+pub fn create(addr: SocketAddr) -> (String, Value) {
+    let r = http::post(addr, "/api/sessions", None);
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+    let f = r.json();
+    (f["session"].as_str().unwrap().to_string(), f)
+}
+
+pub fn put_scene(addr: SocketAddr, s: &str, d: &Value, commit: bool) -> Response {
+    http::put(addr, &format!("/api/sessions/{s}/scene?commit={commit}"), d)
+}
+
+/// `r` is a JSON error with this status that names `field`; its message.
+pub fn expect_error(r: &Response, status: u16, field: &str) -> String {
+    assert_eq!(
+        r.status,
+        status,
+        "expected {status} naming {field}: {}",
+        String::from_utf8_lossy(&r.body)
+    );
+    assert_eq!(r.error_field(), field, "{}", r.json());
+    let message = r.json()["error"]["message"].as_str().unwrap().to_string();
+    assert!(!message.is_empty());
+    message
+}

@@ -1,0 +1,384 @@
+//! The editor's HTTP API (`terrasynth::server`), over real sockets on
+//! 127.0.0.1: every endpoint, the errors bad requests get (status and the
+//! field they name), coalescing, history, saving and the restart that
+//! reloads the saved scene. (Limits and mangled requests:
+//! `tests/serve_limits.rs`.)
+#![cfg(feature = "serve")]
+
+mod common;
+
+use common::editor::{N, create, doc, expect_error, heights, put_scene, serve};
+use common::http;
+use serde_json::{Value, json};
+use std::time::Duration;
+use terrasynth::io::{self, Format, ReadOptions};
+use terrasynth::scene::Scene;
+
+#[test]
+fn info_page_and_assets() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let info = http::get(a, "/api/info").json();
+    assert_eq!(info["status"], "ready");
+    assert!(!info["database"]["types"].as_array().unwrap().is_empty());
+    assert!(
+        info["export_formats"]
+            .as_array()
+            .unwrap()
+            .contains(&json!("exr"))
+    );
+    let page = http::get(a, "/");
+    assert_eq!(page.status, 200);
+    assert!(
+        page.header("content-type")
+            .unwrap()
+            .starts_with("text/html")
+    );
+    assert!(String::from_utf8_lossy(&page.body).contains("/assets/js/main.js"));
+    // Nothing from elsewhere: the browser may load only this server's files.
+    let policy = page.header("content-security-policy").unwrap();
+    assert!(policy.starts_with("default-src 'self';"), "{policy}");
+    for asset in ["editor.css", "js/main.js", "js/tools.js", "js/panel.js"] {
+        let r = http::get(a, &format!("/assets/{asset}"));
+        assert_eq!(r.status, 200, "{asset}");
+        assert!(!r.body.is_empty(), "{asset}");
+    }
+    expect_error(&http::get(a, "/assets/nope.js"), 404, "$");
+    expect_error(&http::get(a, "/api/nothing"), 404, "$");
+    expect_error(
+        &http::request(a, "DELETE", "/api/info", None, None),
+        405,
+        "$",
+    );
+    let ex = http::get(a, "/api/exemplars/0/preview.png");
+    assert_eq!(ex.status, 200);
+    assert_eq!(&ex.body[..8], b"\x89PNG\r\n\x1a\n");
+    expect_error(&http::get(a, "/api/exemplars/99/preview.png"), 422, "index");
+}
+
+#[test]
+fn sessions_edits_and_their_errors() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, first) = create(a);
+    assert_eq!(first["scene"], doc());
+    assert_eq!(first["size"], json!([N, N]));
+    let h0 = heights(a, &id);
+    assert_eq!(h0.len(), N * N);
+
+    // A point changes the terrain around it, and only there.
+    let mut d = doc();
+    d["points"] = json!([{"id": "p", "at": [20, 20], "height_m": 2500, "radius_px": 6}]);
+    let f = put_scene(a, &id, &d, true).json();
+    let b = f["changed"]["bounds"].as_array().unwrap();
+    assert!(
+        b[2].as_u64().unwrap() <= 40 && b[3].as_u64().unwrap() <= 40,
+        "{f}"
+    );
+    assert!(f["changed"]["pixels"].as_u64().unwrap() > 0);
+    assert_eq!(f["history"], json!({"undo": 1, "redo": 0}));
+    assert!(f["timing_ms"]["synth"].as_f64().unwrap() > 0.0);
+    let h1 = heights(a, &id);
+    assert_ne!(h0, h1);
+    assert_eq!(h0[63 * N + 63].to_bits(), h1[63 * N + 63].to_bits());
+
+    // Bad documents name the field and change nothing.
+    let mut bad = d.clone();
+    bad["points"][0]["radius_px"] = json!(-1);
+    expect_error(&put_scene(a, &id, &bad, true), 422, "points[0].radius_px");
+    let mut bad = d.clone();
+    bad["curves"] = json!([{"points": [[1, 1], [1, 1]], "widgets": []}]);
+    expect_error(&put_scene(a, &id, &bad, true), 422, "curves[0].widgets");
+    let mut bad = d.clone();
+    bad["types"] = json!({"strokes": [{"type": "glacier", "points": [[3, 3]], "radius_px": 2}]});
+    expect_error(&put_scene(a, &id, &bad, true), 422, "types.strokes[0].type");
+    let mut bad = d.clone();
+    bad["database"] = json!("/tmp/other.tsdb");
+    expect_error(&put_scene(a, &id, &bad, true), 422, "database");
+    let mut bad = d.clone();
+    bad["freeze"] = json!({"mask": "/etc/passwd"});
+    expect_error(&put_scene(a, &id, &bad, true), 422, "freeze.mask");
+    let mut bad = d.clone();
+    bad["colour"] = json!("red");
+    expect_error(&put_scene(a, &id, &bad, true), 422, "colour");
+    let path = format!("/api/sessions/{id}/scene");
+    expect_error(
+        &http::request(a, "PUT", &path, Some(b"{\"size\": "), None),
+        400,
+        "$",
+    );
+    expect_error(&http::request(a, "PUT", &path, Some(b"[]"), None), 422, "$");
+    expect_error(&http::request(a, "PUT", &path, None, None), 400, "$");
+    expect_error(
+        &http::request(
+            a,
+            "PUT",
+            &path,
+            Some(d.to_string().as_bytes()),
+            Some("text/plain"),
+        ),
+        415,
+        "$",
+    );
+    expect_error(
+        &http::put(a, &format!("{path}?commit=maybe"), &d),
+        400,
+        "commit",
+    );
+    expect_error(
+        &http::put(a, &format!("{path}?comit=true"), &d),
+        400,
+        "comit",
+    );
+    expect_error(&http::put(a, "/api/sessions/0123/scene", &d), 404, "id");
+    assert_eq!(heights(a, &id), h1, "a refused edit changed the terrain");
+    assert_eq!(
+        http::get(a, &format!("/api/sessions/{id}")).json()["scene"],
+        d
+    );
+
+    // View toggles.
+    let v = http::put(
+        a,
+        &format!("/api/sessions/{id}/view"),
+        &json!({"contours": false}),
+    );
+    assert_eq!(v.status, 200);
+    assert_eq!(v.json()["view"]["contours"], false);
+    let bad = http::put(
+        a,
+        &format!("/api/sessions/{id}/view"),
+        &json!({"shadows": true}),
+    );
+    expect_error(&bad, 400, "shadows");
+    let bad = http::put(a, &format!("/api/sessions/{id}/view"), &json!({"types": 1}));
+    expect_error(&bad, 422, "types");
+}
+
+#[test]
+fn history_commits_and_drags() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, _) = create(a);
+    expect_error(
+        &http::post(a, &format!("/api/sessions/{id}/undo"), None),
+        422,
+        "$",
+    );
+    let point = |x: f64| {
+        let mut d = doc();
+        d["points"] = json!([{"at": [x, 30], "height_m": 900, "radius_px": 5}]);
+        d
+    };
+    assert_eq!(put_scene(a, &id, &point(20.0), true).status, 200);
+    // A drag: intermediate states are no undo steps.
+    for x in [22.0, 24.0, 26.0] {
+        assert_eq!(put_scene(a, &id, &point(x), false).status, 200);
+    }
+    let f = put_scene(a, &id, &point(28.0), true).json();
+    assert_eq!(f["history"], json!({"undo": 2, "redo": 0}));
+    let u = http::post(a, &format!("/api/sessions/{id}/undo"), None).json();
+    assert_eq!(u["scene"], point(20.0));
+    assert_eq!(u["history"], json!({"undo": 1, "redo": 1}));
+    let u = http::post(a, &format!("/api/sessions/{id}/undo"), None).json();
+    assert_eq!(u["scene"], doc());
+    let r = http::post(a, &format!("/api/sessions/{id}/redo"), None).json();
+    assert_eq!(r["scene"], point(20.0));
+    // A new edit drops the redo steps.
+    put_scene(a, &id, &point(40.0), true);
+    expect_error(
+        &http::post(a, &format!("/api/sessions/{id}/redo"), None),
+        422,
+        "$",
+    );
+}
+
+/// While one document is synthesized, a newer one replaces any queued one:
+/// the replaced request is answered `superseded`, the newest is shown.
+#[test]
+fn queued_documents_coalesce_latest_wins() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, _) = create(a);
+    let seeded = |seed: u32, x: f64| {
+        let mut d = doc();
+        d["seed"] = json!(seed);
+        d["points"] = json!([{"at": [x, 30], "height_m": 900, "radius_px": 5}]);
+        d
+    };
+    // A slow first job: a new seed at a larger size is a whole new session
+    // (a second or so; the next two arrive within 120 ms).
+    let mut slow = seeded(9, 10.0);
+    slow["size"] = json!([1024, 1024]);
+    let id2 = id.clone();
+    let t1 = std::thread::spawn(move || put_scene(a, &id2, &slow, true));
+    std::thread::sleep(Duration::from_millis(60));
+    let id2 = id.clone();
+    let t2 = std::thread::spawn(move || put_scene(a, &id2, &seeded(9, 20.0), false));
+    std::thread::sleep(Duration::from_millis(60));
+    let t3 = put_scene(a, &id, &seeded(9, 30.0), false);
+    let (r1, r2) = (t1.join().unwrap(), t2.join().unwrap());
+    assert_eq!(r1.status, 200);
+    assert_eq!(r1.json()["rebuilt"], "size changed");
+    assert_eq!(r2.json(), json!({"superseded": true}));
+    assert_eq!(t3.status, 200);
+    assert_eq!(t3.json()["rebuilt"], "size changed");
+    let shown = http::get(a, &format!("/api/sessions/{id}")).json();
+    // The committed document: the first (the others were not commits).
+    assert_eq!(shown["scene"]["points"][0]["at"], json!([10.0, 30]));
+}
+
+#[test]
+fn previews_tiles_heights_and_exports() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, first) = create(a);
+    let png = http::get(a, &format!("/api/sessions/{id}/preview.png"));
+    assert_eq!(png.status, 200);
+    let img = image::load_from_memory(&png.body).unwrap();
+    assert_eq!((img.width() as usize, img.height() as usize), (N, N));
+    let t0 = first["tile"]["revision"].as_u64().unwrap();
+    assert_eq!(first["tile"]["rect"], json!([0, 0, N, N]));
+    let mut d = doc();
+    d["points"] = json!([{"at": [20, 20], "height_m": 2500, "radius_px": 6}]);
+    let f = put_scene(a, &id, &d, true).json();
+    let rect: Vec<usize> = serde_json::from_value(f["tile"]["rect"].clone()).unwrap();
+    assert!(rect[2] - rect[0] < N && rect[3] - rect[1] < N, "{f}");
+    let rev = f["tile"]["revision"].as_u64().unwrap();
+    assert!(rev > t0);
+    let tile = http::get(a, &format!("/api/sessions/{id}/tile.png?revision={rev}"));
+    assert_eq!(tile.status, 200);
+    let timg = image::load_from_memory(&tile.body).unwrap().to_rgba8();
+    assert_eq!(
+        (timg.width() as usize, timg.height() as usize),
+        (rect[2] - rect[0], rect[3] - rect[1])
+    );
+    // The tile is that part of the new preview.
+    let full = http::get(a, &format!("/api/sessions/{id}/preview.png"));
+    let full = image::load_from_memory(&full.body).unwrap().to_rgba8();
+    for (x, y, p) in timg.enumerate_pixels() {
+        assert_eq!(p, full.get_pixel(x + rect[0] as u32, y + rect[1] as u32));
+    }
+    expect_error(
+        &http::get(a, &format!("/api/sessions/{id}/tile.png")),
+        400,
+        "revision",
+    );
+    expect_error(
+        &http::get(a, &format!("/api/sessions/{id}/tile.png?revision=x")),
+        400,
+        "revision",
+    );
+    expect_error(
+        &http::get(a, &format!("/api/sessions/{id}/tile.png?revision=99999")),
+        404,
+        "$",
+    );
+
+    let hf = heights(a, &id);
+    let hr = http::get(a, &format!("/api/sessions/{id}/heights"));
+    assert_eq!(hr.header("x-revision"), Some(rev.to_string().as_str()));
+    let hb = hr.body;
+    let word = |k: usize| u32::from_le_bytes(hb[4 * k..4 * k + 4].try_into().unwrap());
+    assert_eq!((word(0), word(1), word(2)), (N as u32, N as u32, 1));
+    assert_eq!(
+        f32::from_le_bytes(hb[12 + 4 * 70..12 + 4 * 71].try_into().unwrap()),
+        hf[70]
+    );
+
+    for f in Format::ALL.iter().filter(|f| f.can_write()) {
+        let r = http::get(a, &format!("/api/sessions/{id}/export?format={}", f.name()));
+        assert_eq!(r.status, 200, "{f}");
+        assert!(
+            r.header("content-disposition")
+                .unwrap()
+                .contains("attachment")
+        );
+        let sidecar = f.uses_sidecar().then(|| {
+            let s = http::get(
+                a,
+                &format!("/api/sessions/{id}/export?format={}&sidecar=true", f.name()),
+            );
+            assert_eq!(s.status, 200, "{f} sidecar");
+            s.body
+        });
+        let opts = ReadOptions {
+            size: Some((N, N)),
+            ..ReadOptions::default()
+        };
+        let back = io::decode(&r.body, *f, sidecar.as_deref(), &opts).unwrap();
+        assert_eq!((back.width(), back.height()), (N, N), "{f}");
+        if matches!(f, Format::Exr | Format::R32 | Format::Tiff) {
+            assert_eq!(back.data(), &hf[..], "{f} is exact");
+        }
+    }
+    let pv = http::get(a, &format!("/api/sessions/{id}/export?format=preview"));
+    assert_eq!(&pv.body[..4], b"\x89PNG");
+    let e = |q: &str| http::get(a, &format!("/api/sessions/{id}/export{q}"));
+    expect_error(&e(""), 400, "format");
+    expect_error(&e("?format=jpeg"), 422, "format");
+    expect_error(&e("?format=png8"), 422, "format");
+    expect_error(&e("?format=exr&sidecar=true"), 422, "sidecar");
+    expect_error(&e("?format=exr&size=2"), 400, "size");
+}
+
+#[test]
+fn pastes_and_new_parameters_start_a_new_session() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, _) = create(a);
+    let mut d = doc();
+    d["pastes"] = json!([{"source": "exemplar", "exemplar": 1, "lasso": [[10, 10], [40, 12], [30, 40]], "to": [40, 40], "delta_m": 50}]);
+    let f = put_scene(a, &id, &d, true).json();
+    assert_eq!(f["rebuilt"], Value::Null, "{f}");
+    assert!(f["changed"]["pixels"].as_u64().unwrap() > 0);
+    // Removing the paste (undo) cannot be an edit of this session.
+    let u = http::post(a, &format!("/api/sessions/{id}/undo"), None).json();
+    assert_eq!(u["rebuilt"], "a paste was removed or changed");
+    let mut bad = d.clone();
+    bad["pastes"][0]["exemplar"] = json!(77);
+    expect_error(&put_scene(a, &id, &bad, true), 422, "pastes[0].exemplar");
+    let mut bigger = doc();
+    bigger["size"] = json!([96, 80]);
+    let f = put_scene(a, &id, &bigger, true).json();
+    assert_eq!(f["rebuilt"], "size changed");
+    assert_eq!(f["size"], json!([96, 80]));
+    assert_eq!(heights(a, &id).len(), 96 * 80);
+}
+
+#[test]
+fn save_writes_only_the_scene_file_and_a_restart_reloads_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("design.json");
+    let s = serve(N, None, 2);
+    let (id, _) = create(s.addr);
+    expect_error(
+        &http::post(s.addr, &format!("/api/sessions/{id}/save"), None),
+        409,
+        "$",
+    );
+    drop(s);
+
+    let s = serve(N, Some(path.clone()), 2);
+    let a = s.addr;
+    let (id, _) = create(a);
+    let mut d = doc();
+    d["points"] = json!([{"id": "peak", "at": [20, 20], "height_m": 2500, "radius_px": 6}]);
+    d["freeze"] = json!({"strokes": [{"points": [[50, 50]], "radius_px": 5}, {"erase": true, "points": [[50, 50]], "radius_px": 2}]});
+    put_scene(a, &id, &d, true);
+    let r = http::post(a, &format!("/api/sessions/{id}/save"), None);
+    assert_eq!(r.status, 200, "{}", r.json());
+    let files: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(files, vec![std::ffi::OsString::from("design.json")]);
+    let saved = Scene::read(&path).unwrap();
+    assert_eq!(saved.points[0].id, "peak");
+    drop(s);
+
+    // A new server on the same file starts from the saved design.
+    let s = serve(N, Some(path.clone()), 2);
+    let (_, f) = create(s.addr);
+    assert_eq!(f["scene"], d);
+}

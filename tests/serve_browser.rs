@@ -1,0 +1,273 @@
+//! The editor end to end in a real browser: Debian's headless Chromium
+//! driven over WebDriver (chromedriver, through fantoccini) with real
+//! pointer actions on the page served by `terrasynth::server`.
+//!
+//! The design session: freeze a region, place a point, sketch a curve
+//! through the frozen region, paint a type, place a second point and undo
+//! it, save. Then the saved scene file must hold exactly those controls,
+//! and the heightfield must have changed where the controls act and not at
+//! all inside the frozen region. Screenshots of every step go to
+//! `target/editor-screenshots/` (or `$TERRASYNTH_SCREENSHOTS`).
+//!
+//! Without chromium and chromedriver the test says so and passes, unless
+//! `TERRASYNTH_REQUIRE_BROWSER` is set (as `.ci/run` does), which makes a
+//! missing browser a failure.
+#![cfg(feature = "serve")]
+
+mod common;
+
+use common::browser::{
+    click, connect, drag, executables, js, revision, settled, shot, start_driver, wait_for,
+};
+use common::editor::{self, heights};
+use fantoccini::Client;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use terrasynth::scene::Scene;
+use terrasynth::server::Running;
+
+const SIZE: usize = 256;
+
+/// Pixels whose heights differ (bit for bit) between two frames.
+fn changed(a: &[f32], b: &[f32], mask: impl Fn(usize, usize) -> bool) -> (usize, usize) {
+    let (mut n, mut total) = (0, 0);
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        if mask(k % SIZE, k / SIZE) {
+            total += 1;
+            n += (x.to_bits() != y.to_bits()) as usize;
+        }
+    }
+    (n, total)
+}
+
+/// What the design session left: the heights after each step, the type
+/// painted.
+struct Steps {
+    h0: Vec<f32>,
+    h_frozen: Vec<f32>,
+    h_before_second: Vec<f32>,
+    h_second: Vec<f32>,
+    h_final: Vec<f32>,
+    type_name: Value,
+}
+
+/// The design session in the browser (see the module docs).
+async fn design(c: &Client, server: &Running, shots: &Path) -> Steps {
+    c.goto(&server.url()).await.unwrap();
+    settled(c, -1).await;
+    shot(c, shots, "01-loaded").await;
+    let session = js(c, "return window.terrasynth.api.session").await;
+    let session = session.as_str().unwrap().to_string();
+    let addr = server.addr;
+    let h0 = heights(addr, &session);
+
+    // Freeze a band; nothing moves yet.
+    click(c, "[data-tool=freeze]").await;
+    let rev = revision(c).await;
+    drag(c, &[(40.0, 60.0), (70.0, 62.0), (100.0, 64.0)]).await;
+    settled(c, rev).await;
+    let h_frozen = heights(addr, &session);
+    shot(c, shots, "02-frozen").await;
+
+    // A point whose reach overlaps the frozen band.
+    click(c, "[data-tool=point]").await;
+    let rev = revision(c).await;
+    drag(c, &[(120.0, 80.0)]).await;
+    settled(c, rev).await;
+    shot(c, shots, "03-point").await;
+
+    // A curve across the terrain, through the frozen band.
+    click(c, "[data-tool=curve]").await;
+    let rev = revision(c).await;
+    let curve: Vec<(f64, f64)> = (0..=12)
+        .map(|k| {
+            let t = k as f64 / 12.0;
+            (30.0 + 200.0 * t, 40.0 + 180.0 * t)
+        })
+        .collect();
+    drag(c, &curve).await;
+    settled(c, rev).await;
+    shot(c, shots, "04-curve").await;
+
+    // Paint a type.
+    click(c, "[data-tool=types]").await;
+    click(c, ".palette button:nth-child(3)").await;
+    let type_name = js(c, "return window.terrasynth.info.database.types[2].name").await;
+    let rev = revision(c).await;
+    drag(c, &[(150.0, 170.0), (190.0, 180.0), (230.0, 200.0)]).await;
+    settled(c, rev).await;
+    shot(c, shots, "05-types").await;
+    let h_before_second = heights(addr, &session);
+
+    // A second point, then undo it.
+    click(c, "[data-tool=point]").await;
+    let rev = revision(c).await;
+    drag(c, &[(200.0, 60.0)]).await;
+    settled(c, rev).await;
+    let h_second = heights(addr, &session);
+    let rev = revision(c).await;
+    click(c, "#undo").await;
+    settled(c, rev).await;
+    shot(c, shots, "06-undone").await;
+
+    // Save, and read what the page says.
+    click(c, "#save").await;
+    wait_for(
+        c,
+        "the save",
+        "return document.getElementById('status-main').textContent.startsWith('saved')",
+        30,
+    )
+    .await;
+    shot(c, shots, "07-saved").await;
+    let errors = js(c, "return window.__errors || []").await;
+    assert_eq!(errors, json!([]), "the page logged errors");
+    // Nothing named from elsewhere (a CDN): what the page itself refers to,
+    // and everything it loaded, is this server's.
+    let foreign = js(
+        c,
+        "const own = (u) => !u || u.startsWith(location.origin + '/') || /^(blob|data):/.test(u);
+         return [...document.querySelectorAll('[src],[href]')].map((e) => e.src || e.href)
+           .concat(performance.getEntriesByType('resource').map((r) => r.name))
+           .filter((u) => !own(u));",
+    )
+    .await;
+    assert_eq!(foreign, json!([]), "the page refers to other servers");
+    let latency = js(c, "return window.terrasynth.latency").await;
+    eprintln!("in-browser edit → preview (ms): {latency}");
+    let h_final = heights(addr, &session);
+    // A reload keeps the tab's design (a new session starts from it).
+    c.refresh().await.unwrap();
+    settled(c, -1).await;
+    let kept = js(c, "const d = window.terrasynth.doc; return [d.points.length, d.curves.length, d.types.strokes.length, d.freeze.strokes.length]").await;
+    assert_eq!(kept, json!([1, 1, 1, 1]), "the design after a reload");
+    Steps {
+        h0,
+        h_frozen,
+        h_before_second,
+        h_second,
+        h_final,
+        type_name,
+    }
+}
+
+#[test]
+fn a_design_session_in_chromium() {
+    let Some((chromium, driver)) = executables() else {
+        return;
+    };
+    let started = Instant::now();
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("design.json");
+    let server = editor::serve(SIZE, Some(scene_path.clone()), 2);
+    let shots = std::env::var_os("TERRASYNTH_SCREENSHOTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/editor-screenshots")
+        });
+    std::fs::create_dir_all(&shots).unwrap();
+    let wd = start_driver(&driver);
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let c = rt.block_on(connect(&wd, &chromium, dir.path()));
+    // Close the browser even when a step fails (chromedriver alone would
+    // leave it running).
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        rt.block_on(design(&c, &server, &shots))
+    }));
+    let _ = rt.block_on(c.close());
+    let s = outcome.unwrap_or_else(|p| std::panic::resume_unwind(p));
+
+    // The saved scene has exactly the design's controls.
+    let text = std::fs::read(&scene_path).expect("the scene was saved");
+    let saved: Value = serde_json::from_slice(&text).unwrap();
+    let scene = Scene::parse(&text, &scene_path).expect("the saved scene parses");
+    assert_eq!(
+        scene.points.len(),
+        1,
+        "one point (the second was undone): {saved}"
+    );
+    let p = &scene.points[0];
+    assert!(
+        (p.at.x - 120.0).abs() < 2.0 && (p.at.y - 80.0).abs() < 2.0,
+        "{saved}"
+    );
+    assert_eq!(scene.curves.len(), 1, "{saved}");
+    let line = &scene.curves[0].spec.points;
+    assert!(line.len() >= 4, "{saved}");
+    assert!(
+        line[0].distance(glam::DVec2::new(30.0, 40.0)) < 3.0,
+        "{saved}"
+    );
+    assert!(
+        line[line.len() - 1].distance(glam::DVec2::new(230.0, 220.0)) < 3.0,
+        "{saved}"
+    );
+    assert_eq!(
+        saved["types"]["strokes"].as_array().unwrap().len(),
+        1,
+        "{saved}"
+    );
+    assert_eq!(saved["types"]["strokes"][0]["type"], s.type_name, "{saved}");
+    assert_eq!(
+        saved["freeze"]["strokes"].as_array().unwrap().len(),
+        1,
+        "{saved}"
+    );
+
+    // Frozen pixels kept their heights through every edit, bit for bit.
+    let frozen = scene.freeze_raster().unwrap().unwrap();
+    let (moved, total) = changed(&s.h_frozen, &s.h_final, |x, y| frozen[y * SIZE + x]);
+    assert!(total > 200, "the freeze stroke covers {total} pixels");
+    assert_eq!(moved, 0, "{moved} of {total} frozen pixels changed");
+    assert_eq!(
+        changed(&s.h0, &s.h_frozen, |_, _| true).0,
+        0,
+        "freezing alone changed heights"
+    );
+    // The point, the curve and the painted type changed the terrain
+    // where they act (outside the frozen band).
+    let free = |x: usize, y: usize| !frozen[y * SIZE + x];
+    let near = |q: (f64, f64), r: f64| {
+        move |x: usize, y: usize| {
+            free(x, y) && (x as f64 + 0.5 - q.0).hypot(y as f64 + 0.5 - q.1) <= r
+        }
+    };
+    let (n, t) = changed(&s.h0, &s.h_final, near((120.0, 80.0), 8.0));
+    assert!(n * 10 > t * 9, "around the point {n} of {t} pixels changed");
+    let (n, t) = changed(&s.h0, &s.h_final, near((130.0, 130.0), 6.0));
+    assert!(n * 10 > t * 9, "on the curve {n} of {t} pixels changed");
+    let (n, t) = changed(&s.h0, &s.h_final, near((190.0, 180.0), 6.0));
+    assert!(n * 2 > t, "under the type stroke {n} of {t} pixels changed");
+    // The point holds the terrain at its height (the paper's point
+    // constraint), within a tenth of the exemplars' relief.
+    let at = (p.at.y as usize) * SIZE + p.at.x as usize;
+    let missed = (s.h_final[at] as f64 - p.height_m).abs();
+    eprintln!(
+        "the point asks {} m and got {} m",
+        p.height_m, s.h_final[at]
+    );
+    assert!(missed < 250.0, "the point missed its height by {missed} m");
+    // Undo took the second point's raise away again.
+    let site = 60 * SIZE + 200;
+    let raise = s.h_second[site] - s.h_before_second[site];
+    let left = s.h_final[site] - s.h_before_second[site];
+    assert!(
+        raise > 50.0,
+        "the second point raised its site by {raise} m"
+    );
+    assert!(
+        left.abs() < raise / 2.0,
+        "after undo {left} m of {raise} m remain"
+    );
+    drop(wd);
+    server.stop();
+    eprintln!(
+        "browser test took {:.1} s; screenshots in {}",
+        started.elapsed().as_secs_f64(),
+        shots.display()
+    );
+}
