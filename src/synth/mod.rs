@@ -1,7 +1,8 @@
 //! Coarse-to-fine parallel synthesis (paper §4, DESIGN §3, §5, §6).
 //!
-//! Levels M..0 of any output size: level M is 2×2, initialised at the centre
-//! of the start exemplar; each finer level is `upsample_jitter` of the one
+//! Levels top..0 of any output size: the top level is the coarse start
+//! ([`coarse`]: verbatim exemplar blocks, or the start exemplar's centre
+//! without jitter); each finer level is `upsample_jitter` of the one
 //! above and, at levels ≤ L (the database's coarsest), `passes` correction
 //! passes of four interleaved subpasses; `reconstruct` turns level 0 into
 //! metres. Every stage is integer arithmetic and every random choice a hash,
@@ -17,214 +18,31 @@ pub mod atlas;
 pub mod coarse;
 pub mod control;
 pub mod fixed;
+mod params;
 pub mod session;
 pub mod source_map;
 pub mod stages;
 pub mod state;
+mod window;
 
 use crate::backend::{Backend, BackendError, Choice, Stage, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
 use coarse::Start;
-use control::Target;
-use fixed::{Coord, FRAC_BITS};
+use fixed::FRAC_BITS;
 use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
-use thiserror::Error;
+use window::{REACH_PER_SUBPASS, changed_bounds, double, widen};
 
-/// Synthesis settings (paper defaults).
-#[derive(Debug, Clone)]
-pub struct Params {
-    /// Jitter amplitude r of eq. 1, in texels (0 = none; paper: 0.4).
-    pub jitter: f64,
-    /// Correction passes per level (paper: 2), each of four subpasses.
-    pub passes: u32,
-    /// The exemplar synthesis starts from: its blocks make the coarse start
-    /// (see [`coarse`]), or without jitter its centre; the output takes its
-    /// cell size. `None`: blocks from every exemplar in proportion to its
-    /// area (each terrain type by its share of the database), exemplar 0's
-    /// centre without jitter, and exemplar 0's cell size.
-    pub start_exemplar: Option<usize>,
-    /// Height prior weight P of the correction (one of
-    /// `stages::correct::PRIORS`; 0 is the paper's pure relative height
-    /// matching). See the `correct` stage's module docs.
-    pub prior: u32,
-    /// Keep every level's S and V in the result, for inspection.
-    pub keep_levels: bool,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            jitter: 0.4,
-            passes: 2,
-            start_exemplar: None,
-            prior: stages::correct::DEFAULT_PRIOR,
-            keep_levels: false,
-        }
-    }
-}
-
-/// Invalid synthesis requests.
-#[non_exhaustive]
-#[derive(Debug, Error, Clone, PartialEq)]
-pub enum SynthError {
-    #[error("jitter {0} is invalid: expected 0..=4 texels")]
-    Jitter(f64),
-    #[error("passes {0} is invalid: expected 0..=16")]
-    Passes(u32),
-    #[error("height prior {0} is invalid: expected one of {list:?}", list = stages::correct::PRIORS)]
-    Prior(u32),
-    #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
-    StartExemplar { index: usize, count: usize },
-    #[error(transparent)]
-    Size(#[from] crate::error::SizeError),
-    #[error(transparent)]
-    Backend(#[from] BackendError),
-}
-
-/// One level's final state, kept when [`Params::keep_levels`] is set.
-#[derive(Debug, Clone)]
-pub struct LevelMaps {
-    pub level: usize,
-    pub width: usize,
-    pub height: usize,
-    /// Exemplar coordinates (fixed point; atlas units of this level, or of
-    /// level L above it).
-    pub coords: Vec<Coord>,
-    /// Height offsets, in database units.
-    pub offsets: Vec<i32>,
-}
-
-/// Where the time went.
-#[derive(Debug, Clone, Default)]
-pub struct Timings {
-    /// Per level (index = level): upsample, correct, total.
-    pub levels: Vec<LevelTiming>,
-    pub reconstruct: Duration,
-    pub total: Duration,
-    /// Stage times are the device's own (GPU timestamp queries), not wall
-    /// clock.
-    pub device_clock: bool,
-}
-
-#[derive(Debug, Clone, Copy, Default)]
-pub struct LevelTiming {
-    pub upsample: Duration,
-    pub correct: Duration,
-}
-
-/// The result of a synthesis.
-#[derive(Debug, Clone)]
-pub struct Synthesis {
-    pub heightfield: Heightfield,
-    /// Levels M..0 when kept (index = level).
-    pub levels: Vec<LevelMaps>,
-    pub timings: Timings,
-}
-
-/// Control inputs of one synthesis, per level (index = level; levels the
-/// correction never visits are ignored).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Guides {
-    pub levels: Vec<LevelGuide>,
-    /// Re-synthesize only where this frame can differ from the previous
-    /// one: at each level, the window around the pixels whose inputs
-    /// changed and the children of the parent level's changed pixels,
-    /// widened by how far 4·passes subpasses carry a change. Outside it
-    /// every pixel's inputs equal the previous frame's (a weight may only
-    /// have dropped to frozen, which keeps the previous result), so its
-    /// previous per-pass results are what it would compute: restricted and
-    /// full re-synthesis give the same bytes (tested).
-    pub restrict: bool,
-}
-
-/// One level's control rasters (level-sized, row-major).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LevelGuide {
-    /// Geometric targets (every level: see `control::blend`).
-    pub targets: Option<Vec<Target>>,
-    /// Type target sets R^i (levels ≥ 2).
-    pub allowed: Option<Vec<u32>>,
-    /// Coherence weights W^i in quarters (used when a previous frame exists).
-    pub weights: Option<Vec<u8>>,
-    /// Bounds `[x0, y0, x1, y1)` of the pixels whose own inputs (targets,
-    /// type sets, raised weights, pasted candidates) differ from the
-    /// previous frame's; None if none do. Used when [`Guides::restrict`].
-    pub dirty: Option<[usize; 4]>,
-}
-
-/// Subpass reads reach two pixels (DESIGN §5), so within one level a change
-/// spreads at most this far per subpass.
-const REACH_PER_SUBPASS: usize = 2;
-
-/// Every corrected level's state after every pass (index = level, then
-/// pass): the previous frame a coherent re-synthesis reads. A pass writes
-/// each pixel once, in its parity class's subpass, so the state after the
-/// pass holds every subpass's result (paper §5.3: "the results for all
-/// sub-passes are needed").
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Frames {
-    pub levels: Vec<Vec<PassResult>>,
-}
-
-/// One level's S and V after one pass.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct PassResult {
-    pub coords: Vec<Coord>,
-    pub offsets: Vec<i32>,
-}
-
-/// The union of two optional bounds.
-pub(crate) fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
-    match (a, b) {
-        (Some(a), Some(b)) => Some([
-            a[0].min(b[0]),
-            a[1].min(b[1]),
-            a[2].max(b[2]),
-            a[3].max(b[3]),
-        ]),
-        (a, None) => a,
-        (None, b) => b,
-    }
-}
-
-/// The children of a parent level's bounds.
-fn double(b: [usize; 4]) -> [usize; 4] {
-    b.map(|v| 2 * v)
-}
-
-/// Bounds grown by `by` on every side, clipped to `w × h`.
-fn widen(b: [usize; 4], by: usize, w: usize, h: usize) -> [usize; 4] {
-    [
-        b[0].saturating_sub(by),
-        b[1].saturating_sub(by),
-        (b[2] + by).min(w),
-        (b[3] + by).min(h),
-    ]
-}
-
-/// Bounds of the pixels whose S or V (row-major, `width` wide) differ from
-/// `r`; None if none do.
-fn changed_bounds(
-    coords: &[Coord],
-    offsets: &[i32],
-    width: usize,
-    r: &PassResult,
-) -> Option<[usize; 4]> {
-    let mut b: Option<[usize; 4]> = None;
-    for (i, (c, v)) in coords.iter().zip(offsets).enumerate() {
-        if *c != r.coords[i] || *v != r.offsets[i] {
-            let (x, y) = (i % width, i / width);
-            b = union(b, Some([x, y, x + 1, y + 1]));
-        }
-    }
-    b
-}
+pub use params::{
+    Guides, LevelGuide, LevelMaps, LevelTiming, Params, SynthError, Synthesis, Timings,
+};
+pub(crate) use window::union;
+pub use window::{Frames, PassResult};
 
 /// The control side of one run: per-level guides, the previous frame, and
 /// whether to record this one.

@@ -1,0 +1,131 @@
+//! What a synthesis takes and gives: its settings, the control inputs per
+//! level, the errors it reports, and its result with per-level timings.
+
+use super::control::Target;
+use super::fixed::Coord;
+use crate::backend::BackendError;
+use crate::heightfield::Heightfield;
+use std::time::Duration;
+use thiserror::Error;
+
+/// Synthesis settings (paper defaults).
+#[derive(Debug, Clone)]
+pub struct Params {
+    /// Jitter amplitude r of eq. 1, in texels (0 = none; paper: 0.4).
+    pub jitter: f64,
+    /// Correction passes per level (paper: 2), each of four subpasses.
+    pub passes: u32,
+    /// The exemplar synthesis starts from: its blocks make the coarse start
+    /// (see [`coarse`]), or without jitter its centre; the output takes its
+    /// cell size. `None`: blocks from every exemplar in proportion to its
+    /// area (each terrain type by its share of the database), exemplar 0's
+    /// centre without jitter, and exemplar 0's cell size.
+    pub start_exemplar: Option<usize>,
+    /// Height prior weight P of the correction (one of
+    /// `super::stages::correct::PRIORS`; 0 is the paper's pure relative height
+    /// matching). See the `correct` stage's module docs.
+    pub prior: u32,
+    /// Keep every level's S and V in the result, for inspection.
+    pub keep_levels: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            jitter: 0.4,
+            passes: 2,
+            start_exemplar: None,
+            prior: super::stages::correct::DEFAULT_PRIOR,
+            keep_levels: false,
+        }
+    }
+}
+
+/// Invalid synthesis requests.
+#[non_exhaustive]
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SynthError {
+    #[error("jitter {0} is invalid: expected 0..=4 texels")]
+    Jitter(f64),
+    #[error("passes {0} is invalid: expected 0..=16")]
+    Passes(u32),
+    #[error("height prior {0} is invalid: expected one of {list:?}", list = super::stages::correct::PRIORS)]
+    Prior(u32),
+    #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
+    StartExemplar { index: usize, count: usize },
+    #[error(transparent)]
+    Size(#[from] crate::error::SizeError),
+    #[error(transparent)]
+    Backend(#[from] BackendError),
+}
+
+/// One level's final state, kept when [`Params::keep_levels`] is set.
+#[derive(Debug, Clone)]
+pub struct LevelMaps {
+    pub level: usize,
+    pub width: usize,
+    pub height: usize,
+    /// Exemplar coordinates (fixed point; atlas units of this level, or of
+    /// level L above it).
+    pub coords: Vec<Coord>,
+    /// Height offsets, in database units.
+    pub offsets: Vec<i32>,
+}
+
+/// Where the time went.
+#[derive(Debug, Clone, Default)]
+pub struct Timings {
+    /// Per level (index = level): upsample, correct, total.
+    pub levels: Vec<LevelTiming>,
+    pub reconstruct: Duration,
+    pub total: Duration,
+    /// Stage times are the device's own (GPU timestamp queries), not wall
+    /// clock.
+    pub device_clock: bool,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LevelTiming {
+    pub upsample: Duration,
+    pub correct: Duration,
+}
+
+/// The result of a synthesis.
+#[derive(Debug, Clone)]
+pub struct Synthesis {
+    pub heightfield: Heightfield,
+    /// Levels M..0 when kept (index = level).
+    pub levels: Vec<LevelMaps>,
+    pub timings: Timings,
+}
+
+/// Control inputs of one synthesis, per level (index = level; levels the
+/// correction never visits are ignored).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Guides {
+    pub levels: Vec<LevelGuide>,
+    /// Re-synthesize only where this frame can differ from the previous
+    /// one: at each level, the window around the pixels whose inputs
+    /// changed and the children of the parent level's changed pixels,
+    /// widened by how far 4·passes subpasses carry a change. Outside it
+    /// every pixel's inputs equal the previous frame's (a weight may only
+    /// have dropped to frozen, which keeps the previous result), so its
+    /// previous per-pass results are what it would compute: restricted and
+    /// full re-synthesis give the same bytes (tested).
+    pub restrict: bool,
+}
+
+/// One level's control rasters (level-sized, row-major).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LevelGuide {
+    /// Geometric targets (every level: see `control::blend`).
+    pub targets: Option<Vec<Target>>,
+    /// Type target sets R^i (levels ≥ 2).
+    pub allowed: Option<Vec<u32>>,
+    /// Coherence weights W^i in quarters (used when a previous frame exists).
+    pub weights: Option<Vec<u8>>,
+    /// Bounds `[x0, y0, x1, y1)` of the pixels whose own inputs (targets,
+    /// type sets, raised weights, pasted candidates) differ from the
+    /// previous frame's; None if none do. Used when [`Guides::restrict`].
+    pub dirty: Option<[usize; 4]>,
+}

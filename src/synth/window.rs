@@ -1,0 +1,73 @@
+//! The previous frame of a coherent re-synthesis and the bounds of what
+//! changed since it: restricted re-synthesis corrects only the window those
+//! bounds, widened by how far subpasses carry a change, can reach.
+
+use super::fixed::Coord;
+
+/// Subpass reads reach two pixels (DESIGN §5), so within one level a change
+/// spreads at most this far per subpass.
+pub(super) const REACH_PER_SUBPASS: usize = 2;
+
+/// Every corrected level's state after every pass (index = level, then
+/// pass): the previous frame a coherent re-synthesis reads. A pass writes
+/// each pixel once, in its parity class's subpass, so the state after the
+/// pass holds every subpass's result (paper §5.3: "the results for all
+/// sub-passes are needed").
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Frames {
+    pub levels: Vec<Vec<PassResult>>,
+}
+
+/// One level's S and V after one pass.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PassResult {
+    pub coords: Vec<Coord>,
+    pub offsets: Vec<i32>,
+}
+
+/// The union of two optional bounds.
+pub(crate) fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usize; 4]> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some([
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ]),
+        (a, None) => a,
+        (None, b) => b,
+    }
+}
+
+/// The children of a parent level's bounds.
+pub(super) fn double(b: [usize; 4]) -> [usize; 4] {
+    b.map(|v| 2 * v)
+}
+
+/// Bounds grown by `by` on every side, clipped to `w × h`.
+pub(super) fn widen(b: [usize; 4], by: usize, w: usize, h: usize) -> [usize; 4] {
+    [
+        b[0].saturating_sub(by),
+        b[1].saturating_sub(by),
+        (b[2] + by).min(w),
+        (b[3] + by).min(h),
+    ]
+}
+
+/// Bounds of the pixels whose S or V (row-major, `width` wide) differ from
+/// `r`; None if none do.
+pub(super) fn changed_bounds(
+    coords: &[Coord],
+    offsets: &[i32],
+    width: usize,
+    r: &PassResult,
+) -> Option<[usize; 4]> {
+    let mut b: Option<[usize; 4]> = None;
+    for (i, (c, v)) in coords.iter().zip(offsets).enumerate() {
+        if *c != r.coords[i] || *v != r.offsets[i] {
+            let (x, y) = (i % width, i / width);
+            b = union(b, Some([x, y, x + 1, y + 1]));
+        }
+    }
+    b
+}
