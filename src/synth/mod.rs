@@ -25,7 +25,7 @@ pub mod stages;
 pub mod state;
 mod window;
 
-use crate::backend::{Backend, BackendError, Choice, Stage, cpu::Cpu};
+use crate::backend::{Backend, Choice, Stage, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
@@ -117,10 +117,10 @@ impl<'db> Synthesizer<'db> {
         #[cfg(not(feature = "gpu"))]
         match choice {
             Choice::Cpu => Ok(None),
-            Choice::Gpu => Err(BackendError::NotCompiled.into()),
+            Choice::Gpu => Err(crate::backend::BackendError::NotCompiled.into()),
             Choice::Auto => Ok(Some(format!(
                 "{}; using the CPU",
-                BackendError::NotCompiled
+                crate::backend::BackendError::NotCompiled
             ))),
         }
     }
