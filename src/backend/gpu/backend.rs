@@ -1,0 +1,127 @@
+//! [`Backend`] for [`Gpu`]: each method hands over to the stage's own
+//! module.
+
+use super::{Gpu, GpuGuide, GpuRaster, GpuState};
+use crate::backend::{Backend, BackendError, StageTime};
+use crate::synth::fixed::Coord;
+use crate::synth::stages::correct::{CorrectParams, Guide};
+use crate::synth::stages::upsample_jitter::UpsampleParams;
+use crate::synth::state::State;
+
+impl Backend for Gpu {
+    type State = GpuState;
+    type Types = GpuRaster;
+    type Weights = GpuRaster;
+    type Guide<'g> = GpuGuide;
+
+    fn name(&self) -> &'static str {
+        "gpu"
+    }
+
+    fn upload(&self, st: State) -> Result<GpuState, BackendError> {
+        self.upload_state(st)
+    }
+
+    fn alloc(&self, width: usize, height: usize) -> Result<GpuState, BackendError> {
+        self.alloc_state(width, height)
+    }
+
+    fn upsample_jitter(
+        &self,
+        parent: &GpuState,
+        child: &GpuState,
+        level: usize,
+        p: &UpsampleParams,
+    ) {
+        self.dispatch_upsample_jitter(parent, child, level, p)
+    }
+
+    fn correct(&self, st: &GpuState, parent: Option<&GpuState>, level: usize, p: &CorrectParams) {
+        self.dispatch_correct(st, parent, level, p)
+    }
+
+    fn upload_guide(
+        &self,
+        g: &Guide<'_>,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuGuide, BackendError> {
+        self.make_guide(g, width, height)
+    }
+
+    fn correct_guided(
+        &self,
+        st: &GpuState,
+        parent: Option<&GpuState>,
+        level: usize,
+        p: &CorrectParams,
+        g: &GpuGuide,
+    ) {
+        self.dispatch_correct_guided(st, parent, level, p, g)
+    }
+
+    fn reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
+        self.dispatch_reconstruct(st)
+    }
+
+    fn download(&self, st: &GpuState) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {
+        self.download_state(st)
+    }
+
+    fn upload_types(
+        &self,
+        data: &[u32],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        self.upload_raster("type sets", data, width, height)
+    }
+
+    fn upload_weights(
+        &self,
+        data: &[u8],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        self.upload_weight_raster(data, width, height)
+    }
+
+    fn reduce_types(
+        &self,
+        child: &GpuRaster,
+        width: usize,
+        height: usize,
+        full: u32,
+    ) -> Result<GpuRaster, BackendError> {
+        self.dispatch_reduce_types(child, width, height, full)
+    }
+
+    fn reduce_weights(
+        &self,
+        child: &GpuRaster,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        self.dispatch_reduce_weights(child, width, height)
+    }
+
+    fn download_types(&self, r: &GpuRaster) -> Result<Vec<u32>, BackendError> {
+        self.download_type_raster(r)
+    }
+
+    fn download_weights(&self, r: &GpuRaster) -> Result<Vec<u8>, BackendError> {
+        self.download_weight_raster(r)
+    }
+
+    fn finish(&self) -> Result<(), BackendError> {
+        self.ctx.wait()
+    }
+
+    fn has_device_clock(&self) -> bool {
+        self.ctx.profile.is_some()
+    }
+
+    fn device_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {
+        self.ctx.stage_times()
+    }
+}

@@ -1,0 +1,129 @@
+//! The device and its compiled kernels: adapter choice, device creation and
+//! one compute pipeline per WGSL kernel.
+
+use super::timing::{MAX_TIMED, Profile};
+use crate::backend::BackendError;
+use crate::backend::kernels::{self, Kernel};
+use std::sync::{Arc, Mutex};
+
+/// A device with the kernels compiled: create once, share (`Arc`) between
+/// synthesizers — compiling the shaders is the slow part on lavapipe.
+pub struct Context {
+    pub(super) device: wgpu::Device,
+    pub(super) queue: wgpu::Queue,
+    pub(super) info: wgpu::AdapterInfo,
+    pub(super) limits: wgpu::Limits,
+    pub(super) upsample_jitter: wgpu::ComputePipeline,
+    pub(super) correct: wgpu::ComputePipeline,
+    pub(super) reduce_types: wgpu::ComputePipeline,
+    pub(super) reduce_weights: wgpu::ComputePipeline,
+    pub(super) reconstruct: wgpu::ComputePipeline,
+    pub(super) shade: wgpu::ComputePipeline,
+    pub(super) fill_ssd: wgpu::ComputePipeline,
+    /// Timestamp queries, where the adapter has them.
+    pub(super) profile: Option<Mutex<Profile>>,
+}
+
+impl Context {
+    /// The first Vulkan adapter (a hardware one preferred, else the software
+    /// fallback), with every limit it offers.
+    pub fn new() -> Result<Arc<Context>, BackendError> {
+        pollster::block_on(Self::new_async())
+    }
+
+    async fn new_async() -> Result<Arc<Context>, BackendError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::VULKAN;
+        let instance = wgpu::Instance::new(desc);
+        let options = |fallback| wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: fallback,
+            ..Default::default()
+        };
+        let adapter = match instance.request_adapter(&options(false)).await {
+            Ok(a) => a,
+            Err(_) => instance
+                .request_adapter(&options(true))
+                .await
+                .map_err(|e| BackendError::NoAdapter(e.to_string()))?,
+        };
+        let limits = adapter.limits();
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("terrasynth"),
+                required_features: features,
+                required_limits: limits.clone(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| BackendError::Device(e.to_string()))?;
+        let pipeline = |k: Kernel| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(k.name),
+                source: wgpu::ShaderSource::Wgsl(k.module_source().into()),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(k.name),
+                layout: None,
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let upsample_jitter = pipeline(kernels::UPSAMPLE_JITTER);
+        let correct = pipeline(kernels::CORRECT);
+        let reduce_types = pipeline(kernels::REDUCE_TYPES);
+        let reduce_weights = pipeline(kernels::REDUCE_WEIGHTS);
+        let reconstruct = pipeline(kernels::RECONSTRUCT);
+        let shade = pipeline(kernels::SHADE);
+        let fill_ssd = pipeline(kernels::FILL_SSD);
+        if let Some(e) = scope.pop().await {
+            return Err(BackendError::Gpu(e.to_string()));
+        }
+        let profile = features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            Mutex::new(Profile {
+                queries: device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("stage timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2 * MAX_TIMED,
+                }),
+                labels: Vec::new(),
+                overflow: false,
+            })
+        });
+        Ok(Arc::new(Context {
+            profile,
+            info: adapter.get_info(),
+            device,
+            queue,
+            limits,
+            upsample_jitter,
+            correct,
+            reduce_types,
+            reduce_weights,
+            reconstruct,
+            shade,
+            fill_ssd,
+        }))
+    }
+
+    /// Whether stage times come from GPU timestamp queries (else wall clock).
+    pub fn has_timestamps(&self) -> bool {
+        self.profile.is_some()
+    }
+
+    /// The adapter, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
+    pub fn adapter_name(&self) -> String {
+        format!("{} ({:?})", self.info.name, self.info.backend)
+    }
+
+    pub(super) fn wait(&self) -> Result<(), BackendError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| BackendError::Gpu(e.to_string()))
+    }
+}

@@ -1,0 +1,51 @@
+//! Control rasters (type sets, coherence weights) on the device, and their
+//! upload and download.
+
+use super::Gpu;
+use crate::backend::{BackendError, check_raster};
+
+/// One level's control raster on the device, one u32 per pixel: type sets
+/// as they are, coherence weights widened from u8 (see
+/// `kernels/reduce_weights.wgsl`).
+pub struct GpuRaster {
+    pub width: usize,
+    pub height: usize,
+    pub(super) buf: wgpu::Buffer,
+}
+
+impl Gpu {
+    pub(super) fn upload_raster(
+        &self,
+        what: &'static str,
+        data: &[u32],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        check_raster(what, data.len(), width, height)?;
+        Ok(GpuRaster {
+            width,
+            height,
+            buf: self.ctx.storage(what, bytemuck::cast_slice(data))?,
+        })
+    }
+
+    pub(super) fn upload_weight_raster(
+        &self,
+        data: &[u8],
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        let wide: Vec<u32> = data.iter().map(|&w| w as u32).collect();
+        self.upload_raster("coherence weights", &wide, width, height)
+    }
+
+    pub(super) fn download_type_raster(&self, r: &GpuRaster) -> Result<Vec<u32>, BackendError> {
+        Ok(bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?))
+    }
+
+    pub(super) fn download_weight_raster(&self, r: &GpuRaster) -> Result<Vec<u8>, BackendError> {
+        let wide: Vec<u32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?);
+        // Every stored weight is ≤ 255 (an uploaded u8 or a reduction's ≤ 4).
+        Ok(wide.into_iter().map(|w| w as u8).collect())
+    }
+}

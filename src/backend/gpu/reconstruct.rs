@@ -1,0 +1,27 @@
+//! Stage `reconstruct` on the GPU (`kernels/reconstruct.wgsl`): the final
+//! heights, read back to the host.
+
+use super::{Gpu, GpuState, groups};
+use crate::backend::kernels::ReconstructUniform;
+use crate::backend::{BackendError, Stage};
+
+impl Gpu {
+    pub(super) fn dispatch_reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
+        let u = ReconstructUniform {
+            width: st.width as u32,
+            height: st.height as u32,
+            ..Default::default()
+        };
+        let out = self
+            .ctx
+            .storage_empty("heights out", (st.width * st.height * 4) as u64)?;
+        self.ctx.dispatch(
+            Some((Stage::Reconstruct, 0)),
+            &self.ctx.reconstruct,
+            bytemuck::bytes_of(&u),
+            &[&st.s, &st.v, &self.levels[0].columns, &self.heights, &out],
+            (groups(st.width), groups(st.height)),
+        );
+        Ok(bytemuck::pod_collect_to_vec(&self.ctx.read(&out)?))
+    }
+}

@@ -1,0 +1,52 @@
+//! One level's synthesis state on the device, and its upload and download.
+
+use super::Gpu;
+use crate::backend::BackendError;
+use crate::synth::fixed::Coord;
+use crate::synth::state::State;
+
+/// One level's state on the device: S as `vec2<i32>` (the bytes of
+/// `Coord::pack`), V as `i32`.
+pub struct GpuState {
+    pub width: usize,
+    pub height: usize,
+    pub(super) s: wgpu::Buffer,
+    pub(super) v: wgpu::Buffer,
+}
+
+impl Gpu {
+    pub(super) fn upload_state(&self, st: State) -> Result<GpuState, BackendError> {
+        let s: Vec<u64> = st.coords().into_iter().map(Coord::pack).collect();
+        Ok(GpuState {
+            width: st.width,
+            height: st.height,
+            s: self.ctx.storage("state S", bytemuck::cast_slice(&s))?,
+            v: self
+                .ctx
+                .storage("state V", bytemuck::cast_slice(&st.offsets()))?,
+        })
+    }
+
+    pub(super) fn alloc_state(
+        &self,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuState, BackendError> {
+        let n = (width * height) as u64;
+        Ok(GpuState {
+            width,
+            height,
+            s: self.ctx.storage_empty("state S", n * 8)?,
+            v: self.ctx.storage_empty("state V", n * 4)?,
+        })
+    }
+
+    pub(super) fn download_state(
+        &self,
+        st: &GpuState,
+    ) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {
+        let s: Vec<u64> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.s)?);
+        let v: Vec<i32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.v)?);
+        Ok((s.into_iter().map(Coord::unpack).collect(), v))
+    }
+}

@@ -1,0 +1,52 @@
+//! Stage `upsample_jitter` on the GPU (`kernels/upsample_jitter.wgsl`).
+
+use super::{Gpu, GpuState, groups};
+use crate::backend::Stage;
+use crate::backend::kernels::{self, UpsampleUniform};
+use crate::synth::stages::upsample_jitter::{Step, UpsampleParams};
+
+impl Gpu {
+    pub(super) fn dispatch_upsample_jitter(
+        &self,
+        parent: &GpuState,
+        child: &GpuState,
+        level: usize,
+        p: &UpsampleParams,
+    ) {
+        let mut u = UpsampleUniform {
+            child_width: child.width as u32,
+            child_height: child.height as u32,
+            parent_width: parent.width as u32,
+            seed: p.seed,
+            level: p.level,
+            jitter: p.jitter,
+            ..Default::default()
+        };
+        match p.step {
+            Step::Pyramid => u.step = kernels::STEP_PYRAMID,
+            Step::Virtual { shift } => {
+                u.step = kernels::STEP_VIRTUAL;
+                u.shift = shift;
+            }
+            Step::Wrap {
+                min_x,
+                max_x,
+                min_y,
+                max_y,
+            } => {
+                u.step = kernels::STEP_WRAP;
+                (u.min_x, u.max_x, u.min_y, u.max_y) = (min_x, max_x, min_y, max_y);
+            }
+        }
+        // Only the pyramid step reads the columns; the others get the
+        // coarsest level's so that the binding is valid.
+        let columns = &self.levels[level.min(self.levels.len() - 1)].columns;
+        self.ctx.dispatch(
+            Some((Stage::UpsampleJitter, level)),
+            &self.ctx.upsample_jitter,
+            bytemuck::bytes_of(&u),
+            &[&parent.s, &parent.v, &child.s, &child.v, columns],
+            (groups(child.width), groups(child.height)),
+        );
+    }
+}
