@@ -12,12 +12,12 @@
 //! runs them in order, and wgpu orders storage-buffer accesses across
 //! submissions, so one subpass sees the previous one's writes.
 //!
-//! The parts: [`context`] (device and pipelines), [`buffers`] (storage
-//! buffers and read-back), [`dispatch`] (one compute pass), [`timing`]
-//! (timestamp queries), [`database`] (the atlas on the device), [`state`]
-//! and [`rasters`] (per-level data), one module per stage
-//! ([`upsample_jitter`], [`correct`], [`reduce`], [`reconstruct`],
-//! [`shade`]) and [`backend`] (the [`super::Backend`] trait on [`Gpu`]).
+//! The parts: `context` (device and pipelines), `buffers` (storage
+//! buffers and read-back), `dispatch` (one compute pass), `timing`
+//! (timestamp queries), `database` (the atlas on the device), `state`
+//! and `rasters` (per-level data), one module per stage
+//! (`upsample_jitter`, `correct`, `reduce`, `reconstruct`,
+//! `shade`) and `backend` (the [`super::Backend`] trait on [`Gpu`]).
 //! The patch engine's data-parallel cost stage lives in [`fill_ssd`].
 
 mod backend;
