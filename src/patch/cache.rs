@@ -26,14 +26,17 @@ const MAGIC: &[u8; 8] = b"TSPSRC\r\n";
 
 /// The source text of the code that computes [`Features`]: part of the
 /// key, so that a changed algorithm never reads an old entry.
-const CODE: [&str; 7] = [
+const CODE: [&str; 10] = [
     include_str!("candidates.rs"),
     include_str!("ppa.rs"),
     include_str!("graph.rs"),
     include_str!("costs.rs"),
     include_str!("cache.rs"),
     include_str!("../fill.rs"),
-    include_str!("../poisson.rs"),
+    include_str!("../poisson/mod.rs"),
+    include_str!("../poisson/cascadic.rs"),
+    include_str!("../poisson/pcg.rs"),
+    include_str!("../poisson/multigrid.rs"),
 ];
 
 /// FNV-1a, 64-bit: stable across platforms and Rust versions (unlike

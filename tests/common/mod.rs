@@ -10,6 +10,7 @@ pub mod editor;
 pub mod gpu;
 #[cfg(feature = "serve")]
 pub mod http;
+pub mod render;
 
 use terrasynth::io::Format;
 use terrasynth::{Georef, Heightfield};

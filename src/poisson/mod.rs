@@ -1,0 +1,121 @@
+//! A Poisson solver on a masked grid: find `u` on the free pixels such that
+//! `∇²u = f`, with every fixed pixel acting as a Dirichlet boundary value and
+//! the grid border as a Neumann (zero-flux) boundary.
+//!
+//! One solver serves every place that needs it: harmonic nodata filling
+//! (`f = 0`, see [`crate::fill`]), Poisson seam removal and gradient-domain
+//! blending (`f` = divergence of a guidance gradient field).
+//!
+//! Discretisation: the 5-point Laplacian in grid units,
+//! `Σ_{n ∈ N(p)} (u_n − u_p) = f_p`, where `N(p)` are the 4-neighbours inside
+//! the grid (a missing neighbour contributes no flux, which is the Neumann
+//! condition). Restricted to free pixels the negated operator is symmetric
+//! positive definite whenever at least one pixel is fixed, so we use
+//! Jacobi-preconditioned conjugate gradients.
+//!
+//! Speed: plain CG needs O(hole diameter) iterations. A cascadic start
+//! (solve a 2× coarser problem first, recursively, and interpolate it as the
+//! initial guess) removes the low frequencies that CG is slow on, so large
+//! holes converge in tens of iterations per level. For many small solves
+//! (the patch engine's windows), [`solve_mg`] instead preconditions CG with
+//! a multigrid V-cycle and runs sequentially, which needs several times
+//! fewer iterations and no fork-join per vector operation.
+//!
+//! Determinism: every reduction sums fixed-size chunks in index order, so the
+//! result is bit-identical for any number of threads.
+
+mod cascadic;
+mod multigrid;
+mod pcg;
+#[cfg(test)]
+mod tests;
+
+pub use cascadic::solve;
+pub use multigrid::solve_mg;
+
+use thiserror::Error;
+
+/// Why a solve could not run.
+#[non_exhaustive]
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum PoissonError {
+    #[error("buffer length {found} does not match the {width}x{height} grid")]
+    Length {
+        width: usize,
+        height: usize,
+        found: usize,
+    },
+    #[error("no pixel is fixed: the solution is undetermined (at least one known value is needed)")]
+    NothingFixed,
+    #[error(
+        "value at pixel ({x}, {y}) is not finite: fixed values and the right-hand side must be finite"
+    )]
+    NotFinite { x: usize, y: usize },
+}
+
+/// Stopping rule.
+#[derive(Debug, Clone, Copy)]
+pub struct SolveOptions {
+    /// Stop when ‖b − Ax‖₂ ≤ `tolerance` · max(‖b‖₂, 1). The floor of 1 keeps
+    /// the criterion meaningful when the boundary values are all zero.
+    pub tolerance: f64,
+    /// Upper bound on CG iterations on the finest level.
+    pub max_iterations: usize,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            tolerance: 1e-6,
+            max_iterations: 10_000,
+        }
+    }
+}
+
+/// What a solve achieved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveReport {
+    /// Free pixels solved for.
+    pub unknowns: usize,
+    /// CG iterations on the finest level.
+    pub iterations: usize,
+    /// Final relative residual ‖b − Ax‖₂ / max(‖b‖₂, 1).
+    pub relative_residual: f64,
+    /// Whether `relative_residual ≤ tolerance`.
+    pub converged: bool,
+}
+
+/// The checks both solvers make before touching anything: every slice
+/// `width × height` long, fixed values and `f` finite, at least one fixed
+/// pixel (otherwise the solution is defined only up to a constant).
+fn check_inputs(
+    width: usize,
+    height: usize,
+    u: &[f32],
+    fixed: &[bool],
+    rhs: Option<&[f32]>,
+) -> Result<(), PoissonError> {
+    let n = width * height;
+    for len in [u.len(), fixed.len(), rhs.map_or(n, |r| r.len())] {
+        if len != n {
+            return Err(PoissonError::Length {
+                width,
+                height,
+                found: len,
+            });
+        }
+    }
+    for i in 0..n {
+        let bad_fixed = fixed[i] && !u[i].is_finite();
+        if bad_fixed || rhs.is_some_and(|r| !r[i].is_finite()) {
+            return Err(PoissonError::NotFinite {
+                x: i % width,
+                y: i / width,
+            });
+        }
+    }
+    if !fixed.iter().any(|&f| f) {
+        return Err(PoissonError::NothingFixed);
+    }
+    Ok(())
+}

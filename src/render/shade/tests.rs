@@ -1,0 +1,36 @@
+//! The integer helpers against their definitions.
+
+use super::arith::apply_shade;
+use super::lines::on_grid;
+use super::*;
+
+#[test]
+fn isqrt_is_floor_sqrt() {
+    for n in (0..70_000u32).chain([u32::MAX, u32::MAX - 1, 1 << 30, (1 << 30) - 1]) {
+        let r = isqrt(n) as u64;
+        assert!(r * r <= n as u64 && (r + 1) * (r + 1) > n as u64, "{n}");
+    }
+}
+
+#[test]
+fn rounding_helpers() {
+    assert_eq!((floor_div(-7, 5), floor_mod(-7, 5)), (-2, 3));
+    assert_eq!((floor_div(7, 5), floor_mod(7, 5)), (1, 2));
+    assert_eq!((floor_div(-5, 5), floor_mod(-5, 5)), (-1, 0));
+    assert_eq!((shr_sym(-5, 1), shr_sym(5, 1)), (-2, 2));
+    assert_eq!(
+        (shr_round(-6, 2), shr_round(6, 2), shr_round(5, 2)),
+        (-2, 2, 1)
+    );
+    assert!(on_grid(4, 4 * 256) && !on_grid(3, 4 * 256) && !on_grid(0, 256));
+    assert!(on_grid(1, 256) && on_grid(2, 256));
+}
+
+#[test]
+fn blend_ends_are_exact() {
+    let (a, b) = (0x0012_3456, 0x00ab_cdef);
+    assert_eq!(blend(a, b, 0), a);
+    assert_eq!(blend(a, b, FULL), b);
+    assert_eq!(apply_shade(a, FULL), a);
+    assert_eq!(apply_shade(a, 2 * FULL), 0x00ff_ffff);
+}
