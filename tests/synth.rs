@@ -138,39 +138,43 @@ fn the_start_exemplar_dominates_the_result() {
 #[test]
 fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     // The coarse start draws block origins uniformly over every exemplar's
-    // block positions, so each exemplar's share of the blocks follows its
-    // share of the positions (its area), within sampling noise.
+    // interior texels, so each exemplar's share of the blocks follows its
+    // share of the interior area, within sampling noise.
     let l = db().level_count() - 1;
     let atlas = AtlasLevel::new(db(), l);
     let bits = coarse::block_bits(&atlas, None);
     assert!(bits >= 1, "the default exemplars leave room for blocks");
-    let span = (1u32 << bits) - 1;
-    let positions: Vec<f64> = atlas
+    let areas: Vec<f64> = atlas
         .level
         .layout
         .rects
         .iter()
         .map(|r| {
             let c = atlas.columns[r.x0 as usize];
-            let nx = (c.max_x - c.min_x + 1) as u32 - span;
-            let ny = (c.max_y - MARGIN as i32 + 1) as u32 - span;
+            let nx = (c.max_x - c.min_x + 1) as u32;
+            let ny = (c.max_y - MARGIN as i32 + 1) as u32;
             f64::from(nx * ny)
         })
         .collect();
-    let total: f64 = positions.iter().sum();
+    let total: f64 = areas.iter().sum();
     let n = 120;
-    let start = coarse::blocks(&atlas, None, n << (l + bits), n << (l + bits), (l, bits), 5);
-    let mut used = vec![0usize; positions.len()];
-    for i in 0..n * n {
-        let c = start.s(i);
-        let e = atlas
-            .level
-            .layout
-            .exemplar_at(atlas.level.columns, round(c.x) as u32, round(c.y) as u32)
-            .expect("a block origin lies inside an exemplar");
-        used[e] += 1;
+    let side = n << bits;
+    let jitter = 100; // 0.39 texel in fixed point
+    let start = coarse::blocks(&atlas, None, side << l, side << l, (l, bits), 5, jitter);
+    assert_eq!((start.width, start.height), (side, side));
+    let mut used = vec![0usize; areas.len()];
+    for by in 0..n {
+        for bx in 0..n {
+            let c = start.s((by << bits) * side + (bx << bits));
+            let e = atlas
+                .level
+                .layout
+                .exemplar_at(atlas.level.columns, round(c.x) as u32, round(c.y) as u32)
+                .expect("a block origin lies inside an exemplar");
+            used[e] += 1;
+        }
     }
-    for (e, (&u, &p)) in used.iter().zip(&positions).enumerate() {
+    for (e, (&u, &p)) in used.iter().zip(&areas).enumerate() {
         let (got, want) = (u as f64 / (n * n) as f64, p / total);
         // Binomial standard deviation at n² = 14400 draws is < 0.005.
         assert!(
@@ -178,6 +182,37 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
             "exemplar {e}: share {got:.3}, area share {want:.3} ({used:?})"
         );
     }
+}
+
+#[test]
+fn blocks_cover_every_interior_texel_alike_and_stay_inside() {
+    // Blocks wrap inside the interior instead of fitting in it, so texels
+    // at the interior's edges are drawn as often as central ones (blocks
+    // that must fit drew the centre 2^bits times more), and every jittered
+    // coordinate rounds to an interior texel.
+    let l = db().level_count() - 1;
+    let atlas = AtlasLevel::new(db(), l);
+    let bits = coarse::block_bits(&atlas, Some(0));
+    let c = atlas.columns[atlas.level.layout.rects[0].x0 as usize];
+    let (nx, ny) = (
+        (c.max_x - c.min_x + 1) as usize,
+        (c.max_y - MARGIN as i32 + 1) as usize,
+    );
+    let side = 64 << bits;
+    let start = coarse::blocks(&atlas, Some(0), side << l, side << l, (l, bits), 9, 100);
+    let mut hits = vec![0u32; nx];
+    for i in 0..side * side {
+        let s = start.s(i);
+        let (x, y) = (round(s.x), round(s.y));
+        assert!((c.min_x..=c.max_x).contains(&x) && (MARGIN as i32..=c.max_y).contains(&y));
+        hits[(x - c.min_x) as usize] += 1;
+    }
+    let mean = (side * side) as f64 / nx as f64;
+    let (edge, centre) = ((hits[0] + hits[nx - 1]) as f64 / 2.0, hits[nx / 2] as f64);
+    assert!(
+        edge > 0.6 * mean && centre < 1.4 * mean,
+        "edge {edge}, centre {centre}, mean {mean} over {nx}×{ny} interior texels"
+    );
 }
 
 #[test]

@@ -6,13 +6,11 @@
 //! level ≤ L an exact copy of the centre, tiled toroidally when the output
 //! is larger than the exemplar.
 //!
-//! **With jitter**, level `L + b` starts as one hash-chosen position per
-//! pixel — a *block* of 2^b × 2^b texels at level L — from any exemplar,
-//! with probability proportional to how many block positions it has (so
-//! every exemplar, and every terrain type, is drawn by its area). The levels
-//! above L only spread each block (children at `S + (c << shift)`, no
-//! jitter), so level L begins as a mosaic of verbatim exemplar blocks; from
-//! L down the paper's jitter and correction rearrange them.
+//! **With jitter**, level L starts as a mosaic of *blocks* of 2^b × 2^b
+//! texels, each copied verbatim from a hash-chosen origin in any exemplar,
+//! drawn uniformly over every interior texel (so every exemplar, every
+//! terrain type and every part of an exemplar is drawn by its area), plus
+//! the paper's jitter; from L down, jitter and correction rearrange them.
 //!
 //! Why blocks, and why as large as the exemplars allow (b = ⌊log₂⌋ of the
 //! smallest exemplar interior side at L): pixel-based correction can join
@@ -27,8 +25,8 @@
 //! at level 0 average ~100 pixels), and outputs larger than the exemplars
 //! get more blocks rather than a tiled copy.
 //!
-//! Computed on the host for every backend and uploaded: it is tiny
-//! (⌈W/2^(L+b)⌉ × ⌈H/2^(L+b)⌉ pixels), so it has no kernel mirror. Every
+//! Computed on the host for every backend and uploaded: it is small
+//! (level L, ⌈W/2^L⌉ × ⌈H/2^L⌉ pixels), so it has no kernel mirror. Every
 //! choice is a hash of the seed and the block's absolute position
 //! (DESIGN §6), so any window of a terrain starts from the same blocks.
 
@@ -36,6 +34,7 @@ use crate::database::layout::MARGIN;
 use crate::hash::{below, hash4};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::fixed::{Coord, FRAC_BITS};
+use crate::synth::stages::upsample_jitter;
 use crate::synth::state::{State, level_size};
 
 /// Hash salt of the block positions (kept apart from the jitter's
@@ -48,7 +47,7 @@ pub enum Start {
     /// The start exemplar's centre at level M (no jitter, or no room for a
     /// block above L).
     Centre,
-    /// Verbatim blocks of 2^bits level-L texels at level L + bits.
+    /// Verbatim blocks of 2^bits × 2^bits level-L texels, made at level L.
     Blocks { bits: usize },
 }
 
@@ -76,7 +75,7 @@ impl Start {
     pub fn top(self, m: usize, l: usize) -> usize {
         match self {
             Start::Centre => m,
-            Start::Blocks { bits } => l + bits,
+            Start::Blocks { .. } => l,
         }
     }
 }
@@ -109,9 +108,23 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
     side.ilog2() as usize
 }
 
-/// Level `L + bits` of a `width × height` output: each pixel a block origin
-/// drawn uniformly from every block position of exemplar `from` (or of
-/// every exemplar) at L.
+/// Level L of a `width × height` output: the level-`L + bits` pixel above
+/// each 2^bits × 2^bits group of pixels picks one exemplar texel (`hash`
+/// of the seed and the group's position) uniformly over every interior
+/// texel of exemplar `from` (or of every exemplar); the group copies the
+/// exemplar from that origin, wrapping toroidally inside the exemplar's
+/// interior, and each pixel gets the level's jitter (`jitter`, fixed point,
+/// the same hash as `upsample_jitter`).
+///
+/// Why wrap: blocks that must fit the interior start only at the first
+/// `side − 2^bits + 1` texels of each axis, so a texel near an exemplar edge
+/// is covered by one origin where a central one is covered by 2^bits —
+/// measured on the shared DEMs (blocks of 32 in a 43-texel interior), the
+/// output drew 12× more from the exemplar's centre than from its edges,
+/// and real DEMs are not alike across their extent (thuringia: median slope
+/// 6.2° in its centre, 5.0° over all). Wrapping covers every interior texel
+/// equally; the wrap line is one more join, which correction repairs like
+/// the joins between blocks.
 pub fn blocks(
     a: &AtlasLevel<'_>,
     from: Option<usize>,
@@ -119,34 +132,48 @@ pub fn blocks(
     height: usize,
     (l, bits): (usize, usize),
     seed: u32,
+    jitter: i32,
 ) -> State {
-    let span = (1i32 << bits) - 1;
-    // Block origins per exemplar: x in [x0, x1 − span], y in [y0, y1 − span].
-    let ranges: Vec<(i32, i32, u32, u32)> = interiors(a, from)
-        .map(|(x0, x1, y0, y1)| {
-            let nx = (x1 - span - x0 + 1).max(0) as u32;
-            let ny = (y1 - span - y0 + 1).max(0) as u32;
-            (x0, y0, nx, ny)
-        })
+    let mask = (1usize << bits) - 1;
+    // Interior origin and size (x0, y0, nx, ny) per exemplar.
+    let ranges: Vec<(i32, i32, i32, i32)> = interiors(a, from)
+        .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
         .collect();
-    let total: u32 = ranges.iter().map(|&(_, _, nx, ny)| nx * ny).sum();
-    let (w, h) = level_size(width, height, l + bits);
+    let total: u32 = ranges.iter().map(|r| (r.2 * r.3) as u32).sum();
+    let (w, h) = level_size(width, height, l);
     let st = State::new(w, h);
     for y in 0..h {
         for x in 0..w {
-            let hash = hash4(seed, COARSE_SALT, x as u32, y as u32);
+            let hash = hash4(seed, COARSE_SALT, (x >> bits) as u32, (y >> bits) as u32);
             let mut k = below(hash, total);
             for &(x0, y0, nx, ny) in &ranges {
-                if k < nx * ny {
-                    let (tx, ty) = (x0 + (k % nx) as i32, y0 + (k / nx) as i32);
-                    st.set(y * w + x, Coord::from_texel(tx, ty), 0);
+                let n = (nx * ny) as u32;
+                if k < n {
+                    let (bx, by) = ((k % nx as u32) as i32, (k / nx as u32) as i32);
+                    let lx = bx + (x & mask) as i32;
+                    let ly = by + (y & mask) as i32;
+                    let (jx, jy) =
+                        upsample_jitter::jitter(seed, l as u32, x as u32, y as u32, jitter);
+                    let s = Coord {
+                        x: wrap_centred(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
+                        y: wrap_centred(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
+                    };
+                    st.set(y * w + x, s, 0);
                     break;
                 }
-                k -= nx * ny;
+                k -= n;
             }
         }
     }
     st
+}
+
+/// Wraps fixed-point `v` into `[min − ½, min + n − ½)` texels, so that it
+/// rounds (half up) to one of the `n` texels from `min`.
+fn wrap_centred(v: i32, min: i32, n: i32) -> i32 {
+    let half = 1 << (FRAC_BITS - 1);
+    let base = (min << FRAC_BITS) - half;
+    base + (v - base).rem_euclid(n << FRAC_BITS)
 }
 
 /// Level `top` of a `width × height` output without blocks: the centre of

@@ -260,7 +260,7 @@ impl<'db> Synthesizer<'db> {
             if level < top {
                 let t = Instant::now();
                 let child = b.alloc(w, h)?;
-                let p = self.upsample_params(seed, level, start);
+                let p = self.upsample_params(seed, level);
                 b.upsample_jitter(&state, &child, level, &p);
                 if !device_clock {
                     b.finish()?;
@@ -452,26 +452,24 @@ impl<'db> Synthesizer<'db> {
         Ok((start, start.top(m, l), l, timings))
     }
 
-    /// Parameters of the upsampling into level `level`. Above L the levels
-    /// only spread the start (no jitter: blocks stay verbatim, see
-    /// [`coarse`]); jitter begins at L.
-    fn upsample_params(&self, seed: u32, level: usize, start: Start) -> UpsampleParams {
+    /// Parameters of the upsampling into level `level`. Above L (only the
+    /// centre start has levels there) the levels only spread the start;
+    /// jitter begins at L.
+    fn upsample_params(&self, seed: u32, level: usize) -> UpsampleParams {
         let l = self.coarsest();
         UpsampleParams {
             seed,
             level: level as u32,
             jitter: if level > l { 0 } else { self.jitter },
-            step: self.step(level, l, start),
+            step: self.step(level, l),
         }
     }
 
     /// How level `level` is made from the one above.
-    fn step(&self, level: usize, l: usize, start: Start) -> Step {
+    fn step(&self, level: usize, l: usize) -> Step {
         if level < l {
             Step::Pyramid
-        } else if level > l || matches!(start, Start::Blocks { .. }) {
-            // Blocks fit their exemplar's interior, so entering L needs no
-            // wrap (jitter moves a texel by less than half).
+        } else if level > l {
             Step::Virtual {
                 shift: (level - l) as u32,
             }
@@ -494,7 +492,15 @@ impl<'db> Synthesizer<'db> {
         match start {
             Start::Blocks { bits } => {
                 let from = self.params.start_exemplar;
-                coarse::blocks(&self.atlas[l], from, width, height, (l, bits), seed)
+                coarse::blocks(
+                    &self.atlas[l],
+                    from,
+                    width,
+                    height,
+                    (l, bits),
+                    seed,
+                    self.jitter,
+                )
             }
             Start::Centre => {
                 let top = start.top(m, l);

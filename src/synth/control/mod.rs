@@ -51,6 +51,23 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     /// blend skips whole tiles of a level beyond its reach cap with it, so
     /// the finest levels cost a band around the constraint, not its bounds.
     fn distance_bound(&self, x: f64, y: f64) -> f64;
+    /// How tightly it holds the terrain around its site ([`blend`]).
+    fn hold(&self) -> Hold;
+}
+
+/// How tightly a geometric constraint holds the terrain (see [`blend`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hold {
+    /// s of the tolerance cone t = s·d: the terrain may leave the target by
+    /// s metres per metre of distance from the site.
+    pub tolerance_slope: f64,
+    /// At level i the constraint acts within `min(reach, cap·2^i)` output
+    /// pixels (the paper's "min(radius, 4 × 2^d)" with cap 4), or over its
+    /// whole reach at every level (`None`).
+    pub level_cap: Option<f64>,
+    /// No sample reaches farther than this, output pixels (lets the blend
+    /// skip tiles without sampling them).
+    pub max_reach: f64,
 }
 
 /// Invalid control inputs. Messages name the field and the allowed range.

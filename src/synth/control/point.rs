@@ -3,7 +3,7 @@
 //! the site is the plane through it with that slope, so the constraint
 //! shapes both the height at the site and the gradient around it.
 
-use super::{Constraint, ControlError, Sample, check};
+use super::{Constraint, ControlError, Hold, Sample, check};
 
 /// A point constraint, in output pixel coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,6 +100,16 @@ impl Constraint for PointConstraint {
     /// Exact: `sample` reports the Euclidean distance to the site.
     fn distance_bound(&self, x: f64, y: f64) -> f64 {
         (x - self.x).hypot(y - self.y)
+    }
+
+    /// The paper's loose hold: a point pins its site and lets the exemplar
+    /// shape what lies around it (see [`super::blend`]).
+    fn hold(&self) -> Hold {
+        Hold {
+            tolerance_slope: super::blend::S,
+            level_cap: Some(4.0),
+            max_reach: self.radius,
+        }
     }
 }
 

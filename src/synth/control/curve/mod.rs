@@ -31,7 +31,7 @@ pub mod segments;
 pub mod smooth;
 mod spec;
 
-use super::{Constraint, Sample};
+use super::{Constraint, Hold, Sample};
 use field::DistanceField;
 pub use field::FieldCache;
 use glam::DVec2;
@@ -404,6 +404,17 @@ impl Curve {
 }
 
 impl Constraint for Curve {
+    /// A curve's profile (height, slopes, reaches) is the artist's explicit
+    /// shape: held closely over its whole reach at every level (see
+    /// [`super::blend::S_CURVE`]).
+    fn hold(&self) -> Hold {
+        Hold {
+            tolerance_slope: super::blend::S_CURVE,
+            level_cap: None,
+            max_reach: self.field.margin,
+        }
+    }
+
     fn bounds(&self) -> [f64; 4] {
         let f = &self.field;
         [
