@@ -28,7 +28,9 @@ pub mod resample;
 pub mod scene;
 #[cfg(feature = "serve")]
 pub mod server;
+pub mod size;
 pub mod synth;
 
-pub use error::{Error, Result, SizeError};
+pub use error::{Error, Result};
 pub use heightfield::{Georef, Heightfield, Stats};
+pub use size::SizeError;
