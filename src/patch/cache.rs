@@ -15,7 +15,8 @@
 //! concurrent reader never sees half a file). A cache that cannot be
 //! written only costs a rebuild next time.
 
-use super::candidates::{ACROSS, ALONG, Cp, FeatureNode, Features, FillCand, PreparedSource};
+use super::candidates::{FeatureNode, Features, FillCand, PreparedSource};
+use super::control_point::{ACROSS, ALONG, Cp};
 use super::{Params, PatchError};
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! patches (round one, round two, merge), hands the rest to hole filling,
 //! and gives the result its broad shape and level.
 
-use super::candidates::{ACROSS, ALONG, UNIT};
+use super::control_point::{ACROSS, ALONG, UNIT};
 use super::costs::{FEATURE_TRANSFORMS as FEATURE_TRANSFORMS_COUNT, feature_cost};
 use super::merge::{self, Canvas, Window};
 use super::sketch::{Kind, Sketch};

@@ -33,6 +33,7 @@
 
 pub mod cache;
 pub mod candidates;
+pub mod control_point;
 pub mod costs;
 pub mod fill;
 pub mod fill_cost;
