@@ -304,7 +304,7 @@ pub struct Encoded {
 }
 
 /// Encodes a heightfield. Formats that cannot represent nodata refuse a
-/// heightfield that has any (fill it first, see [`crate::fill`]).
+/// heightfield that has any (fill it first, see [`crate::nodata`]).
 pub fn encode(
     hf: &Heightfield,
     format: Format,

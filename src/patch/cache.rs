@@ -33,7 +33,7 @@ const CODE: [&str; 10] = [
     include_str!("graph.rs"),
     include_str!("costs.rs"),
     include_str!("cache.rs"),
-    include_str!("../fill.rs"),
+    include_str!("../nodata.rs"),
     include_str!("../poisson/mod.rs"),
     include_str!("../poisson/cascadic.rs"),
     include_str!("../poisson/pcg.rs"),

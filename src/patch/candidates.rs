@@ -277,7 +277,7 @@ impl PreparedSource {
     ) -> crate::Result<Self> {
         let mut hf = hf.clone();
         if hf.nodata_count() > 0 {
-            crate::fill::fill_nodata(&mut hf)?;
+            crate::nodata::fill_nodata(&mut hf)?;
         }
         let (w, h) = (hf.width(), hf.height());
         let patch = params.patch;
