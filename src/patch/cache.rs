@@ -27,10 +27,11 @@ const MAGIC: &[u8; 8] = b"TSPSRC\r\n";
 
 /// The source text of the code that computes [`Features`]: part of the
 /// key, so that a changed algorithm never reads an old entry.
-const CODE: [&str; 10] = [
+const CODE: [&str; 11] = [
     include_str!("candidates.rs"),
     include_str!("ppa.rs"),
     include_str!("graph.rs"),
+    include_str!("control_point.rs"),
     include_str!("costs.rs"),
     include_str!("cache.rs"),
     include_str!("../nodata.rs"),
