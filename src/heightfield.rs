@@ -8,29 +8,7 @@
 //! reason. The mask view ([`Heightfield::nodata_mask`]) is derived, not stored,
 //! so it cannot disagree with the data.
 
-use crate::error::SizeError;
-
-/// Largest accepted side, in samples. Larger grids are refused before any
-/// allocation (a corrupt header must not make us allocate gigabytes).
-pub const MAX_SIDE: usize = 1 << 20;
-/// Largest accepted sample count (4 GiB of `f32`).
-pub const MAX_PIXELS: usize = 1 << 30;
-
-/// Checks a declared grid size before anything is allocated for it.
-pub fn check_dims(width: usize, height: usize) -> Result<(), SizeError> {
-    if width == 0 || height == 0 {
-        return Err(SizeError::Empty { width, height });
-    }
-    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
-        return Err(SizeError::TooLarge {
-            width,
-            height,
-            max_side: MAX_SIDE,
-            max_pixels: MAX_PIXELS,
-        });
-    }
-    Ok(())
-}
+use crate::size::{SizeError, check_dims};
 
 /// Summary statistics over the valid (non-nodata) samples.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -13,12 +13,12 @@ pub mod blend;
 pub mod database;
 pub mod error;
 pub mod eval;
-pub mod fill;
 pub mod georef;
 pub mod hash;
 pub mod heightfield;
 pub mod io;
 pub mod masks;
+pub mod nodata;
 pub mod patch;
 pub mod poisson;
 pub mod procedural;
@@ -28,7 +28,9 @@ pub mod resample;
 pub mod scene;
 #[cfg(feature = "serve")]
 pub mod server;
+pub mod size;
 pub mod synth;
 
-pub use error::{Error, Result, SizeError};
+pub use error::{Error, Result};
 pub use heightfield::{Georef, Heightfield, Stats};
+pub use size::SizeError;

@@ -4,8 +4,8 @@
 //! into stair-steps). Nodata samples carry no weight; an output sample whose
 //! whole support is nodata stays nodata.
 
-use crate::error::SizeError;
 use crate::heightfield::Heightfield;
+use crate::size::SizeError;
 use rayon::prelude::*;
 
 /// Weights of one output sample along one axis: (first source index, weights).
@@ -39,7 +39,7 @@ fn apply(data: &[f32], stride: usize, (lo, w): &(usize, Vec<f32>)) -> f32 {
 
 /// Resamples to `width × height`; the cell size scales with the width ratio.
 pub fn resample(hf: &Heightfield, width: usize, height: usize) -> Result<Heightfield, SizeError> {
-    crate::heightfield::check_dims(width, height)?;
+    crate::size::check_dims(width, height)?;
     let (sw, sh) = (hf.width(), hf.height());
     let tx = taps(sw, width);
     let ty = taps(sh, height);

@@ -9,13 +9,13 @@ use proptest::prelude::*;
 use std::path::Path;
 use terrasynth::patch::candidates::{COARSE, PreparedSource};
 use terrasynth::patch::costs::{FILL_CLAMP, centre_cells, fill_ssd_scalar, fill_ssd_table};
-use terrasynth::patch::fill::user_cells;
+use terrasynth::patch::hole_fill::user_cells;
 
 mod common;
 use common::dem::DEM;
 
 /// The user's `m × m` cells permuted into every transform's frame, as
-/// `patch::fill` builds them.
+/// `patch::hole_fill` builds them.
 fn perms(cells: &[i32], valid: &[bool], m: usize) -> (Vec<Vec<i32>>, Vec<Vec<i32>>, i64) {
     user_cells(&mut cells.to_vec(), valid, m)
 }
@@ -127,7 +127,7 @@ fn fill_ssd_matches_on_shared_dem_sources() {
 #[test]
 fn sketch_synthesis_matches_end_to_end() {
     use terrasynth::backend::Choice;
-    use terrasynth::patch::fill_cost::FillCost;
+    use terrasynth::patch::fill_ssd::FillCost;
     use terrasynth::patch::sketch::Sketch;
     use terrasynth::patch::{self, Library, Params};
     use terrasynth::progress::Silent;

@@ -167,7 +167,7 @@ fn odd_sizes_do_not_panic() {
     for (w, h) in [(1, 1), (3, 2049), (2049, 3), (1, 700), (2, 1)] {
         let hf = Heightfield::from_fn(w, h, 30.0, |x, y| ((x * 7 + y * 3) % 50) as f32).unwrap();
         let p = render(&hf, &RenderOptions::default()).unwrap();
-        let (ow, oh) = terrasynth::render::resample::fit(w, h, 512, 2048);
+        let (ow, oh) = terrasynth::render::preview_size::fit(w, h, 512, 2048);
         assert_eq!(p.image.dimensions(), (ow as u32, oh as u32));
     }
 }
@@ -192,7 +192,7 @@ proptest! {
         }).unwrap();
         let o = RenderOptions { contours: contour, sea, min_size: 64, ..RenderOptions::default() };
         let p = render(&hf, &o).unwrap();
-        let (ow, oh) = terrasynth::render::resample::fit(w, h, 64, 2048);
+        let (ow, oh) = terrasynth::render::preview_size::fit(w, h, 64, 2048);
         prop_assert_eq!(p.image.dimensions(), (ow as u32, oh as u32));
         prop_assert!(p.image.pixels().all(|px| px[3] == 255));
     }

@@ -7,7 +7,7 @@
 //!   does not raise a plateau;
 //! - [`laplacian`]: multi-resolution blending (§7.4.2, Burt & Adelson) —
 //!   each octave is blended over a distance that matches its size;
-//! - [`poisson`]: gradient-domain blending (§7.4.3, Pérez et al.) — the
+//! - [`gradient_domain`]: Poisson blending (§7.4.3, Pérez et al.) — the
 //!   destination outside the mask is untouched and the source's gradients
 //!   are reproduced inside; built on the crate's one Poisson solver
 //!   ([`crate::poisson`]).
@@ -19,8 +19,8 @@
 //! (`1` = take the source).
 
 pub mod feather;
+pub mod gradient_domain;
 pub mod laplacian;
-pub mod poisson;
 
 use thiserror::Error;
 

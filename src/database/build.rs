@@ -88,7 +88,7 @@ pub fn build(
                     count: nodata,
                 });
             }
-            crate::fill::fill_nodata(&mut ex.heights).map_err(|e| DbError::File {
+            crate::nodata::fill_nodata(&mut ex.heights).map_err(|e| DbError::File {
                 path: ex.name.clone().into(),
                 message: e.to_string(),
             })?;

@@ -46,5 +46,5 @@ pub enum DbError {
     #[error(transparent)]
     Io(#[from] crate::io::IoError),
     #[error(transparent)]
-    Size(#[from] crate::error::SizeError),
+    Size(#[from] crate::size::SizeError),
 }

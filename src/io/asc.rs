@@ -24,7 +24,8 @@
 
 use super::{Encoded, FormatError};
 use crate::georef::{Georef, PixelIs};
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 use std::fmt::Write as _;
 
 const KEYWORDS: &str =

@@ -36,7 +36,7 @@ pub struct CoordsMap {
 
 impl CoordsMap {
     pub fn new(width: usize, height: usize, sources: Vec<Source>) -> Result<Self, FormatError> {
-        crate::heightfield::check_dims(width, height)?;
+        crate::size::check_dims(width, height)?;
         if sources.len() != width * height {
             return Err(FormatError::DimensionMismatch(format!(
                 "{} sources for a {width}x{height} map",

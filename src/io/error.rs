@@ -1,7 +1,7 @@
 //! Errors of the format layer. [`FormatError`] says what is wrong with the
 //! bytes; [`IoError`] adds the file it came from.
 
-use crate::error::SizeError;
+use crate::size::SizeError;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 

@@ -15,7 +15,8 @@
 use super::limits::{DEFLATE_RATIO, PACKBITS_RATIO, check_justified};
 use super::sidecar::DEFAULT_CELL_SIZE_M;
 use super::{Encoded, FormatError};
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 use exr::meta::MetaData;
 use exr::prelude::*;
 // The prelude exports its own `Result`; ours carries a `FormatError`.

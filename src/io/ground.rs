@@ -29,7 +29,8 @@
 
 use super::FormatError;
 use crate::georef::{Crs, Georef, PixelIs, Units};
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 
 /// Relative difference of the two spacings below which cells count as
 /// square (well under the variation of E–W spacing across a 1° tile).

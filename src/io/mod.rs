@@ -7,7 +7,7 @@
 //!   extension, and atomic output (temporary file, then rename — a failed
 //!   write never leaves a partial file behind). Their [`IoError`] names the file.
 //!
-//! Every reader checks declared sizes against [`crate::heightfield::check_dims`]
+//! Every reader checks declared sizes against [`crate::size::check_dims`]
 //! and against what the file's length can justify *before* allocating
 //! (see `limits.rs`).
 //!
@@ -304,7 +304,7 @@ pub struct Encoded {
 }
 
 /// Encodes a heightfield. Formats that cannot represent nodata refuse a
-/// heightfield that has any (fill it first, see [`crate::fill`]).
+/// heightfield that has any (fill it first, see [`crate::nodata`]).
 pub fn encode(
     hf: &Heightfield,
     format: Format,

@@ -10,7 +10,8 @@ use super::limits::{DEFLATE_RATIO, check_justified};
 use super::quantize::{dequantize, quantize16};
 use super::sidecar::Sidecar;
 use super::{Encoded, FormatError};
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 use std::io::Cursor;
 
 /// The bit depth of a greyscale PNG, to choose between 8- and 16-bit decoding.

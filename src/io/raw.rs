@@ -17,7 +17,8 @@
 use super::quantize::{dequantize, quantize16};
 use super::sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
 use super::{Encoded, Format, FormatError};
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 
 pub(super) fn decode16(
     bytes: &[u8],

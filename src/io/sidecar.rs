@@ -280,12 +280,12 @@ fn dimension(obj: &Map<String, Value>, key: &str) -> Result<Option<usize>, Forma
         None | Some(Value::Null) => Ok(None),
         Some(v) => v
             .as_u64()
-            .filter(|&n| n >= 1 && n <= crate::heightfield::MAX_SIDE as u64)
+            .filter(|&n| n >= 1 && n <= crate::size::MAX_SIDE as u64)
             .map(|n| Some(n as usize))
             .ok_or_else(|| {
                 FormatError::InvalidSidecar(format!(
                     "{key} is {v}: expected an integer in 1..={}",
-                    crate::heightfield::MAX_SIDE
+                    crate::size::MAX_SIDE
                 ))
             }),
     }

@@ -16,7 +16,8 @@
 //! has no nodata, so writing refuses NaN.
 
 use super::{Encoded, Format, FormatError};
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 
 const MAGIC: &[u8; 16] = b"TERRAGENTERRAIN ";
 const MARKERS: [&[u8; 4]; 8] = [

@@ -29,7 +29,8 @@ use super::limits::{DEFLATE_RATIO, LZW_RATIO, PACKBITS_RATIO, ZSTD_RATIO, check_
 use super::sidecar::DEFAULT_CELL_SIZE_M;
 use super::{Encoded, FormatError};
 use crate::georef::Georef;
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
+use crate::size::check_dims;
 use std::io::Cursor;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::encoder::{TiffEncoder, colortype::Gray32Float};

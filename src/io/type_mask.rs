@@ -29,7 +29,7 @@ pub struct TypeMask {
 
 impl TypeMask {
     pub fn new(width: usize, height: usize, indices: Vec<u8>) -> Result<TypeMask, FormatError> {
-        crate::heightfield::check_dims(width, height)?;
+        crate::size::check_dims(width, height)?;
         if indices.len() != width * height {
             return Err(FormatError::DimensionMismatch(format!(
                 "{} type indices for a {width}x{height} mask",
@@ -52,9 +52,9 @@ impl TypeMask {
         y: usize,
         w: usize,
         h: usize,
-    ) -> Result<TypeMask, crate::error::SizeError> {
+    ) -> Result<TypeMask, crate::size::SizeError> {
         if w == 0 || h == 0 || x + w > self.width || y + h > self.height {
-            return Err(crate::error::SizeError::Window {
+            return Err(crate::size::SizeError::Window {
                 x,
                 y,
                 w,

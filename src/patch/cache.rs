@@ -15,7 +15,8 @@
 //! concurrent reader never sees half a file). A cache that cannot be
 //! written only costs a rebuild next time.
 
-use super::candidates::{ACROSS, ALONG, Cp, FeatureNode, Features, FillCand, PreparedSource};
+use super::candidates::{FeatureNode, Features, FillCand, PreparedSource};
+use super::control_point::{ACROSS, ALONG, Cp};
 use super::{Params, PatchError};
 use std::path::{Path, PathBuf};
 
@@ -26,13 +27,14 @@ const MAGIC: &[u8; 8] = b"TSPSRC\r\n";
 
 /// The source text of the code that computes [`Features`]: part of the
 /// key, so that a changed algorithm never reads an old entry.
-const CODE: [&str; 10] = [
+const CODE: [&str; 11] = [
     include_str!("candidates.rs"),
     include_str!("ppa.rs"),
     include_str!("graph.rs"),
+    include_str!("control_point.rs"),
     include_str!("costs.rs"),
     include_str!("cache.rs"),
-    include_str!("../fill.rs"),
+    include_str!("../nodata.rs"),
     include_str!("../poisson/mod.rs"),
     include_str!("../poisson/cascadic.rs"),
     include_str!("../poisson/pcg.rs"),

@@ -13,28 +13,12 @@
 //! source on 2 cores to compute, milliseconds to read).
 
 use super::Params;
-use super::costs::{TURN, centre_cells, noise_levels};
+use super::control_point::{ACROSS, ALONG, Cp, TURN, UNIT};
+use super::costs::{centre_cells, noise_levels};
 use super::graph::{FeatureGraph, dist, point_at};
 use super::ppa::{self, PpaParams};
 use super::sketch::Kind;
 use rayon::prelude::*;
-
-/// Samples along the path from the centre to a control point.
-pub const ALONG: usize = 8;
-/// Samples across the path at a control point.
-pub const ACROSS: usize = 7;
-/// Profile value of one prominence.
-pub const UNIT: f32 = 64.0;
-
-/// A control point with its profiles, normalised to the node's prominence.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Cp {
-    pub pos: [f32; 2],
-    /// Direction from the centre, `TURN` units per turn (0 = +x, +y is down).
-    pub angle: u16,
-    pub along: [i16; ALONG],
-    pub across: [i16; ACROSS],
-}
 
 /// A feature patch centre with its control points (sorted by angle).
 #[derive(Debug, Clone, PartialEq)]
@@ -293,7 +277,7 @@ impl PreparedSource {
     ) -> crate::Result<Self> {
         let mut hf = hf.clone();
         if hf.nodata_count() > 0 {
-            crate::fill::fill_nodata(&mut hf)?;
+            crate::nodata::fill_nodata(&mut hf)?;
         }
         let (w, h) = (hf.width(), hf.height());
         let patch = params.patch;

@@ -6,10 +6,7 @@
 //! bit-exact; round two (TPS bending, full-resolution SSD, graph cut) runs
 //! on a handful of candidates per patch on the CPU and uses `f64`.
 
-use super::candidates::{ACROSS, ALONG, Cp};
-
-/// Angle units per turn (control-point angles are `u16`).
-pub const TURN: i32 = 65536;
+use super::control_point::{ACROSS, ALONG, Cp};
 
 /// The 10 feature transforms of seed 004 §4.2: rotations by `k·45°`
 /// (k = 0..8), then mirror in x (`x → −x`) and mirror in y (`y → −y`).

@@ -2,13 +2,13 @@
 //! patches (round one, round two, merge), hands the rest to hole filling,
 //! and gives the result its broad shape and level.
 
-use super::candidates::{ACROSS, ALONG, UNIT};
+use super::control_point::{ACROSS, ALONG, UNIT};
 use super::costs::{FEATURE_TRANSFORMS as FEATURE_TRANSFORMS_COUNT, feature_cost};
 use super::merge::{self, Canvas, Window};
 use super::sketch::{Kind, Sketch};
 use super::{
     Library, PatchError, Scored, Stats, Synthesis, Timings, deform_by_sketch, detrend,
-    feature_warp, fill, fill_cost, graph, remove_drift, round2_cost, sample_warped, select,
+    feature_warp, fill_ssd, graph, hole_fill, remove_drift, round2_cost, sample_warped, select,
     sketch_field, user_patches, user_window,
 };
 use crate::Heightfield;
@@ -33,17 +33,17 @@ pub fn synthesize(
     h: usize,
     progress: &dyn Progress,
 ) -> Result<Synthesis, PatchError> {
-    synthesize_with(lib, sketch, w, h, &fill_cost::FillCost::Cpu, progress)
+    synthesize_with(lib, sketch, w, h, &fill_ssd::FillCost::Cpu, progress)
 }
 
 /// [`synthesize`] with stage `fill_ssd` on the backend `cost` (same bytes
-/// on each; see [`fill_cost`]).
+/// on each; see [`fill_ssd`]).
 pub fn synthesize_with(
     lib: &Library,
     sketch: &Sketch,
     w: usize,
     h: usize,
-    cost: &fill_cost::FillCost,
+    cost: &fill_ssd::FillCost,
     progress: &dyn Progress,
 ) -> Result<Synthesis, PatchError> {
     let params = &lib.params;
@@ -156,7 +156,7 @@ pub fn synthesize_with(
         progress.advance(1);
     }
     progress.finish();
-    fill::fill(
+    hole_fill::fill(
         lib,
         &mut canvas,
         &mut uses,

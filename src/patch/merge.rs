@@ -11,7 +11,7 @@
 //!    small grids, [`crate::poisson::solve_mg`], started from the patch).
 
 use super::graphcut::{Label, Seam, kwatra, min_cut};
-use crate::blend::poisson::guided_rhs;
+use crate::blend::gradient_domain::guided_rhs;
 use crate::poisson::{SolveOptions, SolveReport, solve_mg};
 
 /// The output being synthesized.

@@ -17,7 +17,7 @@
 //!    half-resolution cut, the winner cut coarse to fine in bands),
 //!    Shepard-interpolated gradient correction and a multigrid-preconditioned
 //!    Poisson solve;
-//! 5. [`fill`]: the rest, by priority order, from non-feature candidates
+//! 5. [`hole_fill`]: the rest, by priority order, from non-feature candidates
 //!    under 6 transforms (integer SSD + noise on an 8× reduced grid through
 //!    an explicit-SIMD kernel, then the same second round and merge);
 //! 6. the broad drift of the merge is removed ([`remove_drift`]), the
@@ -33,11 +33,12 @@
 
 pub mod cache;
 pub mod candidates;
+pub mod control_point;
 pub mod costs;
-pub mod fill;
-pub mod fill_cost;
+pub mod fill_ssd;
 pub mod graph;
 pub mod graphcut;
+pub mod hole_fill;
 pub mod merge;
 pub mod ppa;
 pub mod sketch;

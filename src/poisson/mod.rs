@@ -3,7 +3,7 @@
 //! the grid border as a Neumann (zero-flux) boundary.
 //!
 //! One solver serves every place that needs it: harmonic nodata filling
-//! (`f = 0`, see [`crate::fill`]), Poisson seam removal and gradient-domain
+//! (`f = 0`, see [`crate::nodata`]), Poisson seam removal and gradient-domain
 //! blending (`f` = divergence of a guidance gradient field).
 //!
 //! Discretisation: the 5-point Laplacian in grid units,

@@ -1,7 +1,7 @@
 //! Errors of the procedural toolbox: parameters out of range and inputs the
 //! generators cannot work on. Messages name the parameter and its allowed range.
 
-use crate::error::SizeError;
+use crate::size::SizeError;
 use thiserror::Error;
 
 /// A procedural parameter or input that cannot be used.

@@ -26,8 +26,9 @@ use super::remap;
 use super::thermal::{ThermalParams, thermal_erode};
 use super::types::TypeMask;
 use super::warp::Warp;
-use crate::heightfield::{Heightfield, check_dims};
+use crate::heightfield::Heightfield;
 use crate::progress::Progress;
+use crate::size::check_dims;
 
 /// Cell size of the generated terrain, in metres (a typical DEM posting).
 pub const CELL_SIZE_M: f64 = 30.0;

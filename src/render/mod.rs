@@ -22,7 +22,7 @@ mod error;
 pub mod font;
 pub mod overlay;
 pub mod prepare;
-pub mod resample;
+pub mod preview_size;
 pub mod shade;
 pub mod tint;
 pub mod types;

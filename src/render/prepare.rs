@@ -11,7 +11,7 @@ use super::contours::{self, Contours};
 use super::shade::{self, ShadeBuffers, ShadeParams, flags};
 use super::tint::{self, pack};
 use super::types::TypeOverlay;
-use super::{Grid, Lighting, RenderError, RenderOptions, Sea, resample};
+use super::{Grid, Lighting, RenderError, RenderOptions, Sea, preview_size};
 use crate::heightfield::Heightfield;
 
 /// Kernel height units per metre (millimetres).
@@ -80,8 +80,8 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
     }
     let (w, h) = (hf.width(), hf.height());
     // The minimum is a wish and yields to the maximum.
-    let (ow, oh) = resample::fit(w, h, o.min_size.min(o.max_size), o.max_size);
-    let resized = resample::heights(hf.data(), w, h, ow, oh);
+    let (ow, oh) = preview_size::fit(w, h, o.min_size.min(o.max_size), o.max_size);
+    let resized = preview_size::heights(hf.data(), w, h, ow, oh);
     let heights: Vec<i32> = resized.iter().map(|&v| quantize(v as f64)).collect();
     let (sx, sy) = (ow as f64 / w as f64, oh as f64 / h as f64);
     let cell_x = hf.cell_size() / sx;
@@ -204,7 +204,7 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         Some(t) => {
             p.flags |= flags::TYPES;
             let m = &t.mask;
-            let idx = resample::nearest(&m.indices, m.width, m.height, ow, oh);
+            let idx = preview_size::nearest(&m.indices, m.width, m.height, ow, oh);
             let packed = idx
                 .chunks(4)
                 .map(|c| {

@@ -216,7 +216,7 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
         return Err(ServeError::NotLoopback(config.bind));
     }
     let (width, height) = config.size;
-    crate::heightfield::check_dims(width, height)
+    crate::size::check_dims(width, height)
         .map_err(|e| ServeError::Size(width, height, e.to_string()))?;
     let (mut app, source) = prepare(&config)?;
     let listener = std::net::TcpListener::bind(config.bind).map_err(|source| ServeError::Bind {

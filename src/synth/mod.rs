@@ -435,7 +435,7 @@ impl<'db> Synthesizer<'db> {
         width: usize,
         height: usize,
     ) -> Result<(Start, usize, usize, Timings), SynthError> {
-        crate::heightfield::check_dims(width, height)?;
+        crate::size::check_dims(width, height)?;
         let m = top_level(width, height);
         let l = self.coarsest();
         let timings = Timings {

@@ -54,7 +54,7 @@ pub enum SynthError {
     #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
     StartExemplar { index: usize, count: usize },
     #[error(transparent)]
-    Size(#[from] crate::error::SizeError),
+    Size(#[from] crate::size::SizeError),
     #[error(transparent)]
     Backend(#[from] BackendError),
 }

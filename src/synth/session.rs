@@ -125,7 +125,7 @@ impl<'db> Session<'db> {
         height: usize,
         seed: u32,
     ) -> Result<Session<'db>, SessionError> {
-        crate::heightfield::check_dims(width, height).map_err(SynthError::from)?;
+        crate::size::check_dims(width, height).map_err(SynthError::from)?;
         let synth = Synthesizer::new(db, params)?;
         let last = (db.level_count() - 1).min(top_level(width, height));
         let pasted = (0..=last)

@@ -41,7 +41,7 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     let mut hf = a.read.read(&a.input)?;
     if a.fill_nodata {
-        let report = terrasynth::fill::fill_nodata(&mut hf)?;
+        let report = terrasynth::nodata::fill_nodata(&mut hf)?;
         if report.filled > 0 {
             eprintln!("filled {} nodata samples", report.filled);
         }

@@ -6,7 +6,7 @@ use crate::args::{BackendArg, Input, parse_size};
 use crate::progress::Bar;
 use std::path::PathBuf;
 use terrasynth::io::{self, WriteOptions};
-use terrasynth::patch::{self, Library, Params, fill_cost::FillCost, sketch::Sketch};
+use terrasynth::patch::{self, Library, Params, fill_ssd::FillCost, sketch::Sketch};
 use terrasynth::render::{self, RenderOptions};
 
 const ABOUT: &str = "\

@@ -60,7 +60,7 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
             ));
         }
     };
-    crate::heightfield::check_dims(size.0, size.1).map_err(|e| {
+    crate::size::check_dims(size.0, size.1).map_err(|e| {
         r.invalid(
             "size",
             size_v,

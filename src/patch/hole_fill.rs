@@ -11,14 +11,14 @@
 //! (four 90° rotations and two mirrors, which need no resampling). Round
 //! one is integer and data-parallel: DC-corrected SSD against the window's
 //! fully filled 8×8 cells on the 8× reduced grid (stage `fill_ssd`, explicit
-//! SIMD or the GPU: [`super::fill_cost`]), plus the noise-variance difference; the user window is permuted
+//! SIMD or the GPU: [`super::fill_ssd`]), plus the noise-variance difference; the user window is permuted
 //! into each transform's frame once, and every candidate's cells are stored
 //! contiguously, so the kernel streams both. The best 5 per
 //! source go to round two and the graph-cut finalists ([`super::select`]).
 
 use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
 use super::costs::{centre_cells, noise_cost};
-use super::fill_cost::FillCost;
+use super::fill_ssd::FillCost;
 use super::merge::{self, Canvas, Window};
 use super::{
     Library, PatchError, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window,

@@ -1,0 +1,62 @@
+//! Grid-size validation: [`SizeError`] and the limits every reader and
+//! constructor checks a declared size against ([`check_dims`]) before it
+//! allocates. Kept apart from [`crate::error`] and [`crate::heightfield`] so
+//! that the per-area error types (`io`, `database`, `render`, …) can wrap
+//! `SizeError` without depending on the crate-wide [`crate::error::Error`],
+//! which in turn wraps them.
+
+use thiserror::Error;
+
+/// A grid size, window or cell size that cannot be used.
+#[non_exhaustive]
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SizeError {
+    #[error("size {width}x{height} is empty: width and height must be at least 1")]
+    Empty { width: usize, height: usize },
+    #[error(
+        "size {width}x{height} is too large: at most {max_side} per side and {max_pixels} samples"
+    )]
+    TooLarge {
+        width: usize,
+        height: usize,
+        max_side: usize,
+        max_pixels: usize,
+    },
+    #[error("sample count {found} does not match the size ({expected} expected)")]
+    Length { expected: usize, found: usize },
+    #[error("sample at pixel ({x}, {y}) is infinite: heights must be finite, or NaN for nodata")]
+    Infinite { x: usize, y: usize },
+    #[error("cell size {0} m is invalid: expected a finite value > 0")]
+    CellSize(f64),
+    #[error("window {w}x{h} at ({x}, {y}) does not fit a {width}x{height} grid")]
+    Window {
+        x: usize,
+        y: usize,
+        w: usize,
+        h: usize,
+        width: usize,
+        height: usize,
+    },
+}
+
+/// Largest accepted side, in samples. Larger grids are refused before any
+/// allocation (a corrupt header must not make us allocate gigabytes).
+pub const MAX_SIDE: usize = 1 << 20;
+/// Largest accepted sample count (4 GiB of `f32`).
+pub const MAX_PIXELS: usize = 1 << 30;
+
+/// Checks a declared grid size before anything is allocated for it.
+pub fn check_dims(width: usize, height: usize) -> Result<(), SizeError> {
+    if width == 0 || height == 0 {
+        return Err(SizeError::Empty { width, height });
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
+        return Err(SizeError::TooLarge {
+            width,
+            height,
+            max_side: MAX_SIDE,
+            max_pixels: MAX_PIXELS,
+        });
+    }
+    Ok(())
+}
