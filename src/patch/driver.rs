@@ -192,7 +192,8 @@ pub fn synthesize_with(
 }
 
 /// The output's cell size: the median of the sources' (patches are copied
-/// pixel for pixel, without resampling to a common cell size).
+/// pixel for pixel; the library has brought the sources to one cell size
+/// within 1 %).
 fn median_cell(lib: &Library) -> f64 {
     let mut c: Vec<f64> = lib.sources.iter().map(|s| s.cell_size).collect();
     c.sort_by(f64::total_cmp);

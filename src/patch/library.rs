@@ -6,6 +6,7 @@ use super::candidates::{self, PreparedSource};
 use super::{Params, PatchError, cache};
 use crate::Heightfield;
 use crate::progress::Progress;
+use crate::resample::resample;
 
 /// Prepared sources, reusable across sketches (the cache of seed 004 §5.4).
 #[derive(Debug, Clone)]
@@ -54,12 +55,14 @@ impl Library {
         if sources.is_empty() {
             return Err(PatchError::NoSources);
         }
+        let sources = &common_cell(sources)?;
         for (name, hf) in sources {
             if hf.width() < 2 * params.patch || hf.height() < 2 * params.patch {
                 return Err(PatchError::SourceSize {
                     name: name.clone(),
                     width: hf.width(),
                     height: hf.height(),
+                    cell_m: hf.cell_size(),
                     patch: params.patch,
                 });
             }
@@ -110,5 +113,68 @@ impl Library {
             },
             hits,
         ))
+    }
+}
+
+/// The sources on one grid: each resampled to the median of their cell
+/// sizes (area-weighted when reducing, `crate::resample`) unless it is
+/// within 1 % of it.
+///
+/// Why: patches are copied pixel for pixel, so a source at another cell
+/// size would keep its pixel scale in the output — a 30 m DEM among 92 m
+/// ones would enter 3× wider than it is on the ground, its slopes a third
+/// as steep. (On sketch river_ranges.json with the eight shared DEMs, six
+/// of them at 92 m, the output's median slope goes 7.6° → 8.1°: the 8-source
+/// softness has other causes, see issue 14's notes.)
+fn common_cell(
+    sources: &[(String, Heightfield)],
+) -> Result<Vec<(String, Heightfield)>, PatchError> {
+    let mut cells: Vec<f64> = sources.iter().map(|(_, hf)| hf.cell_size()).collect();
+    cells.sort_by(f64::total_cmp);
+    let cell = cells[cells.len() / 2];
+    sources
+        .iter()
+        .map(|(name, hf)| {
+            let k = hf.cell_size() / cell;
+            if (k - 1.0).abs() <= 0.01 {
+                return Ok((name.clone(), hf.clone()));
+            }
+            let (w, h) = (
+                ((hf.width() as f64 * k).round() as usize).max(1),
+                ((hf.height() as f64 * k).round() as usize).max(1),
+            );
+            let r = resample(hf, w, h).map_err(crate::Error::from)?;
+            Ok((name.clone(), r))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(n: usize, cell: f64) -> (String, Heightfield) {
+        let mut hf = Heightfield::new(n, n, cell).unwrap();
+        for (k, v) in hf.data_mut().iter_mut().enumerate() {
+            *v = (k % n) as f32 * cell as f32 * 0.5;
+        }
+        (format!("{n}@{cell}"), hf)
+    }
+
+    #[test]
+    fn sources_are_brought_to_the_median_cell_size() {
+        let out = common_cell(&[ramp(300, 30.0), ramp(100, 90.0), ramp(101, 90.5)]).unwrap();
+        let sizes: Vec<(usize, f64)> = out
+            .iter()
+            .map(|(_, h)| (h.width(), h.cell_size()))
+            .collect();
+        // The 30 m source shrinks 3×, the 90.5 m one is within 1 % and kept
+        // bit for bit; the ground slope (0.5 m/m) survives resampling.
+        assert_eq!(sizes[0].0, 100);
+        assert!((sizes[0].1 - 90.0).abs() < 1e-9, "{sizes:?}");
+        assert_eq!(out[2].1, ramp(101, 90.5).1);
+        let r = &out[0].1;
+        let slope = (r.get(60, 50) - r.get(40, 50)) as f64 / (20.0 * r.cell_size());
+        assert!((slope - 0.5).abs() < 0.01, "slope {slope}");
     }
 }

@@ -21,12 +21,13 @@ pub enum PatchError {
     #[error("no source DEM was given: at least one is needed")]
     NoSources,
     #[error(
-        "source {name} is {width}x{height}: each side must be at least 2x the patch size {patch}"
+        "source {name} is {width}x{height} at {cell_m} m cells (the sources' common cell size: each is resampled to the median of theirs): each side must be at least 2x the patch size {patch}"
     )]
     SourceSize {
         name: String,
         width: usize,
         height: usize,
+        cell_m: f64,
         patch: usize,
     },
     #[error("source {name} was prepared for patch size {found}, not {expected}")]
