@@ -124,8 +124,8 @@ impl Library {
 /// size would keep its pixel scale in the output — a 30 m DEM among 92 m
 /// ones would enter 3× wider than it is on the ground, its slopes a third
 /// as steep. (On sketch river_ranges.json with the eight shared DEMs, six
-/// of them at 92 m, the output's median slope goes 7.6° → 8.1°: the 8-source
-/// softness has other causes, see issue 14's notes.)
+/// of them at 92 m, the output's median slope goes 7.6° → 8.1° only: the
+/// softness of many-source outputs has other causes.)
 fn common_cell(
     sources: &[(String, Heightfield)],
 ) -> Result<Vec<(String, Heightfield)>, PatchError> {
