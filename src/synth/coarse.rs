@@ -23,7 +23,10 @@
 //! Large blocks keep the exemplars' massifs and valley networks; the output
 //! still differs from any exemplar below the block scale (coherent patches
 //! at level 0 average ~100 pixels), and outputs larger than the exemplars
-//! get more blocks rather than a tiled copy.
+//! get more blocks rather than a tiled copy. Halving the blocks (b − 1)
+//! was measured too: relief ≥ 85 % on 2 of the 8 DEMs instead of 4, and
+//! "hills" took 69 % of a typed output where they are 48 % of the
+//! exemplars — every join is levelled towards the middle.
 //!
 //! Computed on the host for every backend and uploaded: it is small
 //! (level L, ⌈W/2^L⌉ × ⌈H/2^L⌉ pixels), so it has no kernel mirror. Every
