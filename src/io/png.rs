@@ -95,6 +95,11 @@ pub(super) fn encode16(
         let mut enc = png::Encoder::new(&mut out, hf.width() as u32, hf.height() as u32);
         enc.set_color(png::ColorType::Grayscale);
         enc.set_depth(png::BitDepth::Sixteen);
+        // Fast (fdeflate) rather than the default zlib level: on one core
+        // the default took 150 ms of a 0.52 s `synth --size 1024x1024 -o
+        // x.png` (synthesis itself 0.36 s on two); Fast makes the whole
+        // process 0.35 s for files 10 % larger, same samples.
+        enc.set_compression(png::Compression::Fast);
         let mut w = enc
             .write_header()
             .map_err(|e| FormatError::Unwritable(e.to_string()))?;
