@@ -51,8 +51,8 @@ pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i
                 .map(|n| {
                     let s = st.s(n);
                     let (tx, ty) = (round(s.x), round(s.y));
-                    let c = &atlas.columns[tx as usize];
-                    (c.base + ty * c.stride as i32 + tx, c.stride as i32, st.v(n))
+                    let stride = atlas.columns[tx as usize].stride as i32;
+                    (atlas.index(tx, ty) as i32, stride, st.v(n))
                 })
                 .collect();
             for (r, row) in block.chunks_mut(w).enumerate() {
