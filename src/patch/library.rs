@@ -7,6 +7,7 @@ use super::{Params, PatchError, cache};
 use crate::Heightfield;
 use crate::progress::Progress;
 use crate::resample::resample;
+use std::borrow::Cow;
 
 /// Prepared sources, reusable across sketches (the cache of seed 004 §5.4).
 #[derive(Debug, Clone)]
@@ -59,7 +60,7 @@ impl Library {
         for (name, hf) in sources {
             if hf.width() < 2 * params.patch || hf.height() < 2 * params.patch {
                 return Err(PatchError::SourceSize {
-                    name: name.clone(),
+                    name: name.to_string(),
                     width: hf.width(),
                     height: hf.height(),
                     cell_m: hf.cell_size(),
@@ -128,7 +129,7 @@ impl Library {
 /// softness of many-source outputs has other causes.)
 fn common_cell(
     sources: &[(String, Heightfield)],
-) -> Result<Vec<(String, Heightfield)>, PatchError> {
+) -> Result<Vec<(&str, Cow<'_, Heightfield>)>, PatchError> {
     let mut cells: Vec<f64> = sources.iter().map(|(_, hf)| hf.cell_size()).collect();
     cells.sort_by(f64::total_cmp);
     let cell = cells[cells.len() / 2];
@@ -137,14 +138,14 @@ fn common_cell(
         .map(|(name, hf)| {
             let k = hf.cell_size() / cell;
             if (k - 1.0).abs() <= 0.01 {
-                return Ok((name.clone(), hf.clone()));
+                return Ok((name.as_str(), Cow::Borrowed(hf)));
             }
             let (w, h) = (
                 ((hf.width() as f64 * k).round() as usize).max(1),
                 ((hf.height() as f64 * k).round() as usize).max(1),
             );
             let r = resample(hf, w, h).map_err(crate::Error::from)?;
-            Ok((name.clone(), r))
+            Ok((name.as_str(), Cow::Owned(r)))
         })
         .collect()
 }
@@ -163,16 +164,18 @@ mod tests {
 
     #[test]
     fn sources_are_brought_to_the_median_cell_size() {
-        let out = common_cell(&[ramp(300, 30.0), ramp(100, 90.0), ramp(101, 90.5)]).unwrap();
+        let sources = [ramp(300, 30.0), ramp(100, 90.0), ramp(101, 90.5)];
+        let out = common_cell(&sources).unwrap();
         let sizes: Vec<(usize, f64)> = out
             .iter()
             .map(|(_, h)| (h.width(), h.cell_size()))
             .collect();
         // The 30 m source shrinks 3×, the 90.5 m one is within 1 % and kept
-        // bit for bit; the ground slope (0.5 m/m) survives resampling.
+        // as it is (borrowed); the ground slope (0.5 m/m) survives resampling.
         assert_eq!(sizes[0].0, 100);
         assert!((sizes[0].1 - 90.0).abs() < 1e-9, "{sizes:?}");
-        assert_eq!(out[2].1, ramp(101, 90.5).1);
+        assert!(matches!(out[2].1, Cow::Borrowed(_)), "kept without a copy");
+        assert_eq!(*out[2].1, ramp(101, 90.5).1);
         let r = &out[0].1;
         let slope = (r.get(60, 50) - r.get(40, 50)) as f64 / (20.0 * r.cell_size());
         assert!((slope - 0.5).abs() < 0.01, "slope {slope}");
