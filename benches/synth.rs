@@ -43,6 +43,7 @@ fn bench(c: &mut Criterion) {
             level: 0,
             jitter: 102,
             step: Step::Pyramid,
+            origin: [0, 0],
         };
         b.iter(|| upsample_jitter::upsample_jitter(black_box(&l1), &child, Some(&atlas), &p))
     });

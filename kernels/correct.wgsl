@@ -30,7 +30,13 @@ struct CorrectParams {
     parent_width: u32,
     parent_height: u32,
     has_parent: u32,
+    // Absolute position of the state's pixel (0, 0) (Guide::origin): type
+    // seeding hashes absolute coordinates.
+    origin_x: u32,
+    origin_y: u32,
     pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 const F_TARGETS: u32 = 1u;
@@ -426,7 +432,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             seeded = true;
             for (var k = 0u; k < SEEDS_PER_ALLOWED_TYPE; k++) {
                 let salt = t * SEEDS_PER_ALLOWED_TYPE + k;
-                let hash = hash4(SEED_SALT | p.level, salt, ux, uy);
+                let hash = hash4(SEED_SALT | p.level, salt, p.origin_x + ux, p.origin_y + uy);
                 let c = type_data[p.type_count + t * SEEDS_PER_TYPE + below(hash, count)];
                 let q = vec2<i32>(i32(c & 0xFFFFu), i32(c >> 16u));
                 let r = score(ns, q.x, q.y, 1u);

@@ -19,6 +19,12 @@ struct UpsampleParams {
     max_x: i32,
     min_y: i32,
     max_y: i32,
+    // Absolute position of the child buffer's pixel (0, 0) (even; the
+    // jitter hashes absolute coordinates).
+    origin_x: u32,
+    origin_y: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> p: UpsampleParams;
@@ -65,7 +71,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let cx = i32(x & 1u);
     let cy = i32(y & 1u);
     let s = parent_s[pi];
-    let j = jitter(p.seed, p.level, x, y, p.jitter);
+    let j = jitter(p.seed, p.level, p.origin_x + x, p.origin_y + y, p.jitter);
     let off_x = (cx << FRAC_BITS) + j.x;
     let off_y = (cy << FRAC_BITS) + j.y;
     var out: vec2<i32>;

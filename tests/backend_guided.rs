@@ -189,6 +189,8 @@ proptest! {
             allowed: (flags & 2 != 0).then_some(&allowed[..]),
             coherence: (flags & 4 != 0).then_some(Coherence { coords: &coords, offsets: &offsets, weights: &weights }),
             window,
+            // Windowed synthesis: type seeding hashes absolute coordinates.
+            origin: [b(0, 10) % 65536 * 2, b(0, 11) % 65536 * 2],
         };
         let (px, py) = SUBPASSES[sub];
         let parent = random_state(a, w.div_ceil(2), h.div_ceil(2), &bits, 0x5EED);
@@ -306,6 +308,7 @@ fn guided_correct_matches_on_real_guides() {
                 weights: lg.weights.as_deref().unwrap(),
             }),
             window: None,
+            origin: [0, 0],
         };
         // With frame 1's results, and without (a first frame: every pixel
         // picks a k-coherence candidate or a seed, then is nudged).

@@ -146,7 +146,11 @@ fn parameter_structs_match_their_wgsl_declarations() {
             min_x,
             max_x,
             min_y,
-            max_y
+            max_y,
+            origin_x,
+            origin_y,
+            pad0,
+            pad1
         })
     );
     assert_eq!(
@@ -167,7 +171,11 @@ fn parameter_structs_match_their_wgsl_declarations() {
             parent_width,
             parent_height,
             has_parent,
-            pad0
+            origin_x,
+            origin_y,
+            pad0,
+            pad1,
+            pad2
         })
     );
     assert_eq!(

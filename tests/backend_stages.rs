@@ -241,7 +241,10 @@ proptest! {
             }
         };
         let parent = random_state(&pair.atlas[parent_level], w, h, &bits);
-        let p = UpsampleParams { seed, level: level as u32, jitter, step };
+        // Windowed synthesis: the jitter hashes absolute (even-cornered)
+        // coordinates.
+        let origin = [bits[1] % 65536 * 2, bits[2] % 65536 * 2];
+        let p = UpsampleParams { seed, level: level as u32, jitter, step, origin };
         check_upsample(pair, &parent, (cw.max(2), ch.max(2)), level, &p);
     }
 
@@ -293,6 +296,7 @@ fn check_real_states(db: &Database, ctx: Arc<Context>, (w, h): (usize, usize), s
                 level: level as u32,
                 jitter: 102,
                 step: Step::Pyramid,
+                origin: [0, 0],
             };
             check_upsample(&pair, &st, child, level, &p);
         }

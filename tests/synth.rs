@@ -7,6 +7,7 @@ use terrasynth::database::layout::MARGIN;
 use terrasynth::database::{Database, default};
 use terrasynth::progress::Silent;
 use terrasynth::synth::atlas::AtlasLevel;
+use terrasynth::synth::cone::Rect;
 use terrasynth::synth::fixed::{FRAC_BITS, round};
 use terrasynth::synth::{Params, Synthesizer, coarse};
 
@@ -160,7 +161,14 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     let n = 120;
     let side = n << bits;
     let jitter = 100; // 0.39 texel in fixed point
-    let start = coarse::blocks(&atlas, None, side << l, side << l, (l, bits), 5, jitter);
+    let start = coarse::blocks(
+        &atlas,
+        None,
+        Rect::new(0, 0, side, side),
+        (l, bits),
+        5,
+        jitter,
+    );
     assert_eq!((start.width, start.height), (side, side));
     let mut used = vec![0usize; areas.len()];
     for by in 0..n {
@@ -199,7 +207,14 @@ fn blocks_cover_every_interior_texel_alike_and_stay_inside() {
         (c.max_y - MARGIN as i32 + 1) as usize,
     );
     let side = 64 << bits;
-    let start = coarse::blocks(&atlas, Some(0), side << l, side << l, (l, bits), 9, 100);
+    let start = coarse::blocks(
+        &atlas,
+        Some(0),
+        Rect::new(0, 0, side, side),
+        (l, bits),
+        9,
+        100,
+    );
     let mut hits = vec![0u32; nx];
     for i in 0..side * side {
         let s = start.s(i);

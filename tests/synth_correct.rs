@@ -242,6 +242,7 @@ proptest! {
             }),
             allowed: (which & 4 != 0).then_some(&allowed[..]),
             window: (which & 8 != 0).then_some(window),
+            origin: [(seed as u32 % 4096) * 2, (seed >> 32) as u32 % 4096 * 2],
         };
         let parent = random_parent(&atlas, w, h, seed);
         let what = format!("guided {which:04b} {w}x{h} at level {level}");

@@ -36,6 +36,10 @@ impl Backend for Cpu<'_, '_> {
         Ok(State::new(width, height))
     }
 
+    fn crop(&self, st: &State, rect: [usize; 4]) -> Result<State, BackendError> {
+        Ok(st.crop(rect))
+    }
+
     fn upsample_jitter(&self, parent: &State, child: &State, level: usize, p: &UpsampleParams) {
         let atlas = matches!(p.step, Step::Pyramid).then(|| &self.atlas[level]);
         upsample_jitter::upsample_jitter(parent, child, atlas, p);

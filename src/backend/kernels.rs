@@ -89,6 +89,11 @@ pub struct UpsampleUniform {
     pub max_x: i32,
     pub min_y: i32,
     pub max_y: i32,
+    /// `UpsampleParams::origin`.
+    pub origin_x: u32,
+    pub origin_y: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }
 
 /// `CorrectParams` of `kernels/correct.wgsl`.
@@ -117,7 +122,12 @@ pub struct CorrectUniform {
     pub parent_width: u32,
     pub parent_height: u32,
     pub has_parent: u32,
+    /// `Guide::origin` (the type-seeding hash reads absolute coordinates).
+    pub origin_x: u32,
+    pub origin_y: u32,
     pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// `GuideCell` of `kernels/correct.wgsl`: one pixel's control inputs of

@@ -70,6 +70,11 @@ pub trait Backend {
     fn upload(&self, st: State) -> Result<Self::State, BackendError>;
     /// A `width × height` state whose contents the next stage overwrites.
     fn alloc(&self, width: usize, height: usize) -> Result<Self::State, BackendError>;
+    /// A copy of the pixels `[x0, x1) × [y0, y1)` of a state: windowed
+    /// synthesis keeps of the level above only what the next level reads
+    /// (`synth::cone::Cone::parent_crop`), so that the stages' parent of
+    /// pixel p stays at p / 2 in the buffers.
+    fn crop(&self, st: &Self::State, rect: [usize; 4]) -> Result<Self::State, BackendError>;
     /// Stage `upsample_jitter` into `child` (level `level`, the child's).
     fn upsample_jitter(
         &self,

@@ -36,6 +36,7 @@
 use crate::database::layout::MARGIN;
 use crate::hash::{below, hash4};
 use crate::synth::atlas::AtlasLevel;
+use crate::synth::cone::Rect;
 use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::stages::upsample_jitter;
 use crate::synth::state::{State, level_size};
@@ -111,7 +112,8 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
     side.ilog2() as usize
 }
 
-/// Level L of a `width × height` output: the level-`L + bits` pixel above
+/// Level L of an output over `region` (absolute level-L pixels: the whole
+/// level, or a window's cone): the level-`L + bits` pixel above
 /// each 2^bits × 2^bits group of pixels picks one exemplar texel (`hash`
 /// of the seed and the group's position) uniformly over every interior
 /// texel of exemplar `from` (or of every exemplar); the group copies the
@@ -131,8 +133,7 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
 pub fn blocks(
     a: &AtlasLevel<'_>,
     from: Option<usize>,
-    width: usize,
-    height: usize,
+    region: Rect,
     (l, bits): (usize, usize),
     seed: u32,
     jitter: i32,
@@ -143,10 +144,10 @@ pub fn blocks(
         .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
         .collect();
     let total: u32 = ranges.iter().map(|r| (r.2 * r.3) as u32).sum();
-    let (w, h) = level_size(width, height, l);
+    let (w, h) = (region.width(), region.height());
     let st = State::new(w, h);
-    for y in 0..h {
-        for x in 0..w {
+    for (i, y) in (region.y0..region.y1).enumerate() {
+        for (j, x) in (region.x0..region.x1).enumerate() {
             let hash = hash4(seed, COARSE_SALT, (x >> bits) as u32, (y >> bits) as u32);
             let mut k = below(hash, total);
             for &(x0, y0, nx, ny) in &ranges {
@@ -161,7 +162,7 @@ pub fn blocks(
                         x: wrap_centred(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
                         y: wrap_centred(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
                     };
-                    st.set(y * w + x, s, 0);
+                    st.set(i * w + j, s, 0);
                     break;
                 }
                 k -= n;
@@ -179,23 +180,24 @@ fn wrap_centred(v: i32, min: i32, n: i32) -> i32 {
     base + (v - base).rem_euclid(n << FRAC_BITS)
 }
 
-/// Level `top` of a `width × height` output without blocks: the centre of
-/// exemplar `e` at the level `min(top, l)` of `a`, spread so that each level
-/// halves the spacing (in level-L units above L).
+/// Level `top` of a `width × height` output without blocks, over `region`
+/// (absolute level-`top` pixels): the centre of exemplar `e` at the level
+/// `min(top, l)` of `a`, spread so that each level halves the spacing (in
+/// level-L units above L).
 pub fn centre(
     a: &AtlasLevel<'_>,
     e: usize,
-    width: usize,
-    height: usize,
+    (width, height): (usize, usize),
+    region: Rect,
     top: usize,
     l: usize,
 ) -> State {
     let r = a.level.layout.rects[e];
     let (w, h) = level_size(width, height, top);
-    let st = State::new(w, h);
+    let st = State::new(region.width(), region.height());
     let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
-    for y in 0..h {
-        for x in 0..w {
+    for (i, y) in (region.y0..region.y1).enumerate() {
+        for (j, x) in (region.x0..region.x1).enumerate() {
             // Offset from the level's centre, in half texels of level top.
             let (hx, hy) = (2 * x as i32 + 1 - w as i32, 2 * y as i32 + 1 - h as i32);
             let to_fixed = |half: i32| -> i32 {
@@ -210,7 +212,7 @@ pub fn centre(
                 x: (cx << FRAC_BITS) + to_fixed(hx),
                 y: (cy << FRAC_BITS) + to_fixed(hy),
             };
-            st.set(y * w + x, s, 0);
+            st.set(i * region.width() + j, s, 0);
         }
     }
     st

@@ -16,6 +16,7 @@
 
 pub mod atlas;
 pub mod coarse;
+pub mod cone;
 pub mod control;
 pub mod fixed;
 mod params;
@@ -30,6 +31,7 @@ use crate::database::Database;
 use crate::heightfield::Heightfield;
 use atlas::AtlasLevel;
 use coarse::Start;
+use cone::{Cone, Rect};
 use fixed::FRAC_BITS;
 use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
@@ -185,7 +187,8 @@ impl<'db> Synthesizer<'db> {
     /// Synthesizes and returns timings (and levels, if kept), on the
     /// backend chosen by [`Synthesizer::use_backend`].
     pub fn run(&self, width: usize, height: usize, seed: u32) -> Result<Synthesis, SynthError> {
-        Ok(self.dispatch(width, height, seed, None)?.0)
+        let cone = self.whole(width, height)?;
+        Ok(self.dispatch(&cone, seed, None)?.0)
     }
 
     /// Synthesis under control inputs (paper §5), on the backend chosen by
@@ -202,44 +205,63 @@ impl<'db> Synthesizer<'db> {
         prev: Option<&Frames>,
         record: bool,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
+        let cone = self.whole(width, height)?;
+        self.run_cone(&cone, seed, guides, prev, record)
+    }
+
+    /// [`Synthesizer::run_with`] over a cone ([`Synthesizer::cone`]): the
+    /// guides and the previous frame cover the cone's regions.
+    pub(crate) fn run_cone(
+        &self,
+        cone: &Cone,
+        seed: u32,
+        guides: &Guides,
+        prev: Option<&Frames>,
+        record: bool,
+    ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         let control = Control {
             guides,
             prev,
             record,
         };
-        self.dispatch(width, height, seed, Some(&control))
+        self.dispatch(cone, seed, Some(&control))
     }
 
     /// [`Synthesizer::drive`] on the chosen backend.
     fn dispatch(
         &self,
-        width: usize,
-        height: usize,
+        cone: &Cone,
         seed: u32,
         control: Option<&Control<'_>>,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         #[cfg(feature = "gpu")]
         if let Some(g) = &self.gpu {
-            return self.drive(g, width, height, seed, control);
+            return self.drive(g, cone, seed, control);
         }
-        self.drive(&self.cpu(), width, height, seed, control)
+        self.drive(&self.cpu(), cone, seed, control)
     }
 
-    /// The synthesis loop, one for every backend and for plain and
-    /// controlled synthesis: the same stage calls in the same order, so
-    /// every backend yields the same bytes. Stage timings are wall clock up
-    /// to [`Backend::finish`], i.e. including the device's work, unless the
-    /// backend has a device clock.
+    /// The synthesis loop, one for every backend, for plain and controlled
+    /// synthesis and for whole worlds and windows: the same stage calls in
+    /// the same order, so every backend yields the same bytes, and a
+    /// window's pixels are those of the whole world (each level computes
+    /// its [`Cone`] region; stages hash absolute coordinates). Stage
+    /// timings are wall clock up to [`Backend::finish`], i.e. including the
+    /// device's work, unless the backend has a device clock.
     fn drive<B: Backend>(
         &self,
         b: &B,
-        width: usize,
-        height: usize,
+        cone: &Cone,
         seed: u32,
         control: Option<&Control<'_>>,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         let t0 = Instant::now();
-        let (start, top, l, mut timings) = self.plan(width, height)?;
+        let (width, height) = cone.world();
+        let (start, top, l) = self.levels(width, height);
+        let mut timings = Timings {
+            levels: vec![LevelTiming::default(); top_level(width, height) + 1],
+            ..Default::default()
+        };
         let mut kept = Vec::new();
         let mut frames = control.filter(|c| c.record).map(|_| Frames {
             levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
@@ -248,7 +270,7 @@ impl<'db> Synthesizer<'db> {
         // wall clock measures it; with one, stages queue back to back.
         let device_clock = b.has_device_clock();
         b.device_times()?; // forget times of earlier calls
-        let mut state = b.upload(self.initial(width, height, start, seed))?;
+        let mut state = b.upload(self.initial(cone, start, seed))?;
         // The level above, kept through this level's correction: its
         // offsets anchor the height prior (`correct` module docs).
         let mut parent: Option<B::State> = None;
@@ -256,16 +278,22 @@ impl<'db> Synthesizer<'db> {
         // previous frame (restricted re-synthesis only).
         let mut changed_parent: Option<[usize; 4]> = None;
         for level in (0..=top).rev() {
-            let (w, h) = level_size(width, height, level);
+            let region = cone.region(level);
+            let (w, h) = (region.width(), region.height());
             if level < top {
                 let t = Instant::now();
+                let above = match cone.parent_crop(level) {
+                    Some(c) => b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?,
+                    None => state,
+                };
                 let child = b.alloc(w, h)?;
-                let p = self.upsample_params(seed, level);
-                b.upsample_jitter(&state, &child, level, &p);
+                let p = self.upsample_params(seed, level, region);
+                b.upsample_jitter(&above, &child, level, &p);
                 if !device_clock {
                     b.finish()?;
                 }
-                parent = Some(std::mem::replace(&mut state, child));
+                parent = Some(above);
+                state = child;
                 timings.levels[level].upsample = t.elapsed();
             }
             if level <= l {
@@ -287,7 +315,7 @@ impl<'db> Synthesizer<'db> {
                         changed_parent = self.correct_level(
                             b,
                             (&state, parent.as_ref()),
-                            (level, w, h),
+                            (level, region),
                             c,
                             changed_parent,
                             frames.as_mut(),
@@ -303,6 +331,7 @@ impl<'db> Synthesizer<'db> {
                 let (coords, offsets) = b.download(&state)?;
                 kept.push(LevelMaps {
                     level,
+                    origin: [region.x0, region.y0],
                     width: w,
                     height: h,
                     coords,
@@ -313,8 +342,7 @@ impl<'db> Synthesizer<'db> {
         kept.reverse();
         let t = Instant::now();
         let fixed = b.reconstruct(&state)?;
-        let stride = level_size(width, height, 0).0;
-        let heightfield = self.to_metres(&fixed, stride, width, height)?;
+        let heightfield = self.to_metres(&fixed, cone)?;
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
         if let Some(times) = b.device_times()? {
@@ -351,11 +379,12 @@ impl<'db> Synthesizer<'db> {
         &self,
         b: &B,
         (state, parent): (&B::State, Option<&B::State>),
-        (level, w, h): (usize, usize, usize),
+        (level, region): (usize, Rect),
         c: &Control<'_>,
         changed_parent: Option<[usize; 4]>,
         mut frames: Option<&mut Frames>,
     ) -> Result<Option<[usize; 4]>, SynthError> {
+        let (w, h) = (region.width(), region.height());
         let lg = c.guides.levels.get(level);
         let before = c.prev.and_then(|f| f.levels.get(level));
         let window = match (c.guides.restrict, before) {
@@ -383,6 +412,7 @@ impl<'db> Synthesizer<'db> {
                 allowed: lg.and_then(|g| g.allowed.as_deref()),
                 coherence,
                 window,
+                origin: [region.x0 as u32, region.y0 as u32],
             };
             let g = b.upload_guide(&guide, w, h)?;
             for &(px, py) in &SUBPASSES {
@@ -427,21 +457,11 @@ impl<'db> Synthesizer<'db> {
         self.params.start_exemplar.unwrap_or(0)
     }
 
-    /// The levels a `width × height` synthesis runs: how it starts, the
-    /// coarsest synthesized level `top`, the database's coarsest level L,
-    /// and empty timings.
-    fn plan(
-        &self,
-        width: usize,
-        height: usize,
-    ) -> Result<(Start, usize, usize, Timings), SynthError> {
-        crate::size::check_dims(width, height)?;
+    /// The levels a `width × height` world runs: how it starts, the
+    /// coarsest synthesized level `top` and the database's coarsest level L.
+    fn levels(&self, width: usize, height: usize) -> (Start, usize, usize) {
         let m = top_level(width, height);
         let l = self.coarsest();
-        let timings = Timings {
-            levels: vec![LevelTiming::default(); m + 1],
-            ..Default::default()
-        };
         let start = Start::choose(
             self.jitter > 0,
             m,
@@ -449,19 +469,33 @@ impl<'db> Synthesizer<'db> {
             &self.atlas[l],
             self.params.start_exemplar,
         );
-        Ok((start, start.top(m, l), l, timings))
+        (start, start.top(m, l), l)
     }
 
-    /// Parameters of the upsampling into level `level`. Above L (only the
-    /// centre start has levels there) the levels only spread the start;
-    /// jitter begins at L.
-    fn upsample_params(&self, seed: u32, level: usize) -> UpsampleParams {
+    /// The cone of a whole `width × height` synthesis: every level whole.
+    fn whole(&self, width: usize, height: usize) -> Result<Cone, SynthError> {
+        crate::size::check_dims(width, height)?;
+        Ok(self.cone((width, height), Rect::new(0, 0, width, height), &[]))
+    }
+
+    /// The cone of `window` in a `world` (see [`Cone::plan`]; `needs`: more
+    /// rectangles per level that must come out right).
+    pub(crate) fn cone(&self, world: (usize, usize), window: Rect, needs: &[Option<Rect>]) -> Cone {
+        let (_, top, l) = self.levels(world.0, world.1);
+        Cone::plan(world, window, (top, l, self.params.passes), needs)
+    }
+
+    /// Parameters of the upsampling into level `level` over `region`. Above
+    /// L (only the centre start has levels there) the levels only spread
+    /// the start; jitter begins at L.
+    fn upsample_params(&self, seed: u32, level: usize, region: Rect) -> UpsampleParams {
         let l = self.coarsest();
         UpsampleParams {
             seed,
             level: level as u32,
             jitter: if level > l { 0 } else { self.jitter },
             step: self.step(level, l),
+            origin: [region.x0 as u32, region.y0 as u32],
         }
     }
 
@@ -486,45 +520,39 @@ impl<'db> Synthesizer<'db> {
         }
     }
 
-    /// The coarsest synthesized level `top` (see [`coarse`]).
-    fn initial(&self, width: usize, height: usize, start: Start, seed: u32) -> State {
+    /// The coarsest synthesized level `top` (see [`coarse`]) over the
+    /// cone's top region.
+    fn initial(&self, cone: &Cone, start: Start, seed: u32) -> State {
+        let (width, height) = cone.world();
         let (m, l) = (top_level(width, height), self.coarsest());
+        let region = cone.region(cone.top());
         match start {
             Start::Blocks { bits } => {
                 let from = self.params.start_exemplar;
-                coarse::blocks(
-                    &self.atlas[l],
-                    from,
-                    width,
-                    height,
-                    (l, bits),
-                    seed,
-                    self.jitter,
-                )
+                coarse::blocks(&self.atlas[l], from, region, (l, bits), seed, self.jitter)
             }
             Start::Centre => {
                 let top = start.top(m, l);
                 let a = &self.atlas[top.min(l)];
-                coarse::centre(a, self.start(), width, height, top, l)
+                coarse::centre(a, self.start(), (width, height), region, top, l)
             }
         }
     }
 
-    /// Level-0 fixed-point heights → metres, cropped to the requested size
-    /// (levels are at least 2×2).
-    fn to_metres(
-        &self,
-        fixed: &[i32],
-        stride: usize,
-        width: usize,
-        height: usize,
-    ) -> Result<Heightfield, SynthError> {
+    /// Level-0 fixed-point heights (over the cone's level-0 region) →
+    /// metres, cropped to the cone's window (levels are at least 2×2).
+    fn to_metres(&self, fixed: &[i32], cone: &Cone) -> Result<Heightfield, SynthError> {
         let q = self.db.quantization();
         let cell = self.cell_size_m();
         let scale = q.scale_m / (1 << HEIGHT_FRAC_BITS) as f64;
-        Ok(Heightfield::from_fn(width, height, cell, |x, y| {
-            (q.offset_m + scale * fixed[y * stride + x] as f64) as f32
-        })?)
+        let (r, win) = (cone.region(0), cone.window());
+        let (dx, dy, stride) = (win.x0 - r.x0, win.y0 - r.y0, r.width());
+        Ok(Heightfield::from_fn(
+            win.width(),
+            win.height(),
+            cell,
+            |x, y| (q.offset_m + scale * fixed[(y + dy) * stride + x + dx] as f64) as f32,
+        )?)
     }
 
     /// Synthesis memory per output pixel: the finest level's state, the

@@ -63,6 +63,9 @@ pub enum SynthError {
 #[derive(Debug, Clone)]
 pub struct LevelMaps {
     pub level: usize,
+    /// Absolute position of pixel (0, 0) in its level: (0, 0) for a whole
+    /// level, a window's cone region's corner otherwise.
+    pub origin: [usize; 2],
     pub width: usize,
     pub height: usize,
     /// Exemplar coordinates (fixed point; atlas units of this level, or of

@@ -67,6 +67,17 @@ impl State {
     pub fn offsets(&self) -> Vec<i32> {
         self.v.iter().map(|a| a.load(Relaxed)).collect()
     }
+    /// A copy of the pixels `[x0, x1) × [y0, y1)`.
+    pub fn crop(&self, [x0, y0, x1, y1]: [usize; 4]) -> State {
+        let out = State::new(x1 - x0, y1 - y0);
+        for (j, y) in (y0..y1).enumerate() {
+            for (i, x) in (x0..x1).enumerate() {
+                let k = y * self.width + x;
+                out.set(j * out.width + i, self.s(k), self.v(k));
+            }
+        }
+        out
+    }
     /// Bytes held per pixel (for memory reports).
     pub const BYTES_PER_PIXEL: usize = 12;
 }

@@ -26,6 +26,10 @@ impl Backend for Gpu {
         self.alloc_state(width, height)
     }
 
+    fn crop(&self, st: &GpuState, rect: [usize; 4]) -> Result<GpuState, BackendError> {
+        self.crop_state(st, rect)
+    }
+
     fn upsample_jitter(
         &self,
         parent: &GpuState,

@@ -11,6 +11,7 @@ use crate::synth::stages::correct::{CorrectParams, Guide};
 /// [`GuideCell`] per pixel when any is.
 pub struct GpuGuide {
     pub(super) level: u32,
+    pub(super) origin: [u32; 2],
     pub(super) window: Option<[usize; 4]>,
     pub(super) flags: u32,
     pub(super) cells: Option<wgpu::Buffer>,
@@ -26,6 +27,7 @@ impl Gpu {
     ) {
         let none = GpuGuide {
             level: level as u32,
+            origin: [0, 0],
             window: None,
             flags: 0,
             cells: None,
@@ -75,6 +77,7 @@ impl Gpu {
             .transpose()?;
         Ok(GpuGuide {
             level: g.level,
+            origin: g.origin,
             window: g.window,
             flags,
             cells,
@@ -105,6 +108,8 @@ impl Gpu {
             parent_width: parent.map_or(0, |pa| pa.width as u32),
             parent_height: parent.map_or(0, |pa| pa.height as u32),
             has_parent: parent.is_some() as u32,
+            origin_x: g.origin[0],
+            origin_y: g.origin[1],
             ..Default::default()
         };
         u.flags = g.flags;

@@ -41,6 +41,25 @@ impl Gpu {
         })
     }
 
+    /// A copy of the pixels `[x0, x1) × [y0, y1)` of `st`, row by row on the
+    /// device (windowed synthesis, [`crate::backend::Backend::crop`]).
+    pub(super) fn crop_state(
+        &self,
+        st: &GpuState,
+        [x0, y0, x1, y1]: [usize; 4],
+    ) -> Result<GpuState, BackendError> {
+        let (w, h) = (x1 - x0, y1 - y0);
+        let out = self.alloc_state(w, h)?;
+        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        for y in 0..h {
+            let (from, to, n) = (((y0 + y) * st.width + x0) as u64, (y * w) as u64, w as u64);
+            enc.copy_buffer_to_buffer(&st.s, from * 8, &out.s, to * 8, n * 8);
+            enc.copy_buffer_to_buffer(&st.v, from * 4, &out.v, to * 4, n * 4);
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        Ok(out)
+    }
+
     pub(super) fn download_state(
         &self,
         st: &GpuState,

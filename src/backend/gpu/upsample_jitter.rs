@@ -20,6 +20,8 @@ impl Gpu {
             seed: p.seed,
             level: p.level,
             jitter: p.jitter,
+            origin_x: p.origin[0],
+            origin_y: p.origin[1],
             ..Default::default()
         };
         match p.step {

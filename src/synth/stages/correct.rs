@@ -185,6 +185,11 @@ pub struct Guide<'a> {
     /// `synth::Guides::restrict`): with [`Guide::coherence`] they take it
     /// (its S and V as they are), without it they keep their state.
     pub window: Option<[usize; 4]>,
+    /// Absolute position, in this level, of the state's pixel (0, 0):
+    /// `[0, 0]` for a whole level, a window's corner for windowed
+    /// synthesis. Type seeding hashes absolute coordinates (DESIGN §6), so
+    /// a window seeds what the whole level seeds there.
+    pub origin: [u32; 2],
 }
 
 impl Guide<'_> {
@@ -195,6 +200,7 @@ impl Guide<'_> {
         allowed: None,
         coherence: None,
         window: None,
+        origin: [0, 0],
     };
 }
 

@@ -50,6 +50,13 @@ pub struct UpsampleParams {
     /// Jitter amplitude r in fixed point (r · 2^FRAC_BITS).
     pub jitter: i32,
     pub step: Step,
+    /// Absolute position, in the child level, of the child buffer's pixel
+    /// (0, 0): `[0, 0]` for a whole level, the window's corner for windowed
+    /// synthesis. The jitter hashes absolute coordinates (DESIGN §6), so a
+    /// window draws what the whole level draws there. Both components are
+    /// even, so a pixel's child parity `c` is the same locally and
+    /// absolutely, and the parent buffer starts at `origin / 2`.
+    pub origin: [u32; 2],
 }
 
 /// The jitter offset of a child pixel: two values in [−r, r) (fixed point).
@@ -71,12 +78,15 @@ pub fn upsample_jitter(
     p: &UpsampleParams,
 ) {
     let (cw, pw) = (child.width, parent.width);
+    let [ox, oy] = p.origin;
+    debug_assert!(ox % 2 == 0 && oy % 2 == 0, "odd origin {:?}", p.origin);
     (0..child.height).into_par_iter().for_each(|y| {
         for x in 0..cw {
             let pi = (y / 2) * pw + x / 2;
             let (cx, cy) = ((x & 1) as i32, (y & 1) as i32);
             let s = parent.s(pi);
-            let (jx, jy) = jitter(p.seed, p.level, x as u32, y as u32, p.jitter);
+            let (ax, ay) = (ox + x as u32, oy + y as u32);
+            let (jx, jy) = jitter(p.seed, p.level, ax, ay, p.jitter);
             let off_x = (cx << FRAC_BITS) + jx;
             let off_y = (cy << FRAC_BITS) + jy;
             let out = match p.step {

@@ -264,7 +264,8 @@ pub fn correct_pixel_guided(
             let list = &atlas.level.seeds[t as usize * SEEDS_PER_TYPE..];
             for k in 0..SEEDS_PER_ALLOWED_TYPE {
                 let salt = t * SEEDS_PER_ALLOWED_TYPE + k;
-                let hash = hash4(SEED_SALT | g.level, salt, x as u32, y as u32);
+                let (ax, ay) = (g.origin[0] + x as u32, g.origin[1] + y as u32);
+                let hash = hash4(SEED_SALT | g.level, salt, ax, ay);
                 let c = list[below(hash, count) as usize];
                 let q = ((c & 0xFFFF) as i32, (c >> 16) as i32);
                 let (sc, hh) = score(atlas, &ns, q.0, q.1, 1, prior);
