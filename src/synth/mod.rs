@@ -25,6 +25,7 @@ pub mod source_map;
 pub mod stages;
 pub mod state;
 mod window;
+mod windowed;
 
 use crate::backend::{Backend, Choice, Stage, cpu::Cpu};
 use crate::database::Database;
@@ -45,6 +46,7 @@ pub use params::{
 };
 pub(crate) use window::union;
 pub use window::{Frames, PassResult};
+pub use windowed::{WindowError, check_window};
 
 /// The control side of one run: per-level guides, the previous frame, and
 /// whether to record this one.

@@ -56,6 +56,8 @@ pub enum SynthError {
     #[error(transparent)]
     Size(#[from] crate::size::SizeError),
     #[error(transparent)]
+    Window(#[from] super::windowed::WindowError),
+    #[error(transparent)]
     Backend(#[from] BackendError),
 }
 
