@@ -66,6 +66,42 @@ pub fn parse_size(s: &str) -> Result<(usize, usize), String> {
     }
 }
 
+/// Parses a world size `WxH` (e.g. `65536x65536`); each side in
+/// 1..=1048576. Only windows of a world are ever allocated (`--window`,
+/// `tiles`), so a world may be far larger than memory.
+pub fn parse_world_size(s: &str) -> Result<(usize, usize), String> {
+    let max = terrasynth::size::MAX_SIDE;
+    let err = || {
+        format!("invalid size {s:?}: expected WxH with each side in 1..={max}, e.g. 65536x65536")
+    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
+    let w: usize = w.trim().parse().map_err(|_| err())?;
+    let h: usize = h.trim().parse().map_err(|_| err())?;
+    if (1..=max).contains(&w) && (1..=max).contains(&h) {
+        Ok((w, h))
+    } else {
+        Err(err())
+    }
+}
+
+/// Parses a window `X,Y,W,H` of output pixels (W, H ≥ 1; whether it fits
+/// the world is checked against `--size`).
+pub fn parse_window(s: &str) -> Result<terrasynth::synth::cone::Rect, String> {
+    let err = || {
+        format!(
+            "invalid window {s:?}: expected X,Y,W,H in output pixels with W and H at least 1, e.g. 4096,8192,1024,1024"
+        )
+    };
+    let v: Vec<usize> = s
+        .split(',')
+        .map(|p| p.trim().parse().map_err(|_| err()))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y, w, h] if w >= 1 && h >= 1 => Ok(terrasynth::synth::cone::Rect::new(x, y, w, h)),
+        _ => Err(err()),
+    }
+}
+
 /// Loads `--db`, or the embedded default database (built and cached on
 /// first use, with a progress bar and a one-line notice).
 pub fn load_database(

@@ -1,7 +1,10 @@
 //! `terrasynth synth`: synthesize a terrain from an exemplar database.
 
 use crate::CliResult;
-use crate::args::{BackendArg, EngineArg, load_database, parse_size, select_backend, write_output};
+use crate::args::{
+    BackendArg, EngineArg, load_database, parse_window, parse_world_size, select_backend,
+    write_output,
+};
 use std::path::{Path, PathBuf};
 use terrasynth::database::Database;
 use terrasynth::io::{self, CoordsMap};
@@ -14,9 +17,17 @@ pub struct Args {
     /// Exemplar database (.tsdb, from `db build`); default: the embedded one.
     #[arg(long)]
     db: Option<PathBuf>,
-    /// Output size WxH (any size, e.g. 1024x1024 or 777x333).
-    #[arg(long, value_parser = parse_size, default_value = "1024x1024")]
+    /// Output size WxH (any size, e.g. 1024x1024 or 777x333); with
+    /// --window, the size of the world the window is cut from (each side up
+    /// to 1048576, e.g. 65536x65536).
+    #[arg(long, value_parser = parse_world_size, default_value = "1024x1024")]
     size: (usize, usize),
+    /// Synthesize only this window X,Y,W,H of the world (output pixels):
+    /// the same heights as the same crop of the whole world, computed in
+    /// memory and time proportional to the window. The output is placed in
+    /// the world's grid (GeoTIFF, sidecars), so windows tile seamlessly.
+    #[arg(long, value_parser = parse_window, conflicts_with_all = ["coords", "coords_preview"])]
+    window: Option<terrasynth::synth::cone::Rect>,
     /// Random seed: the same seed and inputs give the same bytes.
     #[arg(long, default_value_t = 1)]
     seed: u32,
@@ -122,7 +133,9 @@ pub fn run(a: Args) -> CliResult {
         &inputs,
     )?;
     let (w, h) = a.size;
-    check_synthesis_memory(w, h, 1.0)?;
+    if a.window.is_none() {
+        check_synthesis_memory(w, h, 1.0)?;
+    }
     let db = load_database(a.db.as_deref())?;
     let params = Params {
         jitter: a.jitter,
@@ -133,11 +146,26 @@ pub fn run(a: Args) -> CliResult {
     };
     let mut synth = Synthesizer::new(&db, params)?;
     select_backend(&mut synth, a.backend)?;
-    let result = synth.run(w, h, a.seed)?;
+    let (result, what) = match a.window {
+        None => (synth.run(w, h, a.seed)?, format!("{w} x {h}")),
+        Some(win) => {
+            let cone = synth.window_cone((w, h), win).map_err(window_error(win))?;
+            let what = format!("a {}x{} window of a {w}x{h} world", win.width(), win.height());
+            io::check_memory(&what, cone.bytes())?;
+            let what = format!(
+                "{} x {} at ({}, {}) of {w} x {h}",
+                win.width(),
+                win.height(),
+                win.x0,
+                win.y0
+            );
+            (synth.run_window((w, h), win, a.seed)?, what)
+        }
+    };
     write_output(&result.heightfield, &a.output, None, a.engine, &inputs)?;
     let s = result.heightfield.stats().expect("synthesis has no nodata");
     eprintln!(
-        "wrote {} ({w} x {h}, seed {}): heights {:.1} .. {:.1} m in {:.0} ms",
+        "wrote {} ({what}, seed {}): heights {:.1} .. {:.1} m in {:.0} ms",
         a.output.display(),
         a.seed,
         s.min,
@@ -154,6 +182,23 @@ pub fn run(a: Args) -> CliResult {
         write_coords(&source_map(&l0.coords, l0.width, w, h, &db), &db, paths)?;
     }
     Ok(())
+}
+
+/// Names `--window` (and `--size`) in a window the world cannot hold.
+pub fn window_error(
+    win: terrasynth::synth::cone::Rect,
+) -> impl Fn(terrasynth::synth::SynthError) -> Box<dyn std::error::Error + Send + Sync> {
+    move |e| match e {
+        terrasynth::synth::SynthError::Window(e) => format!(
+            "--window {},{},{},{}: {e} (--size)",
+            win.x0,
+            win.y0,
+            win.width(),
+            win.height()
+        )
+        .into(),
+        e => e.into(),
+    }
 }
 
 /// Writes where every pixel of a synthesis was drawn from: the exact map
