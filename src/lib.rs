@@ -30,6 +30,7 @@ pub mod scene;
 pub mod server;
 pub mod size;
 pub mod synth;
+pub mod tiles;
 
 pub use error::{Error, Result};
 pub use heightfield::{Georef, Heightfield, Stats};

@@ -16,6 +16,7 @@ mod serve;
 mod sketch;
 mod suite;
 mod synth;
+mod tiles;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -46,6 +47,9 @@ enum Command {
     Db(db::Command),
     /// Synthesize a terrain from real exemplars (the embedded ones by default).
     Synth(synth::Args),
+    /// Write a whole world as a directory of tiles (each a window of it,
+    /// exactly), a manifest and a GDAL mosaic; resumable.
+    Tiles(tiles::Args),
     /// Apply scene files in order as edits of one session, writing every
     /// frame, its preview and a report of where the terrain changed.
     Edit(edit::Args),
@@ -78,6 +82,7 @@ fn main() -> ExitCode {
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),
         Command::Synth(a) => synth::run(a),
+        Command::Tiles(a) => tiles::run(a),
         Command::Edit(a) => edit::run(a),
         Command::Generate(a) => generate::run(a),
         Command::Sketch(a) => sketch::run(a),

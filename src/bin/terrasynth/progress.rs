@@ -20,9 +20,11 @@ impl terrasynth::progress::Progress for Bar {
     fn start(&self, stage: &str, total: u64) {
         let bar = ProgressBar::new(total);
         bar.set_style(
-            ProgressStyle::with_template("{msg:>24} [{bar:40}] {percent:>3}% {elapsed_precise}")
-                .expect("template is valid")
-                .progress_chars("=> "),
+            ProgressStyle::with_template(
+                "{msg:>24} [{bar:40}] {percent:>3}% {elapsed_precise} ETA {eta}",
+            )
+            .expect("template is valid")
+            .progress_chars("=> "),
         );
         bar.set_message(stage.to_string());
         if let Some(old) = self

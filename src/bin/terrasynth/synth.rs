@@ -150,7 +150,11 @@ pub fn run(a: Args) -> CliResult {
         None => (synth.run(w, h, a.seed)?, format!("{w} x {h}")),
         Some(win) => {
             let cone = synth.window_cone((w, h), win).map_err(window_error(win))?;
-            let what = format!("a {}x{} window of a {w}x{h} world", win.width(), win.height());
+            let what = format!(
+                "a {}x{} window of a {w}x{h} world",
+                win.width(),
+                win.height()
+            );
             io::check_memory(&what, cone.bytes())?;
             let what = format!(
                 "{} x {} at ({}, {}) of {w} x {h}",

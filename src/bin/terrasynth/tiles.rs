@@ -1,0 +1,179 @@
+//! `terrasynth tiles`: a whole world as a directory of tiles, a manifest
+//! and a GDAL mosaic (see `terrasynth::tiles`).
+
+use crate::CliResult;
+use crate::args::{BackendArg, load_database, parse_world_size, select_backend};
+use std::path::PathBuf;
+use std::time::Instant;
+use terrasynth::io::{self, Format};
+use terrasynth::synth::cone::Rect;
+use terrasynth::synth::{Params, Synthesizer};
+use terrasynth::tiles::{self, Tiling, grid::Grid};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Folder for the tiles, manifest.json and world.vrt. Running again
+    /// over it resumes: tiles whose CRC verifies are kept.
+    #[arg(long)]
+    out_dir: PathBuf,
+    /// World size WxH (each side up to 1048576, e.g. 65536x65536).
+    #[arg(long, value_parser = parse_world_size)]
+    size: (usize, usize),
+    /// Tile side in pixels (the last row and column may be shorter).
+    #[arg(long, default_value_t = 1024)]
+    tile: usize,
+    /// Extra pixels each tile file holds on every side (shared with its
+    /// neighbours, for tools that blend tile borders; the mosaic uses the
+    /// cores only). At most the tile size.
+    #[arg(long, default_value_t = 0)]
+    overlap: usize,
+    /// Tile format.
+    #[arg(long, value_enum, default_value_t = TileFormat::Tiff)]
+    format: TileFormat,
+    /// 16-bit formats (png, r16): metres MIN,MAX mapped onto the codes,
+    /// the same for every tile. Default: the database's height range
+    /// widened by a quarter of it on each side.
+    #[arg(long, value_parser = parse_range)]
+    height_range: Option<(f64, f64)>,
+    /// Exemplar database (.tsdb); default: the embedded one.
+    #[arg(long)]
+    db: Option<PathBuf>,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Jitter amplitude r in texels.
+    #[arg(long, default_value_t = 0.4)]
+    jitter: f64,
+    /// Correction passes per level.
+    #[arg(long, default_value_t = 2)]
+    passes: u32,
+    /// Exemplar (index) the synthesis starts from (see `synth --help`).
+    #[arg(long)]
+    start_exemplar: Option<usize>,
+    /// Height prior P of the correction: 0, 1, 2, 4 or 8.
+    #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
+    height_prior: u32,
+    /// Where the stages run: cpu, gpu or auto. Same tiles on each.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
+}
+
+/// `--format`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum TileFormat {
+    /// Float32 GeoTIFF, placed in the world's local grid.
+    Tiff,
+    /// OpenEXR, one float channel.
+    Exr,
+    /// 16-bit PNG with a JSON sidecar (metres mapping).
+    Png,
+    /// Headerless 16-bit little-endian with a JSON sidecar (Unity/Unreal).
+    R16,
+}
+
+impl From<TileFormat> for Format {
+    fn from(f: TileFormat) -> Format {
+        match f {
+            TileFormat::Tiff => Format::Tiff,
+            TileFormat::Exr => Format::Exr,
+            TileFormat::Png => Format::Png16,
+            TileFormat::R16 => Format::R16,
+        }
+    }
+}
+
+/// Parses `MIN,MAX` metres.
+fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    let err = || format!("invalid height range {s:?}: expected MIN,MAX in metres with MIN < MAX");
+    let (a, b) = s.split_once(',').ok_or_else(err)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| err())?,
+        b.trim().parse().map_err(|_| err())?,
+    );
+    if a.is_finite() && b.is_finite() && a < b {
+        Ok((a, b))
+    } else {
+        Err(err())
+    }
+}
+
+pub fn run(a: Args) -> CliResult {
+    let db = load_database(a.db.as_deref())?;
+    let params = Params {
+        jitter: a.jitter,
+        passes: a.passes,
+        start_exemplar: a.start_exemplar,
+        prior: a.height_prior,
+        keep_levels: false,
+    };
+    let mut synth = Synthesizer::new(&db, params)?;
+    select_backend(&mut synth, a.backend)?;
+    let format = Format::from(a.format);
+    let grid = Grid {
+        world: a.size,
+        tile: a.tile,
+        overlap: a.overlap,
+    };
+    // Memory: one tile's cone per thread, for a tile amid the world (at
+    // the edges the cone is smaller).
+    let (w, h) = a.size;
+    let side = |n: usize| (a.tile + 2 * a.overlap).min(n);
+    let (tw, th) = (side(w), side(h));
+    let probe = Rect::new((w - tw) / 2, (h - th) / 2, tw, th);
+    let cone = synth
+        .window_cone(a.size, probe)
+        .map_err(crate::synth::window_error(probe))?;
+    let threads = rayon::current_num_threads() as u64;
+    io::check_memory(
+        &format!("{threads} tiles of {tw}x{th} in parallel"),
+        cone.bytes() * threads,
+    )?;
+    let height_range_m = matches!(format, Format::Png16 | Format::R16).then(|| {
+        a.height_range
+            .unwrap_or_else(|| tiles::default_height_range(db.quantization()))
+    });
+    let source = serde_json::json!({
+        "database": {
+            "file": a.db.as_ref().map(|p| p.display().to_string()),
+            "crc32": format!("0x{:08x}", crc32fast::hash(db.file_bytes())),
+        },
+        "seed": a.seed,
+        "jitter": a.jitter,
+        "passes": a.passes,
+        "start_exemplar": a.start_exemplar,
+        "height_prior": a.height_prior,
+    });
+    let tiling = Tiling {
+        grid,
+        format,
+        height_range_m,
+        cell_size_m: synth.cell_size_m(),
+        source,
+    };
+    let t = Instant::now();
+    let window = |r: Rect| synth.synthesize_window(a.size, r, a.seed);
+    let s = tiles::write(&tiling, &a.out_dir, &window, &crate::progress::Bar::new())?;
+    let secs = t.elapsed().as_secs_f64();
+    let (cols, rows) = grid.size();
+    eprintln!(
+        "wrote {} of {} tiles ({cols} x {rows}; {} kept from an earlier run) of a {w}x{h} world to {} in {secs:.1} s ({:.2} MP/s)",
+        s.written,
+        cols * rows,
+        s.kept,
+        a.out_dir.display(),
+        s.pixels as f64 / 1e6 / secs.max(1e-9)
+    );
+    if s.clamped > 0 {
+        let (lo, hi) = height_range_m.expect("16-bit formats have a range");
+        eprintln!(
+            "note: {} samples lay outside the height range {lo:.1}..{hi:.1} m and were clamped (widen it with --height-range)",
+            s.clamped
+        );
+    }
+    eprintln!("wrote {}", s.manifest.display());
+    match &s.vrt {
+        Some(v) => eprintln!("wrote {} (open the mosaic in GDAL or QGIS)", v.display()),
+        None => eprintln!("note: GDAL cannot open {format} tiles, so no world.vrt was written"),
+    }
+    Ok(())
+}
