@@ -71,10 +71,12 @@ mod error;
 pub mod overlay;
 mod parse;
 mod raster;
+mod window;
 
 pub use controls::{SceneEdits, polygon_centroid};
 pub use error::{SceneError, SceneErrorKind};
 pub use raster::stroke_mask;
+pub use window::WindowedScene;
 
 use crate::synth::control::curve::{CurveSpec, JunctionHeight};
 use glam::DVec2;

@@ -3,26 +3,33 @@
 
 use super::*;
 use crate::io::type_mask::{NO_TYPE, TypeMask};
+use crate::synth::cone::Rect;
 use rayon::prelude::*;
 
 /// Pixels whose centre lies within a stroke's radius of its polyline.
 pub fn stroke_mask(width: usize, height: usize, strokes: &[&Stroke]) -> Vec<bool> {
     let mut mask = vec![false; width * height];
-    paint(width, strokes.iter().map(|s| (*s, true)), &mut mask);
+    paint(
+        Rect::new(0, 0, width, height),
+        strokes.iter().map(|s| (*s, true)),
+        &mut mask,
+    );
     mask
 }
 
-/// Paints `value` of each stroke, in order, onto `out` (rows in parallel):
+/// Paints `value` of each stroke, in order, onto `out`, the pixels of
+/// `rect` (the whole scene, or a window's footprint; rows in parallel):
 /// a pixel takes the value of the last stroke whose polyline comes within
 /// its radius of the pixel's centre. Each row visits only the segments
 /// whose capsule (bounding box grown by the radius) crosses it, and only
 /// the columns of that box, so an editor that repaints every stroke of a
 /// scene on every edit pays for the strokes' area, not the image's.
 fn paint<'a, T: Copy + Send + Sync>(
-    width: usize,
+    rect: Rect,
     strokes: impl Iterator<Item = (&'a Stroke, T)>,
     out: &mut [T],
 ) {
+    let width = rect.width();
     // Per segment (a one-point stroke is one degenerate segment): its ends,
     // the stroke's radius and value, and its capsule's bounds.
     struct Seg<T> {
@@ -51,19 +58,32 @@ fn paint<'a, T: Copy + Send + Sync>(
             })
         })
         .collect();
+    let (left, right) = (rect.x0 as f64, rect.x1 as f64);
     out.par_chunks_mut(width).enumerate().for_each(|(j, row)| {
-        let y = j as f64 + 0.5;
+        let y = (rect.y0 + j) as f64 + 0.5;
         for s in segs.iter().filter(|s| y >= s.lo.y && y <= s.hi.y) {
-            // Pixel centres i + 0.5 in [lo.x, hi.x].
-            let x0 = (s.lo.x - 0.5).ceil().max(0.0) as usize;
-            let x1 = ((s.hi.x - 0.5).floor() + 1.0).clamp(0.0, width as f64) as usize;
+            // Pixel centres i + 0.5 in [lo.x, hi.x], inside the rectangle.
+            let x0 = (s.lo.x - 0.5).ceil().clamp(left, right) as usize - rect.x0;
+            let x1 = ((s.hi.x - 0.5).floor() + 1.0).clamp(left, right) as usize - rect.x0;
             for (i, slot) in row.iter_mut().enumerate().take(x1).skip(x0) {
-                if segment_distance(DVec2::new(i as f64 + 0.5, y), s.a, s.b) <= s.r {
+                let x = (rect.x0 + i) as f64 + 0.5;
+                if segment_distance(DVec2::new(x, y), s.a, s.b) <= s.r {
                     *slot = s.value;
                 }
             }
         }
     });
+}
+
+/// The pixels of `rect` painted by `strokes` in order over `blank`.
+pub(crate) fn paint_strokes<T: Copy + Send + Sync>(
+    rect: Rect,
+    strokes: &[(Stroke, T)],
+    blank: T,
+) -> Vec<T> {
+    let mut out = vec![blank; rect.pixels()];
+    paint(rect, strokes.iter().map(|(s, v)| (s, *v)), &mut out);
+    out
 }
 
 /// Distance from `p` to the segment `a`–`b` (a point when they coincide).
@@ -76,43 +96,17 @@ impl Scene {
     /// ([`NO_TYPE`] = unconstrained), or `None` when nothing is painted.
     /// `type_names` are the database's, by index.
     pub fn type_raster(&self, type_names: &[String]) -> Result<Option<Vec<u8>>, SceneError> {
-        let known = || {
-            if type_names.is_empty() {
-                "no types".to_string()
-            } else {
-                type_names.join(", ")
-            }
-        };
-        let index_of = |name: &str, path: String| -> Result<u8, SceneError> {
-            type_names
-                .iter()
-                .position(|n| n == name)
-                .map(|i| i as u8)
-                .ok_or_else(|| {
-                    self.err(
-                        path,
-                        SceneErrorKind::UnknownType {
-                            name: name.to_string(),
-                            known: known(),
-                        },
-                    )
-                })
-        };
+        let index_of = |name: &str, path: String| self.type_index(type_names, name, path);
         let (w, h) = (self.width, self.height);
         match &self.types {
             None => Ok(None),
-            Some(TypePaint::Strokes(strokes)) => {
-                let mut values = Vec::with_capacity(strokes.len());
-                for (i, (name, s)) in strokes.iter().enumerate() {
-                    let value = match name {
-                        Some(name) => index_of(name, format!("types.strokes[{i}].type"))?,
-                        None => NO_TYPE,
-                    };
-                    values.push((s, value));
-                }
-                let mut out = vec![NO_TYPE; w * h];
-                paint(w, values.into_iter(), &mut out);
-                Ok(Some(out))
+            Some(TypePaint::Strokes(_)) => {
+                let strokes = self.type_strokes(type_names)?.unwrap_or_default();
+                Ok(Some(paint_strokes(
+                    Rect::new(0, 0, w, h),
+                    &strokes,
+                    NO_TYPE,
+                )))
             }
             Some(TypePaint::Image(path)) => {
                 let mask = TypeMask::read(path).map_err(|e| self.err("types.image", e.into()))?;
@@ -129,13 +123,60 @@ impl Scene {
         }
     }
 
+    /// The database index of type `name` (`path` locates it in the scene).
+    fn type_index(
+        &self,
+        type_names: &[String],
+        name: &str,
+        path: String,
+    ) -> Result<u8, SceneError> {
+        let known = match type_names.is_empty() {
+            true => "no types".to_string(),
+            false => type_names.join(", "),
+        };
+        (type_names.iter().position(|n| n == name))
+            .map(|i| i as u8)
+            .ok_or_else(|| {
+                self.err(
+                    path,
+                    SceneErrorKind::UnknownType {
+                        name: name.to_string(),
+                        known,
+                    },
+                )
+            })
+    }
+
+    /// Stroke-form type paint with database type indices ([`NO_TYPE`] for
+    /// an eraser), or `None` when the paint is not strokes.
+    pub(crate) fn type_strokes(
+        &self,
+        type_names: &[String],
+    ) -> Result<Option<Vec<(Stroke, u8)>>, SceneError> {
+        let Some(TypePaint::Strokes(strokes)) = &self.types else {
+            return Ok(None);
+        };
+        let mut values = Vec::with_capacity(strokes.len());
+        for (i, (name, s)) in strokes.iter().enumerate() {
+            let value = match name {
+                Some(name) => {
+                    self.type_index(type_names, name, format!("types.strokes[{i}].type"))?
+                }
+                None => NO_TYPE,
+            };
+            values.push((s.clone(), value));
+        }
+        Ok(Some(values))
+    }
+
     /// The frozen pixels, or `None` when nothing is frozen.
     pub fn freeze_raster(&self) -> Result<Option<Vec<bool>>, SceneError> {
         match &self.freeze {
             None => Ok(None),
             Some(Freeze::Strokes(s)) => {
                 let mut out = vec![false; self.width * self.height];
-                paint(self.width, s.iter().map(|(v, s)| (s, *v)), &mut out);
+                let all = Rect::new(0, 0, self.width, self.height);
+                paint(all, s.iter().map(|(v, s)| (s, *v)), &mut out);
                 Ok(Some(out))
             }
             Some(Freeze::Mask(path)) => {

@@ -46,7 +46,7 @@ pub use params::{
 };
 pub(crate) use window::union;
 pub use window::{Frames, PassResult};
-pub use windowed::{WindowError, check_window};
+pub use windowed::{Paint, WindowControls, WindowError, check_window};
 
 /// The control side of one run: per-level guides, the previous frame, and
 /// whether to record this one.

@@ -80,6 +80,7 @@
 
 use super::Constraint;
 use crate::database::Quantization;
+use crate::synth::cone::Rect;
 
 /// The paper's tolerance slope s (eq. 8), for points.
 pub const S: f64 = 0.5;
@@ -134,9 +135,12 @@ struct Sums {
     bd: i64,
 }
 
-/// Running sums of one level.
+/// Running sums of one level, over its pixels `[x0, x0 + width) ×
+/// [y0, y0 + height)` (the whole level, or a window's cone region).
 #[derive(Debug, Clone)]
 struct LevelSums {
+    x0: usize,
+    y0: usize,
     width: usize,
     height: usize,
     /// Allocated by the first constraint added (24 B per pixel: level 0
@@ -149,7 +153,8 @@ impl PartialEq for LevelSums {
     /// Equal sums, an unallocated level counting as all zero.
     fn eq(&self, other: &LevelSums) -> bool {
         let zero = |s: &[Sums]| s.iter().all(|x| *x == Sums::default());
-        (self.width, self.height) == (other.width, other.height)
+        (self.x0, self.y0, self.width, self.height)
+            == (other.x0, other.y0, other.width, other.height)
             && match (self.sums.is_empty(), other.sums.is_empty()) {
                 (false, false) => self.sums == other.sums,
                 (true, _) => zero(&other.sums),
@@ -169,14 +174,27 @@ pub struct Blend {
 impl Blend {
     /// Empty sums for levels `0..=last` of an output of this size.
     pub fn new(width: usize, height: usize, last: usize, q: Quantization) -> Blend {
-        let levels = (0..=last)
+        let regions: Vec<Rect> = (0..=last)
             .map(|i| {
                 let (w, h) = crate::synth::state::level_size(width, height, i);
-                LevelSums {
-                    width: w,
-                    height: h,
-                    sums: Vec::new(),
-                }
+                Rect::new(0, 0, w, h)
+            })
+            .collect();
+        Blend::over(&regions, q)
+    }
+
+    /// Empty sums over one region per level (index = level): a windowed
+    /// synthesis blends only its cone. Every pixel's sums are those of the
+    /// whole level, as samples are taken at absolute pixel centres.
+    pub fn over(regions: &[Rect], q: Quantization) -> Blend {
+        let levels = regions
+            .iter()
+            .map(|r| LevelSums {
+                x0: r.x0,
+                y0: r.y0,
+                width: r.width(),
+                height: r.height(),
+                sums: Vec::new(),
             })
             .collect();
         Blend { q, levels }
@@ -208,17 +226,17 @@ impl Blend {
             let cap = hold.level_cap.map_or(f64::INFINITY, |k| k * scale);
             // Radius of the disc inscribed in a pixel's footprint.
             let half = scale / 2.0;
-            // Level pixels whose centre lies in the bounds.
-            let range = |a: f64, b: f64, n: usize| {
-                let lo = ((a / scale - 0.5).ceil().max(0.0) as usize).min(n);
-                let hi = (((b / scale - 0.5).floor() + 1.0).max(0.0) as usize).min(n);
+            // Level pixels of the region whose centre lies in the bounds.
+            let range = |a: f64, b: f64, from: usize, n: usize| {
+                let lo = ((a / scale - 0.5).ceil().max(0.0) as usize).clamp(from, from + n);
+                let hi = (((b / scale - 0.5).floor() + 1.0).max(0.0) as usize).min(from + n);
                 lo..hi.max(lo)
             };
             let (w, h) = (level.width, level.height);
             if level.sums.is_empty() {
                 level.sums = vec![Sums::default(); w * h];
             }
-            let (ys, xs) = (range(y0, y1, h), range(x0, x1, w));
+            let (ys, xs) = (range(y0, y1, level.y0, h), range(x0, x1, level.x0, w));
             for ty in ys.clone().step_by(TILE) {
                 for tx in xs.clone().step_by(TILE) {
                     let (ty1, tx1) = ((ty + TILE).min(ys.end), (tx + TILE).min(xs.end));
@@ -242,7 +260,7 @@ impl Blend {
                             let d_tol = (s.distance - half).max(0.0);
                             let t_px = hold.tolerance_slope * d_tol;
                             let (b, bh, bd) = contribution(&q, s.target_m, s.distance, t_px);
-                            let cell = &mut level.sums[y * w + x];
+                            let cell = &mut level.sums[(y - level.y0) * w + x - level.x0];
                             cell.b += sign * b;
                             cell.bh += sign * bh;
                             cell.bd += sign * bd;

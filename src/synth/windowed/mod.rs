@@ -5,8 +5,18 @@
 //! stages see, inside the cone, exactly the inputs they see in the whole
 //! world and hash absolute coordinates (DESIGN §6).
 //!
+//! Under user control ([`controls`]) a window is what a scene's session
+//! makes, with pastes computed over their bounded sources ([`paste`]) and
+//! the control pyramids over aligned footprints ([`pyramid`]).
+//!
 //! (Not to be confused with [`super::window`], the region a coherent
 //! re-synthesis restricts itself to.)
+
+mod controls;
+mod paste;
+mod pyramid;
+
+pub use controls::{Paint, WindowControls};
 
 use super::cone::{Cone, Rect};
 use super::{SynthError, Synthesis, Synthesizer};
@@ -30,6 +40,21 @@ pub enum WindowError {
         h: usize,
         width: usize,
         height: usize,
+    },
+    #[error("{what} gave {got} values for a rectangle of {expected} pixels")]
+    Paint {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+    },
+    #[error(
+        "type paint at pixel ({x}, {y}) has type {id}: expected 0..={max} or 255 (unconstrained)"
+    )]
+    TypeId {
+        x: usize,
+        y: usize,
+        id: u8,
+        max: usize,
     },
 }
 
