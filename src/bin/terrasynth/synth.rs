@@ -68,7 +68,8 @@ pub struct Args {
     backend: BackendArg,
     /// A scene file (see data/scenes/): its database, size, seed and
     /// controls replace --db, --size, --seed, --jitter, --passes and
-    /// --start-exemplar; the preview shows the controls.
+    /// --start-exemplar; the preview shows the controls (not with
+    /// --window, whose preview is plain).
     #[arg(long, conflicts_with = "db")]
     scene: Option<PathBuf>,
     /// With --scene: a preview without the controls drawn on it.
@@ -111,6 +112,9 @@ pub fn check_synthesis_memory(width: usize, height: usize, factor: f64) -> Resul
 }
 
 pub fn run(a: Args) -> CliResult {
+    if let (Some(scene), Some(win)) = (&a.scene, a.window) {
+        return scene_window(&a, scene, win);
+    }
     if let Some(scene) = &a.scene {
         return crate::edit::synth_scene(
             scene,
@@ -184,6 +188,49 @@ pub fn run(a: Args) -> CliResult {
     if let Some(l0) = result.levels.first() {
         let paths = (a.coords.as_deref(), a.coords_preview.as_deref());
         write_coords(&source_map(&l0.coords, l0.width, w, h, &db), &db, paths)?;
+    }
+    Ok(())
+}
+
+/// `synth --scene S --window X,Y,W,H`: a window of the scene's terrain
+/// (its size is the world's).
+fn scene_window(a: &Args, scene_path: &Path, win: terrasynth::synth::cone::Rect) -> CliResult {
+    use terrasynth::scene::{Scene, WindowedScene};
+    let scene = Scene::read(scene_path)?;
+    let mut inputs = vec![scene_path];
+    inputs.extend(scene.database.as_deref());
+    check_outputs(&[Some(&a.output), a.preview.as_deref()], &inputs)?;
+    let db = load_database(scene.database.as_deref())?;
+    let ws = WindowedScene::new(&scene, &db)?;
+    let mut synth = Synthesizer::new(&db, ws.params())?;
+    select_backend(&mut synth, a.backend)?;
+    let world = (scene.width, scene.height);
+    let cone = synth.window_cone(world, win).map_err(window_error(win))?;
+    // A scene's first frame is recorded for its pastes (every pass of
+    // every level): about three times one synthesis, as `synth --scene`.
+    let what = format!("a {}x{} window of the scene", win.width(), win.height());
+    io::check_memory(&what, cone.bytes() * 3)?;
+    let t = std::time::Instant::now();
+    let hf = ws.synthesize_window(&synth, win)?;
+    write_output(&hf, &a.output, None, a.engine, &inputs)?;
+    let s = hf.stats().expect("synthesis has no nodata");
+    eprintln!(
+        "wrote {} ({} x {} at ({}, {}) of the {} x {} scene, seed {}): heights {:.1} .. {:.1} m in {:.0} ms",
+        a.output.display(),
+        win.width(),
+        win.height(),
+        win.x0,
+        win.y0,
+        scene.width,
+        scene.height,
+        scene.seed,
+        s.min,
+        s.max,
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    if let Some(p) = &a.preview {
+        render::write_png(p, &preview(&synth, &hf)?.image)?;
+        eprintln!("wrote {}", p.display());
     }
     Ok(())
 }

@@ -6,6 +6,7 @@ use crate::args::{BackendArg, load_database, parse_world_size, select_backend};
 use std::path::PathBuf;
 use std::time::Instant;
 use terrasynth::io::{self, Format};
+use terrasynth::scene::{Scene, WindowedScene};
 use terrasynth::synth::cone::Rect;
 use terrasynth::synth::{Params, Synthesizer};
 use terrasynth::tiles::{self, Tiling, grid::Grid};
@@ -17,8 +18,13 @@ pub struct Args {
     #[arg(long)]
     out_dir: PathBuf,
     /// World size WxH (each side up to 1048576, e.g. 65536x65536).
-    #[arg(long, value_parser = parse_world_size)]
-    size: (usize, usize),
+    #[arg(long, value_parser = parse_world_size, required_unless_present = "scene")]
+    size: Option<(usize, usize)>,
+    /// A scene file: the world is its terrain (its database, size, seed and
+    /// controls replace --db, --size, --seed, --jitter, --passes,
+    /// --start-exemplar and --height-prior).
+    #[arg(long, conflicts_with_all = ["db", "size", "seed", "jitter", "passes", "start_exemplar", "height_prior"])]
+    scene: Option<PathBuf>,
     /// Tile side in pixels (the last row and column may be shorter).
     #[arg(long, default_value_t = 1024)]
     tile: usize,
@@ -97,52 +103,93 @@ fn parse_range(s: &str) -> Result<(f64, f64), String> {
     }
 }
 
+/// What the tiles are windows of: a plain synthesis or a scene.
+enum World {
+    Plain { size: (usize, usize), seed: u32 },
+    Scene(Box<WindowedScene>),
+}
+
 pub fn run(a: Args) -> CliResult {
-    let db = load_database(a.db.as_deref())?;
-    let params = Params {
-        jitter: a.jitter,
-        passes: a.passes,
-        start_exemplar: a.start_exemplar,
-        prior: a.height_prior,
-        keep_levels: false,
+    let scene = a.scene.as_deref().map(Scene::read).transpose()?;
+    let db_path = match &scene {
+        Some(s) => s.database.clone(),
+        None => a.db.clone(),
     };
-    let mut synth = Synthesizer::new(&db, params)?;
+    let db = load_database(db_path.as_deref())?;
+    let (world, params) = match &scene {
+        Some(s) => {
+            let ws = WindowedScene::new(s, &db)?;
+            let params = ws.params();
+            (World::Scene(Box::new(ws)), params)
+        }
+        None => {
+            let params = Params {
+                jitter: a.jitter,
+                passes: a.passes,
+                start_exemplar: a.start_exemplar,
+                prior: a.height_prior,
+                keep_levels: false,
+            };
+            let size = a.size.expect("clap requires --size without --scene");
+            (World::Plain { size, seed: a.seed }, params)
+        }
+    };
+    let size = match &world {
+        World::Plain { size, .. } => *size,
+        World::Scene(s) => (s.width, s.height),
+    };
+    let mut synth = Synthesizer::new(&db, params.clone())?;
     select_backend(&mut synth, a.backend)?;
     let format = Format::from(a.format);
     let grid = Grid {
-        world: a.size,
+        world: size,
         tile: a.tile,
         overlap: a.overlap,
     };
     // Memory: one tile's cone per thread, for a tile amid the world (at
-    // the edges the cone is smaller).
-    let (w, h) = a.size;
+    // the edges the cone is smaller); a scene's tiles hold about three
+    // times that (its first frame's passes are recorded for the pastes).
+    let (w, h) = size;
     let side = |n: usize| (a.tile + 2 * a.overlap).min(n);
     let (tw, th) = (side(w), side(h));
     let probe = Rect::new((w - tw) / 2, (h - th) / 2, tw, th);
     let cone = synth
-        .window_cone(a.size, probe)
+        .window_cone(size, probe)
         .map_err(crate::synth::window_error(probe))?;
     let threads = rayon::current_num_threads() as u64;
+    let factor = if scene.is_some() { 3 } else { 1 };
     io::check_memory(
         &format!("{threads} tiles of {tw}x{th} in parallel"),
-        cone.bytes() * threads,
+        cone.bytes() * threads * factor,
     )?;
     let height_range_m = matches!(format, Format::Png16 | Format::R16).then(|| {
         a.height_range
             .unwrap_or_else(|| tiles::default_height_range(db.quantization()))
     });
-    let source = serde_json::json!({
+    let crc = |b: &[u8]| format!("0x{:08x}", crc32fast::hash(b));
+    let mut source = serde_json::json!({
         "database": {
-            "file": a.db.as_ref().map(|p| p.display().to_string()),
-            "crc32": format!("0x{:08x}", crc32fast::hash(db.file_bytes())),
+            "file": db_path.as_ref().map(|p| p.display().to_string()),
+            "crc32": crc(db.file_bytes()),
         },
-        "seed": a.seed,
-        "jitter": a.jitter,
-        "passes": a.passes,
-        "start_exemplar": a.start_exemplar,
-        "height_prior": a.height_prior,
+        "jitter": params.jitter,
+        "passes": params.passes,
+        "start_exemplar": params.start_exemplar,
+        "height_prior": params.prior,
     });
+    source["seed"] = match &world {
+        World::Plain { seed, .. } => *seed,
+        World::Scene(s) => s.seed,
+    }
+    .into();
+    if let Some(path) = &a.scene {
+        // The scene file itself (images it names are not checked).
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        source["scene"] = serde_json::json!({
+            "file": path.display().to_string(),
+            "crc32": crc(&bytes),
+        });
+    }
     let tiling = Tiling {
         grid,
         format,
@@ -151,7 +198,10 @@ pub fn run(a: Args) -> CliResult {
         source,
     };
     let t = Instant::now();
-    let window = |r: Rect| synth.synthesize_window(a.size, r, a.seed);
+    let window = |r: Rect| match &world {
+        World::Plain { size, seed } => synth.synthesize_window(*size, r, *seed),
+        World::Scene(s) => s.synthesize_window(&synth, r),
+    };
     let s = tiles::write(&tiling, &a.out_dir, &window, &crate::progress::Bar::new())?;
     let secs = t.elapsed().as_secs_f64();
     let (cols, rows) = grid.size();
