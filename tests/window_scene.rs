@@ -147,3 +147,25 @@ fn bad_paint_is_a_typed_error() {
         "{e:?}"
     );
 }
+
+/// The GPU makes the same scene windows (type seeding at absolute
+/// coordinates, guides over the cone, the paste frame).
+#[cfg(feature = "gpu")]
+#[test]
+fn gpu_scene_windows_match_the_cpu() {
+    #[path = "common/gpu.rs"]
+    mod gpu;
+    let Some(ctx) = gpu::context() else { return };
+    let s = scene(everything());
+    let ws = WindowedScene::new(&s, db()).unwrap();
+    let cpu = Synthesizer::new(db(), ws.params()).unwrap();
+    let mut gpu = Synthesizer::new(db(), ws.params()).unwrap();
+    gpu.use_gpu(ctx).unwrap();
+    let win = Rect::new(190, 30, 110, 100);
+    let bits = |h: &Heightfield| -> Vec<u32> { h.data().iter().map(|v| v.to_bits()).collect() };
+    let (a, b) = (
+        ws.synthesize_window(&cpu, win).unwrap(),
+        ws.synthesize_window(&gpu, win).unwrap(),
+    );
+    assert!(bits(&a) == bits(&b), "GPU window differs");
+}
