@@ -17,6 +17,7 @@ pub mod georef;
 pub mod hash;
 pub mod heightfield;
 pub mod io;
+pub mod level;
 pub mod masks;
 pub mod nodata;
 pub mod patch;
