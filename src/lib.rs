@@ -30,6 +30,7 @@ pub mod scene;
 #[cfg(feature = "serve")]
 pub mod server;
 pub mod size;
+pub mod stages;
 pub mod synth;
 
 pub use error::{Error, Result};

@@ -19,10 +19,10 @@ pub mod control;
 mod params;
 pub mod session;
 pub mod source_map;
-pub mod stages;
 mod window;
 
 pub use crate::level::{atlas, fixed, state};
+pub use crate::stages;
 
 use crate::backend::{Backend, Choice, Stage, cpu::Cpu};
 use crate::database::Database;

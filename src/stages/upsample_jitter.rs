@@ -17,9 +17,9 @@
 
 use crate::database::layout::MARGIN;
 use crate::hash::hash4;
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::fixed::{Coord, FRAC_BITS};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, FRAC_BITS};
+use crate::level::state::State;
 use rayon::prelude::*;
 
 /// How children relate to parents at this step.
@@ -111,7 +111,7 @@ pub fn upsample_jitter(
 /// rounded position falls in.
 #[inline(always)]
 fn clamp(a: &AtlasLevel<'_>, c: Coord) -> Coord {
-    let tx = crate::synth::fixed::round(c.x);
+    let tx = crate::level::fixed::round(c.x);
     let col = &a.columns[tx as usize];
     Coord {
         x: c.x.clamp(col.min_x << FRAC_BITS, col.max_x << FRAC_BITS),

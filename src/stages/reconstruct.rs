@@ -21,9 +21,9 @@
 //! predict. Conversion to metres is a CPU-side `offset + scale · value / 256`
 //! (DESIGN §6 rule 5).
 
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::fixed::{div_floor, round};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{div_floor, round};
+use crate::level::state::State;
 use rayon::prelude::*;
 
 /// Fractional bits of reconstructed heights.

@@ -7,7 +7,7 @@
 //! Sets are u32 bit masks of type ids; [`ALL_TYPES`] and `full` (every
 //! type of the database) both count as full.
 
-use crate::synth::stages::correct::ALL_TYPES;
+use crate::stages::correct::ALL_TYPES;
 use rayon::prelude::*;
 
 /// R^{i} (`w × h`) from R^{i−1} (`cw × ch`); children past the child

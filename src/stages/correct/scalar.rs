@@ -10,10 +10,10 @@ use super::{
 use crate::database::appearance::{MODE1_BIAS, unpack_texel};
 use crate::database::types::SEEDS_PER_TYPE;
 use crate::hash::{below, hash4};
-use crate::synth::atlas::AtlasLevel;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, FRAC_BITS, round};
+use crate::level::state::State;
 use crate::synth::control::blend::nudge;
-use crate::synth::fixed::{Coord, FRAC_BITS, round};
-use crate::synth::state::State;
 use rayon::prelude::*;
 
 /// Reflects a coordinate at the level border by 2 (keeps parity); the
