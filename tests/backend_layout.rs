@@ -324,7 +324,7 @@ fn shade_constants_match() {
 fn correct_constants_match() {
     use terrasynth::database::appearance::MODE1_BIAS;
     use terrasynth::database::types::SEEDS_PER_TYPE;
-    use terrasynth::synth::control::blend::MAX_ERROR;
+    use terrasynth::stages::correct::nudge::MAX_ERROR;
     use terrasynth::synth::stages::correct::{
         ALL_TYPES, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };

@@ -56,13 +56,14 @@
 //! the level, coordinates are extrapolated from the reflected pixel (see
 //! [`neighbour`]).
 
+pub mod nudge;
 pub mod scalar;
 pub mod simd;
 
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, div_floor};
 use crate::level::state::State;
-use crate::synth::control::Target;
+use nudge::Target;
 use rayon::prelude::*;
 
 /// Residual clamp (in ×3 height units), see the module docs.

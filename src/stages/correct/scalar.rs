@@ -3,6 +3,7 @@
 //! (borders included) and is the oracle the [`super::simd`] path is tested
 //! against.
 
+use super::nudge::nudge;
 use super::{
     ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, Prior, SEED_SALT,
     SEEDS_PER_ALLOWED_TYPE, W_FREE, weigh,
@@ -13,7 +14,6 @@ use crate::hash::{below, hash4};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use crate::synth::control::blend::nudge;
 use rayon::prelude::*;
 
 /// Reflects a coordinate at the level border by 2 (keeps parity); the
