@@ -5,4 +5,5 @@ pub mod correct;
 pub mod reconstruct;
 pub mod reduce_types;
 pub mod reduce_weights;
+pub mod shade;
 pub mod upsample_jitter;
