@@ -15,13 +15,12 @@ use std::hint::black_box;
 use std::path::Path;
 use terrasynth::io::{self, ReadOptions};
 use terrasynth::patch::candidates::{COARSE, FILL_TRANSFORMS};
-use terrasynth::patch::costs::{
-    FEATURE_TRANSFORMS, centre_cells, feature_cost, fill_ssd, fill_ssd_scalar,
-};
+use terrasynth::patch::costs::{FEATURE_TRANSFORMS, feature_cost};
 use terrasynth::patch::merge::{self, Canvas, Window};
 use terrasynth::patch::sketch::{Kind, Sketch};
 use terrasynth::patch::{self, Library, Params, sketch_field, sketch_graph};
 use terrasynth::progress::Silent;
+use terrasynth::stages::fill_ssd::{centre_cells, fill_ssd, fill_ssd_scalar};
 
 const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
 const NAMES: [&str; 8] = [

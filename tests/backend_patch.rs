@@ -8,8 +8,8 @@
 use proptest::prelude::*;
 use std::path::Path;
 use terrasynth::patch::candidates::{COARSE, PreparedSource};
-use terrasynth::patch::costs::{FILL_CLAMP, centre_cells, fill_ssd_scalar, fill_ssd_table};
 use terrasynth::patch::hole_fill::user_cells;
+use terrasynth::stages::fill_ssd::{FILL_CLAMP, centre_cells, fill_ssd_scalar, fill_ssd_table};
 
 mod common;
 use common::dem::DEM;

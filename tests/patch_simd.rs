@@ -3,7 +3,8 @@
 //! DC-corrected SSD unchanged while no cell is clamped.
 
 use proptest::prelude::*;
-use terrasynth::patch::costs::{FILL_CLAMP, centre_cells, fill_ssd, fill_ssd_scalar, ssd_dc};
+use terrasynth::patch::costs::ssd_dc;
+use terrasynth::stages::fill_ssd::{FILL_CLAMP, centre_cells, fill_ssd, fill_ssd_scalar};
 
 /// `m × m` user cells, candidate cells and validity for `m` in 1..=32
 /// (patch sizes 8..256), values anywhere in the clamp range.

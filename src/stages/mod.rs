@@ -2,6 +2,7 @@
 //! its WGSL mirror in `kernels/` (DESIGN §3).
 
 pub mod correct;
+pub mod fill_ssd;
 pub mod reconstruct;
 pub mod reduce_types;
 pub mod reduce_weights;
