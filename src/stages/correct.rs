@@ -59,12 +59,15 @@
 pub mod nudge;
 pub mod scalar;
 pub mod simd;
+mod uniform;
 
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, div_floor};
 use crate::level::state::State;
 use nudge::Target;
 use rayon::prelude::*;
+
+pub use uniform::{CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, CorrectUniform, GuideCell};
 
 /// Residual clamp (in ×3 height units), see the module docs.
 pub const CLAMP: i32 = 9_459;

@@ -6,6 +6,8 @@
 //! explicit-SIMD twin, [`fill_ssd_table`] the data-parallel loop over
 //! candidates. Where it runs (CPU or GPU) is `patch::fill_ssd::FillCost`.
 
+use bytemuck::{Pod, Zeroable};
+
 /// Largest magnitude of a centred cell in the round-one fill kernels
 /// ([`fill_ssd`]), in decimetres (819.1 m). Cells are centred on their
 /// window's mean first, which leaves the DC-corrected SSD unchanged (it is
@@ -119,4 +121,14 @@ pub fn fill_ssd_table(user: &[Vec<i32>], mask: &[Vec<i32>], cells: &[i32], k: i6
                 .map(move |(u, m)| fill_ssd(u, m, c, k))
         })
         .collect()
+}
+
+/// `FillSsdParams` of `kernels/fill_ssd.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct FillSsdUniform {
+    pub cells: u32,
+    pub candidates: u32,
+    pub transforms: u32,
+    pub pad0: u32,
 }

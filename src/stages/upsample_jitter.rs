@@ -20,6 +20,7 @@ use crate::hash::hash4;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS};
 use crate::level::state::State;
+use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 
 /// How children relate to parents at this step.
@@ -125,6 +126,29 @@ fn clamp(a: &AtlasLevel<'_>, c: Coord) -> Coord {
 fn wrap(v: i32, min: i32, max: i32) -> i32 {
     let period = (max - min + 1) << FRAC_BITS;
     (min << FRAC_BITS) + (v - (min << FRAC_BITS)).rem_euclid(period)
+}
+
+/// [`Step`] as the kernel's `step` field.
+pub const STEP_PYRAMID: u32 = 0;
+pub const STEP_VIRTUAL: u32 = 1;
+pub const STEP_WRAP: u32 = 2;
+
+/// `UpsampleParams` of `kernels/upsample_jitter.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct UpsampleUniform {
+    pub child_width: u32,
+    pub child_height: u32,
+    pub parent_width: u32,
+    pub seed: u32,
+    pub level: u32,
+    pub jitter: i32,
+    pub step: u32,
+    pub shift: u32,
+    pub min_x: i32,
+    pub max_x: i32,
+    pub min_y: i32,
+    pub max_y: i32,
 }
 
 #[cfg(test)]

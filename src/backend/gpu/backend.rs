@@ -3,10 +3,10 @@
 
 use super::{Gpu, GpuGuide, GpuRaster, GpuState};
 use crate::backend::{Backend, BackendError, StageTime};
-use crate::synth::fixed::Coord;
-use crate::synth::stages::correct::{CorrectParams, Guide};
-use crate::synth::stages::upsample_jitter::UpsampleParams;
-use crate::synth::state::State;
+use crate::level::fixed::Coord;
+use crate::level::state::State;
+use crate::stages::correct::{CorrectParams, Guide};
+use crate::stages::upsample_jitter::UpsampleParams;
 
 impl Backend for Gpu {
     type State = GpuState;

@@ -67,7 +67,7 @@ impl Context {
                 label: Some(k.name),
                 layout: None,
                 module: &module,
-                entry_point: Some("main"),
+                entry_point: Some(kernels::ENTRY_POINT),
                 compilation_options: Default::default(),
                 cache: None,
             })

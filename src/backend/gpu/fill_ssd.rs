@@ -10,8 +10,7 @@
 
 use super::Context;
 use crate::backend::BackendError;
-use crate::backend::kernels::FillSsdUniform;
-use crate::stages::fill_ssd::dc_ssd;
+use crate::stages::fill_ssd::{FillSsdUniform, dc_ssd};
 
 /// One source's candidate cells on the device.
 pub struct FillSource {

@@ -15,10 +15,11 @@
 //! The parts: `context` (device and pipelines), `buffers` (storage
 //! buffers and read-back), `dispatch` (one compute pass), `timing`
 //! (timestamp queries), `database` (the atlas on the device), `state`
-//! and `rasters` (per-level data), one module per stage
-//! (`upsample_jitter`, `correct`, `reduce`, `reconstruct`,
-//! `shade`) and `backend` (the [`super::Backend`] trait on [`Gpu`]).
-//! The patch engine's data-parallel cost stage lives in [`fill_ssd`].
+//! and `rasters` (per-level data), one module per stage, named like its
+//! kernel and its CPU mirror in `stages` (`upsample_jitter`, `correct`,
+//! `reduce_types`, `reduce_weights`, `reconstruct`, `shade`, and the patch
+//! engine's [`fill_ssd`]) and `backend` (the [`super::Backend`] trait on
+//! [`Gpu`]).
 
 mod backend;
 mod buffers;
@@ -29,7 +30,8 @@ mod dispatch;
 pub mod fill_ssd;
 mod rasters;
 mod reconstruct;
-mod reduce;
+mod reduce_types;
+mod reduce_weights;
 mod shade;
 mod state;
 mod timing;

@@ -2,8 +2,8 @@
 //! heights, read back to the host.
 
 use super::{Gpu, GpuState, groups};
-use crate::backend::kernels::ReconstructUniform;
 use crate::backend::{BackendError, Stage};
+use crate::stages::reconstruct::ReconstructUniform;
 
 impl Gpu {
     pub(super) fn dispatch_reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {

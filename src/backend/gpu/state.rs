@@ -2,8 +2,8 @@
 
 use super::Gpu;
 use crate::backend::BackendError;
-use crate::synth::fixed::Coord;
-use crate::synth::state::State;
+use crate::level::fixed::Coord;
+use crate::level::state::State;
 
 /// One level's state on the device: S as `vec2<i32>` (the bytes of
 /// `Coord::pack`), V as `i32`.
