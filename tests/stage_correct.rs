@@ -54,10 +54,6 @@ proptest! {
         let runs = rig.correct(level, (&st, with_parent.then_some(&parent)), &p, None);
         assert_agree(&runs, &format!("random {w}x{h} level {level} prior {prior}"));
     }
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(24))]
 
     /// Coherent patches of coordinates (so candidate de-duplication is
     /// exercised), every subpass at every prior, through the guided entry
@@ -205,10 +201,6 @@ proptest! {
         let what = format!("guided {which:04b} {w}x{h} at level {level}");
         rig.correct_at_every_prior(level, (&st, Some(&parent)), Some(&g), &what);
     }
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
     /// Random states, targets (some unconstrained, tolerances 0..MAX_TOL,
     /// far-off heights), type sets (none, one or several types, empty

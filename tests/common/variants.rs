@@ -6,7 +6,7 @@
 //! built.
 
 use std::fmt::Debug;
-use terrasynth::backend::{Backend, cpu::Cpu};
+use terrasynth::backend::{Backend, BackendError, cpu::Cpu};
 use terrasynth::database::Database;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::fixed::Coord;
@@ -37,6 +37,24 @@ pub fn assert_agree<T: PartialEq + Debug>(runs: &[Run<T>], what: &str) {
         }
         assert_eq!(got.len(), want.len(), "{what}: {name}'s length");
     }
+}
+
+/// The upload of 5 values as a 2 × 3 raster was refused with
+/// [`BackendError::RasterSize`] (a stage indexes rasters by pixel: a short
+/// one must be a typed error, never an out-of-bounds read).
+pub fn assert_mis_sized(r: Result<(), BackendError>) {
+    assert!(
+        matches!(
+            r,
+            Err(BackendError::RasterSize {
+                len: 5,
+                width: 2,
+                height: 3,
+                ..
+            })
+        ),
+        "{r:?}"
+    )
 }
 
 /// Whether a stage without a CPU fast path has anything to compare (a
