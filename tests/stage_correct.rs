@@ -12,7 +12,6 @@
 
 use proptest::prelude::*;
 use std::path::Path;
-use terrasynth::database::Database;
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::state::{State, level_size};
@@ -26,7 +25,7 @@ use terrasynth::synth::control::UNCONSTRAINED;
 use terrasynth::synth::{Guides, LevelGuide, Params, Synthesizer};
 
 mod common;
-use common::db::{PYRENEES_JURA, RIVIERA_PYRENEES, default_db, two_dems};
+use common::db::{RIVIERA_PYRENEES, default_db, real_syntheses, two_dems};
 use common::dem::DEM;
 use common::states::{
     copy, from_maps, patchy_parent, patchy_state, random_state, real_levels, xorshift,
@@ -74,34 +73,25 @@ proptest! {
     }
 }
 
-/// Every subpass at the default prior on every corrected level of one
-/// synthesis, each from the same state.
-fn check_real_states(db: &'static Database, size: (usize, usize), seed: u32) {
-    let rig = rig(db);
-    let l = db.level_count() - 1;
-    for r in real_levels(db, size, seed).iter().filter(|r| r.level <= l) {
-        for (k, &(px, py)) in SUBPASSES.iter().enumerate() {
-            let p = CorrectParams {
-                px,
-                py,
-                prior: DEFAULT_PRIOR,
-            };
-            let runs = rig.correct(r.level, (&r.state, r.parent.as_ref()), &p, None);
-            let what = format!("real state, level {}, subpass {k}", r.level);
-            assert_agree(&runs, &what);
+/// Every subpass at the default prior on every corrected level of each
+/// real synthesis, each from the same state.
+#[test]
+fn correct_agrees_on_real_states() {
+    for (db, size, seed) in real_syntheses("real-DEM correct cross-checks") {
+        let rig = rig(db);
+        let l = db.level_count() - 1;
+        for r in real_levels(db, size, seed).iter().filter(|r| r.level <= l) {
+            for (k, &(px, py)) in SUBPASSES.iter().enumerate() {
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: DEFAULT_PRIOR,
+                };
+                let runs = rig.correct(r.level, (&r.state, r.parent.as_ref()), &p, None);
+                let what = format!("real state, level {}, subpass {k}", r.level);
+                assert_agree(&runs, &what);
+            }
         }
-    }
-}
-
-#[test]
-fn correct_agrees_on_real_states_of_the_default_database() {
-    check_real_states(default_db(), (256, 192), 3);
-}
-
-#[test]
-fn correct_agrees_on_real_states_of_shared_dems() {
-    if let Some(db) = two_dems(PYRENEES_JURA, "real-DEM correct cross-checks") {
-        check_real_states(db, (200, 256), 11);
     }
 }
 

@@ -6,10 +6,9 @@
 //! and passes.
 
 use proptest::prelude::*;
-use terrasynth::database::Database;
 
 mod common;
-use common::db::{PYRENEES_JURA, default_db, two_dems};
+use common::db::{default_db, real_syntheses};
 use common::states::{random_state, real_levels};
 use common::variants::{assert_agree, gpu_or_skip, rig};
 
@@ -30,26 +29,15 @@ proptest! {
     }
 }
 
-/// Level 0 of one synthesis.
-fn check_real_state(db: &'static Database, size: (usize, usize), seed: u32) {
-    let levels = real_levels(db, size, seed);
-    let level0 = levels.iter().find(|r| r.level == 0).expect("level 0 kept");
-    assert_agree(&rig(db).reconstruct(&level0.state), "reconstruct (real)");
-}
-
+/// Level 0 of each real synthesis.
 #[test]
-fn reconstruct_agrees_on_real_states_of_the_default_database() {
-    if gpu_or_skip("reconstruct") {
-        check_real_state(default_db(), (256, 192), 3);
-    }
-}
-
-#[test]
-fn reconstruct_agrees_on_real_states_of_shared_dems() {
+fn reconstruct_agrees_on_real_states() {
     if !gpu_or_skip("reconstruct") {
         return;
     }
-    if let Some(db) = two_dems(PYRENEES_JURA, "real-DEM reconstruct cross-checks") {
-        check_real_state(db, (200, 256), 11);
+    for (db, size, seed) in real_syntheses("real-DEM reconstruct cross-checks") {
+        let levels = real_levels(db, size, seed);
+        let level0 = levels.iter().find(|r| r.level == 0).expect("level 0 kept");
+        assert_agree(&rig(db).reconstruct(&level0.state), "reconstruct (real)");
     }
 }

@@ -6,12 +6,12 @@
 //! every test says so and passes.
 
 use proptest::prelude::*;
-use terrasynth::database::{Database, layout::MARGIN};
+use terrasynth::database::layout::MARGIN;
 use terrasynth::level::state::level_size;
 use terrasynth::stages::upsample_jitter::{Step, UpsampleParams};
 
 mod common;
-use common::db::{PYRENEES_JURA, default_db, two_dems};
+use common::db::{default_db, real_syntheses};
 use common::states::{random_state, real_levels};
 use common::variants::{assert_agree, gpu_or_skip, rig};
 
@@ -54,39 +54,28 @@ proptest! {
     }
 }
 
-/// Every kept level of one synthesis at or below the database's coarsest
-/// (and above level 0) upsampled into the level below it.
-fn check_real_states(db: &'static Database, (w, h): (usize, usize), seed: u32) {
-    let rig = rig(db);
-    let l = db.level_count() - 1;
-    for r in real_levels(db, (w, h), seed) {
-        if r.level >= 1 && r.level <= l {
-            let level = r.level - 1;
-            let p = UpsampleParams {
-                seed,
-                level: level as u32,
-                jitter: 102,
-                step: Step::Pyramid,
-            };
-            let runs = rig.upsample_jitter(&r.state, level_size(w, h, level), level, &p);
-            assert_agree(&runs, &format!("upsample_jitter to level {level} (real)"));
-        }
-    }
-}
-
+/// Every kept level of each real synthesis at or below the database's
+/// coarsest (and above level 0) upsampled into the level below it.
 #[test]
-fn upsample_jitter_agrees_on_real_states_of_the_default_database() {
-    if gpu_or_skip("upsample_jitter") {
-        check_real_states(default_db(), (256, 192), 3);
-    }
-}
-
-#[test]
-fn upsample_jitter_agrees_on_real_states_of_shared_dems() {
+fn upsample_jitter_agrees_on_real_states() {
     if !gpu_or_skip("upsample_jitter") {
         return;
     }
-    if let Some(db) = two_dems(PYRENEES_JURA, "real-DEM upsample_jitter cross-checks") {
-        check_real_states(db, (200, 256), 11);
+    for (db, (w, h), seed) in real_syntheses("real-DEM upsample_jitter cross-checks") {
+        let rig = rig(db);
+        let l = db.level_count() - 1;
+        for r in real_levels(db, (w, h), seed) {
+            if r.level >= 1 && r.level <= l {
+                let level = r.level - 1;
+                let p = UpsampleParams {
+                    seed,
+                    level: level as u32,
+                    jitter: 102,
+                    step: Step::Pyramid,
+                };
+                let runs = rig.upsample_jitter(&r.state, level_size(w, h, level), level, &p);
+                assert_agree(&runs, &format!("upsample_jitter to level {level} (real)"));
+            }
+        }
     }
 }

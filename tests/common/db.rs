@@ -54,6 +54,16 @@ pub const PYRENEES_CATALAN: TwoDems = TwoDems {
     typed: true,
 };
 
+/// The syntheses whose real level states every level stage is checked on:
+/// `(database, size, seed)` — 256×192 of the default database (seed 3)
+/// and, where ../shared/dem is present (else saying that `what` is
+/// skipped), 200×256 of [`PYRENEES_JURA`] (seed 11).
+pub fn real_syntheses(what: &str) -> Vec<(&'static Database, (usize, usize), u32)> {
+    let mut out = vec![(default_db(), (256, 192), 3)];
+    out.extend(two_dems(PYRENEES_JURA, what).map(|db| (db, (200, 256), 11)));
+    out
+}
+
 /// The database of `spec`, built once per test binary, or `None` (saying
 /// that `what` is skipped) when ../shared/dem is absent.
 pub fn two_dems(spec: TwoDems, what: &str) -> Option<&'static Database> {
