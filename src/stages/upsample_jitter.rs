@@ -12,8 +12,10 @@
 //! L they wrap toroidally into the start exemplar's interior, so an output
 //! larger than the exemplar starts from a jittered, tiled copy that the
 //! correction at level L then rearranges. Below L, children are clamped into
-//! their exemplar's interior (the parent's exemplar: jitter never moves a
-//! child across exemplars because exemplars are ≥ 2 texels apart).
+//! the interior of their parent's exemplar, found from the child's position
+//! before jitter: a jitter of up to 4 texels (the `--jitter` limit) can
+//! carry a child past the 2-texel margin and gap, into another exemplar or
+//! off the atlas (a crash at `--jitter 4` before this rule).
 
 use crate::database::layout::MARGIN;
 use crate::hash::hash4;
@@ -87,7 +89,7 @@ pub fn upsample_jitter(
                         x: 2 * s.x + off_x,
                         y: 2 * s.y + off_y,
                     };
-                    clamp(a, c)
+                    clamp(a, c, 2 * s.x + (cx << FRAC_BITS))
                 }
                 Step::Virtual { shift } => Coord {
                     x: s.x + (off_x << shift),
@@ -108,11 +110,12 @@ pub fn upsample_jitter(
     });
 }
 
-/// Clamps a fixed-point coordinate into the interior of the exemplar its
-/// rounded position falls in.
+/// Clamps a fixed-point coordinate into the interior of the exemplar that
+/// holds `home_x` (the child's x before jitter, inside its parent's
+/// exemplar).
 #[inline(always)]
-fn clamp(a: &AtlasLevel<'_>, c: Coord) -> Coord {
-    let tx = crate::level::fixed::round(c.x);
+fn clamp(a: &AtlasLevel<'_>, c: Coord, home_x: i32) -> Coord {
+    let tx = crate::level::fixed::round(home_x);
     let col = &a.columns[tx as usize];
     Coord {
         x: c.x.clamp(col.min_x << FRAC_BITS, col.max_x << FRAC_BITS),

@@ -118,7 +118,7 @@ impl Backend for Gpu {
     }
 
     fn has_device_clock(&self) -> bool {
-        self.ctx.profile.is_some()
+        self.ctx.queries.is_some()
     }
 
     fn device_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {

@@ -101,7 +101,7 @@ impl Context {
             &[&user_buf, &src.buf, &out],
             (super::groups(src.candidates), super::groups(transforms)),
         );
-        let sums: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&self.read(&out)?);
+        let sums: Vec<[u32; 4]> = self.read(&out)?;
         Ok(sums
             .iter()
             .map(|&[s, lo, hi, _]| {

@@ -8,9 +8,10 @@
 //! a hardware adapter wgpu falls back to Mesa's lavapipe (software Vulkan,
 //! Debian package `mesa-vulkan-drivers`), which is how CI checks this path.
 //!
-//! Each stage call records one command buffer and submits it; the queue
-//! runs them in order, and wgpu orders storage-buffer accesses across
-//! submissions, so one subpass sees the previous one's writes.
+//! Each stage call records one compute pass into a shared encoder,
+//! submitted in batches (`dispatch`); passes run in recording order and
+//! wgpu orders storage-buffer accesses between them, so one subpass sees
+//! the previous one's writes.
 //!
 //! The parts: `context` (device and pipelines), `buffers` (storage
 //! buffers and read-back), `dispatch` (one compute pass), `timing`

@@ -40,11 +40,11 @@ impl Gpu {
     }
 
     pub(super) fn download_type_raster(&self, r: &GpuRaster) -> Result<Vec<u32>, BackendError> {
-        Ok(bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?))
+        self.ctx.read(&r.buf)
     }
 
     pub(super) fn download_weight_raster(&self, r: &GpuRaster) -> Result<Vec<u8>, BackendError> {
-        let wide: Vec<u32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?);
+        let wide: Vec<u32> = self.ctx.read(&r.buf)?;
         // Every stored weight is ≤ 255 (an uploaded u8 or a reduction's ≤ 4).
         Ok(wide.into_iter().map(|w| w as u8).collect())
     }

@@ -25,6 +25,6 @@ impl Context {
             &[&heights, &types, &tint, &colours, &out],
             (groups(p.width as usize), groups(p.height as usize)),
         );
-        Ok(bytemuck::pod_collect_to_vec(&self.read(&out)?))
+        self.read(&out)
     }
 }

@@ -45,8 +45,8 @@ impl Gpu {
         &self,
         st: &GpuState,
     ) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {
-        let s: Vec<u64> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.s)?);
-        let v: Vec<i32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.v)?);
+        let s: Vec<u64> = self.ctx.read(&st.s)?;
+        let v: Vec<i32> = self.ctx.read(&st.v)?;
         Ok((s.into_iter().map(Coord::unpack).collect(), v))
     }
 }
