@@ -2,22 +2,18 @@
 //! `ppa/sketch/1024` (PPA + feature graph of a sketch), `prepare/source/800`
 //! (one DEM's features and candidates), `feature_cost/cpu/<n>` (round one
 //! over every ridge node of one source × 10 transforms for one user patch),
-//! `fill_ssd/{scalar,simd}/<n>` (round one of hole filling: every fill
-//! candidate of one source × 6 transforms, scalar oracle against the
-//! explicit-SIMD kernel), `graphcut/cpu/64` (one full seam) and
+//! `graphcut/cpu/64` (one full seam) and
 //! `graphcut/banded/64` (half-resolution seam, then the banded full one, as
 //! synthesis does), `poisson_merge/cpu/64` (Shepard + multigrid Poisson of
-//! one patch), and end to end `sketch/<k>src/512`. Per-stage times of a
+//! one patch), and end to end `sketch/<k>src/512`. Stage `fill_ssd` (round
+//! one of hole filling): `benches/stages.rs`. Per-stage times of a
 //! whole 1024² run are printed by `terrasynth sketch` (Timings).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
 use terrasynth::io::{self, ReadOptions};
-use terrasynth::patch::candidates::{COARSE, FILL_TRANSFORMS};
-use terrasynth::patch::costs::{
-    FEATURE_TRANSFORMS, centre_cells, feature_cost, fill_ssd, fill_ssd_scalar,
-};
+use terrasynth::patch::costs::{FEATURE_TRANSFORMS, feature_cost};
 use terrasynth::patch::merge::{self, Canvas, Window};
 use terrasynth::patch::sketch::{Kind, Sketch};
 use terrasynth::patch::{self, Library, Params, sketch_field, sketch_graph};
@@ -87,38 +83,7 @@ fn bench(c: &mut Criterion) {
     });
     g.finish();
 
-    // Round one of hole filling against a window whose left half is filled,
-    // taken from the source itself (user cells already permuted per
-    // transform, as `fill` does once per step).
     let src = &lib.sources[4];
-    let m = 64 / COARSE;
-    let mut user: Vec<i32> = (0..m * m)
-        .map(|i| src.coarse[(20 + i / m) * src.coarse_w + 30 + i % m])
-        .collect();
-    let valid: Vec<bool> = (0..m * m).map(|i| i % m < m / 2).collect();
-    let k = centre_cells(&mut user, Some(&valid));
-    let mask: Vec<i32> = valid.iter().map(|&v| -(v as i32)).collect();
-    let perms: Vec<Vec<i32>> = (0..FILL_TRANSFORMS).map(|_| user.clone()).collect();
-    let mut g = c.benchmark_group("fill_ssd");
-    type Kernel = fn(&[i32], &[i32], &[i32], i64) -> u64;
-    for (name, f) in [
-        ("scalar", fill_ssd_scalar as Kernel),
-        ("simd", fill_ssd as Kernel),
-    ] {
-        g.bench_function(format!("{name}/{}", src.fill.len()), |b| {
-            b.iter(|| {
-                let mut best = u64::MAX;
-                for cells in src.fill_cells.chunks(m * m) {
-                    for a in &perms {
-                        best = best.min(f(a, &mask, cells, k));
-                    }
-                }
-                black_box(best)
-            })
-        });
-    }
-    g.finish();
-
     // A half-filled canvas and a patch from another place of the same DEM.
     let mut canvas = Canvas::new(128, 128);
     for y in 0..128 {

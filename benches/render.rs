@@ -1,6 +1,6 @@
-//! The preview renderer on a 1024² DEM: the `shade` stage alone
-//! (`shade/cpu/1024`, inputs prepared once) and end to end (`render/1024`:
-//! prepare + shade, and with PNG encoding).
+//! The preview renderer on a 1024² DEM end to end (`render/1024`: prepare
+//! and shade, and with PNG encoding). The `shade` stage alone:
+//! `benches/stages.rs`.
 //!
 //! Uses the shared 1024² Olympic Peninsula DEM when `../shared/dem` is
 //! present, otherwise (with a message) a synthetic 1024² terrain of the same
@@ -10,7 +10,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
 use terrasynth::Heightfield;
-use terrasynth::render::{self, RenderOptions, shade};
+use terrasynth::render::{self, RenderOptions};
 
 fn dem() -> Heightfield {
     let path = Path::new(concat!(
@@ -33,16 +33,6 @@ fn dem() -> Heightfield {
 fn bench(c: &mut Criterion) {
     let hf = dem();
     let opts = RenderOptions::default();
-    let prep = render::prepare(&hf, &opts).expect("default options render");
-    let mut out = vec![0u32; prep.heights.len()];
-
-    let mut g = c.benchmark_group("shade");
-    g.sample_size(20);
-    g.bench_function("cpu/1024", |b| {
-        b.iter(|| shade::shade(&prep.params, &prep.buffers(), black_box(&mut out)).unwrap())
-    });
-    g.finish();
-
     let mut g = c.benchmark_group("render");
     g.sample_size(10);
     g.bench_function("1024", |b| {

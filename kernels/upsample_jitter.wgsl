@@ -50,10 +50,10 @@ fn wrap(v: i32, lo: i32, hi: i32) -> i32 {
     return (lo << FRAC_BITS) + rem_floor(v - (lo << FRAC_BITS), period);
 }
 
-// upsample_jitter::clamp: into the interior of the exemplar the rounded
-// position falls in.
-fn clamp_exemplar(c: vec2<i32>) -> vec2<i32> {
-    let col = columns[round_fixed(c.x)];
+// upsample_jitter::clamp: into the interior of the exemplar that holds
+// home_x (the child's x before jitter).
+fn clamp_exemplar(c: vec2<i32>, home_x: i32) -> vec2<i32> {
+    let col = columns[round_fixed(home_x)];
     return vec2<i32>(
         clamp(c.x, col.min_x << FRAC_BITS, col.max_x << FRAC_BITS),
         clamp(c.y, MARGIN << FRAC_BITS, col.max_y << FRAC_BITS),
@@ -77,7 +77,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var out: vec2<i32>;
     switch p.step {
         case STEP_PYRAMID: {
-            out = clamp_exemplar(vec2<i32>(2 * s.x + off_x, 2 * s.y + off_y));
+            out = clamp_exemplar(vec2<i32>(2 * s.x + off_x, 2 * s.y + off_y), 2 * s.x + (cx << FRAC_BITS));
         }
         case STEP_VIRTUAL: {
             out = vec2<i32>(s.x + (off_x << p.shift), s.y + (off_y << p.shift));

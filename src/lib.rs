@@ -17,6 +17,7 @@ pub mod georef;
 pub mod hash;
 pub mod heightfield;
 pub mod io;
+pub mod level;
 pub mod masks;
 pub mod nodata;
 pub mod patch;
@@ -29,6 +30,7 @@ pub mod scene;
 #[cfg(feature = "serve")]
 pub mod server;
 pub mod size;
+pub mod stages;
 pub mod synth;
 pub mod tiles;
 

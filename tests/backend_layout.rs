@@ -3,12 +3,15 @@
 //! and member offsets on both sides.
 
 use std::mem::{offset_of, size_of};
-use terrasynth::backend::kernels::{
-    self, CorrectUniform, FillSsdUniform, GuideCell, ReconstructUniform, ReduceTypesUniform,
-    ReduceWeightsUniform, UpsampleUniform,
-};
-use terrasynth::render::shade::ShadeParams;
-use terrasynth::synth::atlas::Column;
+use terrasynth::backend::kernels;
+use terrasynth::level::atlas::Column;
+use terrasynth::stages::correct::{CorrectUniform, GuideCell};
+use terrasynth::stages::fill_ssd::FillSsdUniform;
+use terrasynth::stages::reconstruct::ReconstructUniform;
+use terrasynth::stages::reduce_types::ReduceTypesUniform;
+use terrasynth::stages::reduce_weights::ReduceWeightsUniform;
+use terrasynth::stages::shade::ShadeParams;
+use terrasynth::stages::upsample_jitter::UpsampleUniform;
 
 fn module(k: kernels::Kernel) -> naga::Module {
     module_info(k).0
@@ -122,9 +125,12 @@ fn every_kernel_parses_and_validates() {
     for k in kernels::ALL {
         let m = module(k);
         assert!(
-            m.entry_points.iter().any(|e| e.name == "main"),
-            "{} has no `main` entry point",
-            k.name
+            m.entry_points
+                .iter()
+                .any(|e| e.name == kernels::ENTRY_POINT),
+            "{} has no `{}` entry point",
+            k.name,
+            kernels::ENTRY_POINT
         );
     }
 }
@@ -298,7 +304,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
 
 #[test]
 fn shade_constants_match() {
-    use terrasynth::render::shade::{self, flags};
+    use terrasynth::stages::shade::{self, flags};
     let src = kernels::SHADE.source;
     for (name, v) in [
         ("F_CONTOURS", flags::CONTOURS),
@@ -332,15 +338,16 @@ fn shade_constants_match() {
 fn correct_constants_match() {
     use terrasynth::database::appearance::MODE1_BIAS;
     use terrasynth::database::types::SEEDS_PER_TYPE;
-    use terrasynth::synth::control::blend::MAX_ERROR;
-    use terrasynth::synth::stages::correct::{
-        ALL_TYPES, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE,
+    use terrasynth::stages::correct::nudge::MAX_ERROR;
+    use terrasynth::stages::correct::{
+        ALL_TYPES, CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, SEED_SALT,
+        SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };
     let src = kernels::CORRECT.source;
     for (name, v) in [
-        ("F_TARGETS", kernels::CORRECT_TARGETS),
-        ("F_ALLOWED", kernels::CORRECT_ALLOWED),
-        ("F_COHERENCE", kernels::CORRECT_COHERENCE),
+        ("F_TARGETS", CORRECT_TARGETS),
+        ("F_ALLOWED", CORRECT_ALLOWED),
+        ("F_COHERENCE", CORRECT_COHERENCE),
         ("ALL_TYPES", ALL_TYPES),
         ("W_FREE", W_FREE as u32),
         ("SEEDS_PER_ALLOWED_TYPE", SEEDS_PER_ALLOWED_TYPE),
@@ -362,7 +369,7 @@ fn correct_constants_match() {
 
 #[test]
 fn all_types_matches_reduce_types() {
-    assert_eq!(terrasynth::synth::stages::correct::ALL_TYPES, u32::MAX);
+    assert_eq!(terrasynth::stages::correct::ALL_TYPES, u32::MAX);
     assert!(
         kernels::REDUCE_TYPES
             .source
@@ -373,11 +380,12 @@ fn all_types_matches_reduce_types() {
 
 #[test]
 fn step_constants_match() {
+    use terrasynth::stages::upsample_jitter::{STEP_PYRAMID, STEP_VIRTUAL, STEP_WRAP};
     let src = kernels::UPSAMPLE_JITTER.source;
     for (name, v) in [
-        ("STEP_PYRAMID", kernels::STEP_PYRAMID),
-        ("STEP_VIRTUAL", kernels::STEP_VIRTUAL),
-        ("STEP_WRAP", kernels::STEP_WRAP),
+        ("STEP_PYRAMID", STEP_PYRAMID),
+        ("STEP_VIRTUAL", STEP_VIRTUAL),
+        ("STEP_WRAP", STEP_WRAP),
     ] {
         assert!(
             src.contains(&format!("const {name}: u32 = {v}u;")),

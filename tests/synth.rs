@@ -81,33 +81,39 @@ fn without_jitter_the_exemplar_is_reproduced() {
     }
 }
 
+/// At every jitter up to the `--jitter` limit of 4 texels — which carries
+/// a child past the 2-texel margin, into the gap or off the atlas, unless
+/// the clamp picks the parent's exemplar (`--jitter 4` crashed before).
 #[test]
 fn coordinates_stay_inside_exemplar_interiors_at_every_level() {
-    let params = Params {
-        keep_levels: true,
-        ..Params::default()
-    };
-    let s = Synthesizer::new(db(), params).unwrap();
-    let out = s.run(333, 257, 5).unwrap();
-    let coarsest = db().level_count() - 1;
-    for maps in out.levels.iter().filter(|m| m.level <= coarsest) {
-        let level = db().level(maps.level);
-        for c in &maps.coords {
-            let (x, y) = (round(c.x), round(c.y));
-            assert!(
-                x >= 0 && y >= 0,
-                "negative coordinate at level {}",
-                maps.level
-            );
-            let e = level
-                .layout
-                .exemplar_at(level.columns, x as u32, y as u32)
-                .unwrap_or_else(|| panic!("level {}: ({x},{y}) is in no exemplar", maps.level));
-            assert!(
-                level.layout.rects[e].is_interior(x as u32, y as u32),
-                "level {}: ({x},{y}) on an edge",
-                maps.level
-            );
+    for (jitter, seed, (w, h)) in [
+        (0.4, 5, (333, 257)),
+        (4.0, 1, (512, 512)),
+        (4.0, 2, (512, 512)),
+    ] {
+        let params = Params {
+            keep_levels: true,
+            jitter,
+            ..Params::default()
+        };
+        let s = Synthesizer::new(db(), params).unwrap();
+        let out = s.run(w, h, seed).unwrap();
+        let coarsest = db().level_count() - 1;
+        for maps in out.levels.iter().filter(|m| m.level <= coarsest) {
+            let level = db().level(maps.level);
+            let at = format!("jitter {jitter} seed {seed} level {}", maps.level);
+            for c in &maps.coords {
+                let (x, y) = (round(c.x), round(c.y));
+                assert!(x >= 0 && y >= 0, "{at}: negative coordinate");
+                let e = level
+                    .layout
+                    .exemplar_at(level.columns, x as u32, y as u32)
+                    .unwrap_or_else(|| panic!("{at}: ({x},{y}) is in no exemplar"));
+                assert!(
+                    level.layout.rects[e].is_interior(x as u32, y as u32),
+                    "{at}: ({x},{y}) on an edge"
+                );
+            }
         }
     }
 }

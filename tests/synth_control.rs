@@ -15,28 +15,13 @@ use terrasynth::synth::control::{
 use terrasynth::synth::session::{Edit, Session};
 
 mod common;
+use common::db::{PYRENEES_CATALAN, two_dems};
 use common::dem::{self, DEM};
-const N: usize = 256;
+/// The output side, the crops' side.
+const N: usize = PYRENEES_CATALAN.side;
 
 fn db() -> Option<&'static Database> {
-    static DB: OnceLock<Option<Database>> = OnceLock::new();
-    DB.get_or_init(|| {
-        let crop = |name: &str, x: usize, y: usize| dem::exemplar(name, (x, y, N, N), true);
-        let inputs = vec![
-            crop("pyrenees_andorra", 300, 200)?,
-            crop("catalan_coast_hills", 300, 300)?,
-        ];
-        let opts = BuildOptions {
-            levels: 4,
-            ..Default::default()
-        };
-        Some(database::build(inputs, &opts, &Silent).unwrap().0)
-    })
-    .as_ref()
-    .or_else(|| {
-        eprintln!("{DEM} not found: control tests on real DEMs skipped");
-        None
-    })
+    two_dems(PYRENEES_CATALAN, "control tests on real DEMs")
 }
 
 /// Relief (max − min) of the start exemplar, metres.

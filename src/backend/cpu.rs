@@ -1,15 +1,15 @@
-//! The CPU backend: the rayon + SIMD stages of `synth::stages`, state in
+//! The CPU backend: the rayon + SIMD stages of `stages`, state in
 //! host memory. The reference every other backend is checked against.
 
 use super::{Backend, BackendError, Raster};
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::fixed::Coord;
-use crate::synth::stages::correct::{self, CorrectParams};
-use crate::synth::stages::reconstruct;
-use crate::synth::stages::reduce_types::reduce_types;
-use crate::synth::stages::reduce_weights::reduce_weights;
-use crate::synth::stages::upsample_jitter::{self, Step, UpsampleParams};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::Coord;
+use crate::level::state::State;
+use crate::stages::correct::{self, CorrectParams};
+use crate::stages::reconstruct;
+use crate::stages::reduce_types::reduce_types;
+use crate::stages::reduce_weights::reduce_weights;
+use crate::stages::upsample_jitter::{self, Step, UpsampleParams};
 
 /// Stages on the host, over one database's atlas levels.
 pub struct Cpu<'a, 'db> {

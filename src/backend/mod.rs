@@ -14,10 +14,10 @@ pub mod cpu;
 pub mod gpu;
 pub mod kernels;
 
-use crate::synth::fixed::Coord;
-use crate::synth::stages::correct::{self, CorrectParams};
-use crate::synth::stages::upsample_jitter::UpsampleParams;
-use crate::synth::state::State;
+use crate::level::fixed::Coord;
+use crate::level::state::State;
+use crate::stages::correct::{self, CorrectParams};
+use crate::stages::upsample_jitter::UpsampleParams;
 use std::time::Duration;
 use thiserror::Error;
 
@@ -113,7 +113,7 @@ pub trait Backend {
         g: &Self::Guide<'_>,
     );
     /// Stage `reconstruct` of a level-0 state: fixed-point heights (see
-    /// `synth::stages::reconstruct`), row-major.
+    /// `stages::reconstruct`), row-major.
     fn reconstruct(&self, st: &Self::State) -> Result<Vec<i32>, BackendError>;
     /// A copy of a state's coordinates and offsets, row-major.
     fn download(&self, st: &Self::State) -> Result<(Vec<Coord>, Vec<i32>), BackendError>;
@@ -272,5 +272,5 @@ pub enum BackendError {
     #[error("GPU error: {0}")]
     Gpu(String),
     #[error(transparent)]
-    Shade(#[from] crate::render::shade::ParamsError),
+    Shade(#[from] crate::stages::shade::ParamsError),
 }

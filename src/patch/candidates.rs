@@ -14,10 +14,11 @@
 
 use super::Params;
 use super::control_point::{ACROSS, ALONG, Cp, TURN, UNIT};
-use super::costs::{centre_cells, noise_levels};
+use super::costs::noise_levels;
 use super::graph::{FeatureGraph, dist, point_at};
 use super::ppa::{self, PpaParams};
 use super::sketch::Kind;
+use crate::stages::fill_ssd::centre_cells;
 use rayon::prelude::*;
 
 /// A feature patch centre with its control points (sorted by angle).
@@ -157,7 +158,7 @@ pub struct PreparedSource {
     pub coarse_w: usize,
     pub fill: Vec<FillCand>,
     /// Per fill candidate, its `(patch/COARSE)²` reduced cells, contiguous,
-    /// centred and clamped ([`super::costs::centre_cells`]): what the
+    /// centred and clamped ([`centre_cells`]): what the
     /// round-one kernel reads, so it streams instead of gathering rows.
     pub fill_cells: Vec<i32>,
     /// The patch size this was prepared for.

@@ -1,13 +1,13 @@
 //! Where round one of hole filling runs — stage `fill_ssd`, the patch
 //! engine's data-parallel cost (DESIGN §7): on the CPU
-//! ([`super::costs::fill_ssd_table`], rayon over candidates, `wide` SIMD
+//! ([`fill_ssd_table`], rayon over candidates, `wide` SIMD
 //! over cells) or, with the `gpu` feature, as `kernels/fill_ssd.wgsl`, with
 //! every source's candidate cells uploaded once per synthesis. Both give
 //! the same table, so the same terrain bytes.
 
-use super::costs::fill_ssd_table;
 use super::{Library, PatchError};
 use crate::backend::Choice;
+use crate::stages::fill_ssd::fill_ssd_table;
 
 /// The backend of stage `fill_ssd`.
 pub enum FillCost {

@@ -17,13 +17,14 @@
 //! source go to round two and the graph-cut finalists ([`super::select`]).
 
 use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
-use super::costs::{centre_cells, noise_cost};
+use super::costs::noise_cost;
 use super::fill_ssd::FillCost;
 use super::merge::{self, Canvas, Window};
 use super::{
     Library, PatchError, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window,
 };
 use crate::progress::Progress;
+use crate::stages::fill_ssd::centre_cells;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::time::Instant;

@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! Heightfield ─► prepare (CPU, floats: resize, quantize, palette, params)
-//!             ─► shade   (the stage: integer per-pixel kernel, GPU-mirrorable)
+//!             ─► shade   (the stage `stages::shade`: integer per-pixel kernel, GPU-mirrorable)
 //!             ─► overlay (CPU: points, curves, regions, markers) ─► PNG
 //! ```
 //!
@@ -23,9 +23,10 @@ pub mod font;
 pub mod overlay;
 pub mod prepare;
 pub mod preview_size;
-pub mod shade;
 pub mod tint;
 pub mod types;
+
+pub use crate::stages::shade;
 
 pub use compose::side_by_side;
 pub use contours::Contours;

@@ -14,18 +14,17 @@
 //! plain synthesis, scenes and editing sessions run on the CPU or the GPU
 //! with the same bytes.
 
-pub mod atlas;
 pub mod coarse;
 pub mod cone;
 pub mod control;
-pub mod fixed;
 mod params;
 pub mod session;
 pub mod source_map;
-pub mod stages;
-pub mod state;
 mod window;
 mod windowed;
+
+pub use crate::level::{atlas, fixed, state};
+pub use crate::stages;
 
 use crate::backend::{Backend, Choice, Stage, cpu::Cpu};
 use crate::database::Database;

@@ -28,3 +28,19 @@ pub fn exemplar(
         types,
     })
 }
+
+/// The stem of every shared DEM with a type mask (`<stem>.png` beside
+/// `<stem>_types.png` in [`DEM`]), sorted; `None`, saying that `what` is
+/// skipped, when the folder is absent.
+pub fn typed_stems(what: &str) -> Option<Vec<String>> {
+    let Ok(entries) = std::fs::read_dir(DEM) else {
+        eprintln!("{DEM} not found: {what} skipped");
+        return None;
+    };
+    let mut stems: Vec<String> = entries
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter_map(|n| n.strip_suffix("_types.png").map(str::to_owned))
+        .collect();
+    stems.sort();
+    Some(stems)
+}

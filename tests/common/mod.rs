@@ -3,6 +3,7 @@
 
 #[cfg(feature = "serve")]
 pub mod browser;
+pub mod db;
 pub mod dem;
 #[cfg(feature = "serve")]
 pub mod editor;
@@ -11,6 +12,8 @@ pub mod gpu;
 #[cfg(feature = "serve")]
 pub mod http;
 pub mod render;
+pub mod states;
+pub mod variants;
 
 use terrasynth::io::Format;
 use terrasynth::{Georef, Heightfield};

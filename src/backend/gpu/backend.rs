@@ -3,10 +3,10 @@
 
 use super::{Gpu, GpuGuide, GpuRaster, GpuState};
 use crate::backend::{Backend, BackendError, StageTime};
-use crate::synth::fixed::Coord;
-use crate::synth::stages::correct::{CorrectParams, Guide};
-use crate::synth::stages::upsample_jitter::UpsampleParams;
-use crate::synth::state::State;
+use crate::level::fixed::Coord;
+use crate::level::state::State;
+use crate::stages::correct::{CorrectParams, Guide};
+use crate::stages::upsample_jitter::UpsampleParams;
 
 impl Backend for Gpu {
     type State = GpuState;
@@ -122,7 +122,7 @@ impl Backend for Gpu {
     }
 
     fn has_device_clock(&self) -> bool {
-        self.ctx.profile.is_some()
+        self.ctx.queries.is_some()
     }
 
     fn device_times(&self) -> Result<Option<Vec<StageTime>>, BackendError> {

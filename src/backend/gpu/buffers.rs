@@ -65,7 +65,12 @@ impl Context {
     }
 
     /// Copies a device buffer back to the host (waits for queued work).
-    pub(super) fn read(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, BackendError> {
+    /// Copies `buffer` back to the host as `T`s, after every pass recorded
+    /// so far (one copy on the host: mapped bytes straight into the `Vec`).
+    pub(super) fn read<T: bytemuck::Pod>(
+        &self,
+        buffer: &wgpu::Buffer,
+    ) -> Result<Vec<T>, BackendError> {
         let size = buffer.size();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -73,9 +78,12 @@ impl Context {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        self.queue.submit([enc.finish()]);
+        self.recorder()
+            .encoder(&self.device)
+            .copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        // Submitted before mapping: a buffer waiting to be mapped may not be
+        // used by a later submission.
+        self.flush();
         let (tx, rx) = mpsc::channel();
         staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
             // The receiver outlives the poll below; a send cannot fail.
@@ -85,11 +93,12 @@ impl Context {
         rx.recv()
             .map_err(|e| BackendError::Gpu(e.to_string()))?
             .map_err(|e| BackendError::Gpu(e.to_string()))?;
-        let data = staging
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| BackendError::Gpu(e.to_string()))?
-            .to_vec();
+        let data = bytemuck::pod_collect_to_vec(
+            &staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| BackendError::Gpu(e.to_string()))?,
+        );
         Ok(data)
     }
 }

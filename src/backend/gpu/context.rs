@@ -1,7 +1,8 @@
 //! The device and its compiled kernels: adapter choice, device creation and
 //! one compute pipeline per WGSL kernel.
 
-use super::timing::{MAX_TIMED, Profile};
+use super::dispatch::Recorder;
+use super::timing::MAX_TIMED;
 use crate::backend::BackendError;
 use crate::backend::kernels::{self, Kernel};
 use std::sync::{Arc, Mutex};
@@ -20,8 +21,10 @@ pub struct Context {
     pub(super) reconstruct: wgpu::ComputePipeline,
     pub(super) shade: wgpu::ComputePipeline,
     pub(super) fill_ssd: wgpu::ComputePipeline,
-    /// Timestamp queries, where the adapter has them.
-    pub(super) profile: Option<Mutex<Profile>>,
+    /// Timestamp queries (two per timed dispatch), where the adapter has them.
+    pub(super) queries: Option<wgpu::QuerySet>,
+    /// Passes recorded and not yet submitted, and what the queries time.
+    pub(super) recorder: Mutex<Recorder>,
 }
 
 impl Context {
@@ -67,7 +70,7 @@ impl Context {
                 label: Some(k.name),
                 layout: None,
                 module: &module,
-                entry_point: Some("main"),
+                entry_point: Some(kernels::ENTRY_POINT),
                 compilation_options: Default::default(),
                 cache: None,
             })
@@ -83,19 +86,16 @@ impl Context {
         if let Some(e) = scope.pop().await {
             return Err(BackendError::Gpu(e.to_string()));
         }
-        let profile = features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
-            Mutex::new(Profile {
-                queries: device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("stage timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 2 * MAX_TIMED,
-                }),
-                labels: Vec::new(),
-                overflow: false,
+        let queries = features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("stage timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2 * MAX_TIMED,
             })
         });
         Ok(Arc::new(Context {
-            profile,
+            queries,
+            recorder: Mutex::default(),
             info: adapter.get_info(),
             device,
             queue,
@@ -112,7 +112,7 @@ impl Context {
 
     /// Whether stage times come from GPU timestamp queries (else wall clock).
     pub fn has_timestamps(&self) -> bool {
-        self.profile.is_some()
+        self.queries.is_some()
     }
 
     /// The adapter, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
@@ -120,7 +120,9 @@ impl Context {
         format!("{} ({:?})", self.info.name, self.info.backend)
     }
 
+    /// Submits what is recorded and waits until the device is idle.
     pub(super) fn wait(&self) -> Result<(), BackendError> {
+        self.flush();
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())

@@ -2,9 +2,11 @@
 //! inputs it reads uploaded once per pass.
 
 use super::{Gpu, GpuState, groups};
-use crate::backend::kernels::{self, CorrectUniform, GuideCell};
 use crate::backend::{BackendError, Stage, check_guide};
-use crate::synth::stages::correct::{CorrectParams, Guide};
+use crate::stages::correct::{
+    CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, CorrectParams, CorrectUniform, Guide,
+    GuideCell,
+};
 
 /// The control inputs of `correct` for one pass of one level on the device
 /// ([`crate::backend::Backend::upload_guide`]): which controls are on, and one
@@ -44,9 +46,9 @@ impl Gpu {
         check_guide(g, width, height)?;
         let mut flags = 0;
         for (on, flag) in [
-            (g.targets.is_some(), kernels::CORRECT_TARGETS),
-            (g.allowed.is_some(), kernels::CORRECT_ALLOWED),
-            (g.coherence.is_some(), kernels::CORRECT_COHERENCE),
+            (g.targets.is_some(), CORRECT_TARGETS),
+            (g.allowed.is_some(), CORRECT_ALLOWED),
+            (g.coherence.is_some(), CORRECT_COHERENCE),
         ] {
             if on {
                 flags |= flag;

@@ -3,8 +3,8 @@
 
 use super::Context;
 use crate::backend::BackendError;
-use crate::backend::kernels::GuideCell;
-use crate::synth::atlas::AtlasLevel;
+use crate::level::atlas::AtlasLevel;
+use crate::stages::correct::GuideCell;
 use std::sync::Arc;
 
 /// One database level on the device.

@@ -1,17 +1,16 @@
 //! Stage `fill_ssd` on the GPU (`kernels/fill_ssd.wgsl`): round one of the
 //! patch engine's hole filling, the mirror of
-//! [`crate::patch::costs::fill_ssd_table`]. A source's candidate cells are
+//! [`crate::stages::fill_ssd::fill_ssd_table`]. A source's candidate cells are
 //! uploaded once ([`FillSource`]) and stay on the device for every window
 //! of a synthesis; per window only the user's permuted cells go up and one
 //! `(s, s2)` pair per candidate and transform comes back. The kernel sums
 //! in integers (s2 in two u32 words); the host ends with
-//! [`crate::patch::costs::dc_ssd`] like the CPU, so the table is the same
+//! [`dc_ssd`] like the CPU, so the table is the same
 //! bytes.
 
 use super::Context;
 use crate::backend::BackendError;
-use crate::backend::kernels::FillSsdUniform;
-use crate::patch::costs::dc_ssd;
+use crate::stages::fill_ssd::{FillSsdUniform, dc_ssd};
 
 /// One source's candidate cells on the device.
 pub struct FillSource {
@@ -102,7 +101,7 @@ impl Context {
             &[&user_buf, &src.buf, &out],
             (super::groups(src.candidates), super::groups(transforms)),
         );
-        let sums: Vec<[u32; 4]> = bytemuck::pod_collect_to_vec(&self.read(&out)?);
+        let sums: Vec<[u32; 4]> = self.read(&out)?;
         Ok(sums
             .iter()
             .map(|&[s, lo, hi, _]| {

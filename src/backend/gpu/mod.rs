@@ -8,17 +8,19 @@
 //! a hardware adapter wgpu falls back to Mesa's lavapipe (software Vulkan,
 //! Debian package `mesa-vulkan-drivers`), which is how CI checks this path.
 //!
-//! Each stage call records one command buffer and submits it; the queue
-//! runs them in order, and wgpu orders storage-buffer accesses across
-//! submissions, so one subpass sees the previous one's writes.
+//! Each stage call records one compute pass into a shared encoder,
+//! submitted in batches (`dispatch`); passes run in recording order and
+//! wgpu orders storage-buffer accesses between them, so one subpass sees
+//! the previous one's writes.
 //!
 //! The parts: `context` (device and pipelines), `buffers` (storage
 //! buffers and read-back), `dispatch` (one compute pass), `timing`
 //! (timestamp queries), `database` (the atlas on the device), `state`
-//! and `rasters` (per-level data), one module per stage
-//! (`upsample_jitter`, `correct`, `reduce`, `reconstruct`,
-//! `shade`) and `backend` (the [`super::Backend`] trait on [`Gpu`]).
-//! The patch engine's data-parallel cost stage lives in [`fill_ssd`].
+//! and `rasters` (per-level data), one module per stage, named like its
+//! kernel and its CPU mirror in `stages` (`upsample_jitter`, `correct`,
+//! `reduce_types`, `reduce_weights`, `reconstruct`, `shade`, and the patch
+//! engine's [`fill_ssd`]) and `backend` (the [`super::Backend`] trait on
+//! [`Gpu`]).
 
 mod backend;
 mod buffers;
@@ -29,7 +31,8 @@ mod dispatch;
 pub mod fill_ssd;
 mod rasters;
 mod reconstruct;
-mod reduce;
+mod reduce_types;
+mod reduce_weights;
 mod shade;
 mod state;
 mod timing;

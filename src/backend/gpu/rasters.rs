@@ -1,7 +1,7 @@
-//! Control rasters (type sets, coherence weights) on the device, and their
-//! upload and download.
+//! Control rasters (type sets, coherence weights) on the device: their
+//! upload and download, and the one dispatch both reductions share.
 
-use super::Gpu;
+use super::{Gpu, groups};
 use crate::backend::{BackendError, check_raster};
 
 /// One level's control raster on the device, one u32 per pixel: type sets
@@ -40,12 +40,38 @@ impl Gpu {
     }
 
     pub(super) fn download_type_raster(&self, r: &GpuRaster) -> Result<Vec<u32>, BackendError> {
-        Ok(bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?))
+        self.ctx.read(&r.buf)
     }
 
     pub(super) fn download_weight_raster(&self, r: &GpuRaster) -> Result<Vec<u8>, BackendError> {
-        let wide: Vec<u32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&r.buf)?);
+        let wide: Vec<u32> = self.ctx.read(&r.buf)?;
         // Every stored weight is ≤ 255 (an uploaded u8 or a reduction's ≤ 4).
         Ok(wide.into_iter().map(|w| w as u8).collect())
+    }
+
+    /// One dispatch of a reduction from `child` into a new `width × height`
+    /// raster.
+    pub(super) fn reduce(
+        &self,
+        what: &'static str,
+        pipeline: &wgpu::ComputePipeline,
+        uniform: &[u8],
+        child: &GpuRaster,
+        width: usize,
+        height: usize,
+    ) -> Result<GpuRaster, BackendError> {
+        let bytes = (width as u64)
+            .checked_mul(height as u64)
+            .and_then(|n| n.checked_mul(4))
+            .unwrap_or(u64::MAX);
+        let buf = self.ctx.storage_empty(what, bytes)?;
+        self.ctx.dispatch(
+            None,
+            pipeline,
+            uniform,
+            &[&child.buf, &buf],
+            (groups(width), groups(height)),
+        );
+        Ok(GpuRaster { width, height, buf })
     }
 }

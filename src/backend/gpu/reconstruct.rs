@@ -2,8 +2,8 @@
 //! heights, read back to the host.
 
 use super::{Gpu, GpuState, groups};
-use crate::backend::kernels::ReconstructUniform;
 use crate::backend::{BackendError, Stage};
+use crate::stages::reconstruct::ReconstructUniform;
 
 impl Gpu {
     pub(super) fn dispatch_reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
@@ -22,6 +22,6 @@ impl Gpu {
             &[&st.s, &st.v, &self.levels[0].columns, &self.heights, &out],
             (groups(st.width), groups(st.height)),
         );
-        Ok(bytemuck::pod_collect_to_vec(&self.ctx.read(&out)?))
+        self.ctx.read(&out)
     }
 }

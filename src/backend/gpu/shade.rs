@@ -2,11 +2,11 @@
 
 use super::{Context, groups};
 use crate::backend::BackendError;
-use crate::render::shade::{ShadeBuffers, ShadeParams};
+use crate::stages::shade::{ShadeBuffers, ShadeParams};
 
 impl Context {
     /// Stage `shade` (the preview renderer's): the same packed RGBA pixels
-    /// as `render::shade::shade`, row-major. Checks the parameters first,
+    /// as `stages::shade::shade`, row-major. Checks the parameters first,
     /// exactly like the CPU stage.
     pub fn shade(&self, p: &ShadeParams, b: &ShadeBuffers<'_>) -> Result<Vec<u32>, BackendError> {
         p.validate(b)?;
@@ -25,6 +25,6 @@ impl Context {
             &[&heights, &types, &tint, &colours, &out],
             (groups(p.width as usize), groups(p.height as usize)),
         );
-        Ok(bytemuck::pod_collect_to_vec(&self.read(&out)?))
+        self.read(&out)
     }
 }

@@ -2,8 +2,8 @@
 
 use super::Gpu;
 use crate::backend::BackendError;
-use crate::synth::fixed::Coord;
-use crate::synth::state::State;
+use crate::level::fixed::Coord;
+use crate::level::state::State;
 
 /// One level's state on the device: S as `vec2<i32>` (the bytes of
 /// `Coord::pack`), V as `i32`.
@@ -64,8 +64,8 @@ impl Gpu {
         &self,
         st: &GpuState,
     ) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {
-        let s: Vec<u64> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.s)?);
-        let v: Vec<i32> = bytemuck::pod_collect_to_vec(&self.ctx.read(&st.v)?);
+        let s: Vec<u64> = self.ctx.read(&st.s)?;
+        let v: Vec<i32> = self.ctx.read(&st.v)?;
         Ok((s.into_iter().map(Coord::unpack).collect(), v))
     }
 }

@@ -2,8 +2,9 @@
 
 use super::{Gpu, GpuState, groups};
 use crate::backend::Stage;
-use crate::backend::kernels::{self, UpsampleUniform};
-use crate::synth::stages::upsample_jitter::{Step, UpsampleParams};
+use crate::stages::upsample_jitter::{
+    STEP_PYRAMID, STEP_VIRTUAL, STEP_WRAP, Step, UpsampleParams, UpsampleUniform,
+};
 
 impl Gpu {
     pub(super) fn dispatch_upsample_jitter(
@@ -25,9 +26,9 @@ impl Gpu {
             ..Default::default()
         };
         match p.step {
-            Step::Pyramid => u.step = kernels::STEP_PYRAMID,
+            Step::Pyramid => u.step = STEP_PYRAMID,
             Step::Virtual { shift } => {
-                u.step = kernels::STEP_VIRTUAL;
+                u.step = STEP_VIRTUAL;
                 u.shift = shift;
             }
             Step::Wrap {
@@ -36,7 +37,7 @@ impl Gpu {
                 min_y,
                 max_y,
             } => {
-                u.step = kernels::STEP_WRAP;
+                u.step = STEP_WRAP;
                 (u.min_x, u.max_x, u.min_y, u.max_y) = (min_x, max_x, min_y, max_y);
             }
         }

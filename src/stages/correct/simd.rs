@@ -21,11 +21,11 @@
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 
+use super::nudge::nudge;
 use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, Prior, W_FREE, scalar, weigh};
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::control::blend::nudge;
-use crate::synth::fixed::{Coord, FRAC_BITS, round};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, FRAC_BITS, round};
+use crate::level::state::State;
 use wide::{i16x8, i32x8};
 
 /// A neighbour as the kernel needs it.

@@ -21,9 +21,10 @@
 //! predict. Conversion to metres is a CPU-side `offset + scale · value / 256`
 //! (DESIGN §6 rule 5).
 
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::fixed::{div_floor, round};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{div_floor, round};
+use crate::level::state::State;
+use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 
 /// Fractional bits of reconstructed heights.
@@ -84,4 +85,15 @@ pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i
             }
         });
     out
+}
+
+/// `ReconstructParams` of `kernels/reconstruct.wgsl` (padded to 16 bytes,
+/// the uniform block granularity).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct ReconstructUniform {
+    pub width: u32,
+    pub height: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }

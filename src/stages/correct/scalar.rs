@@ -3,6 +3,7 @@
 //! (borders included) and is the oracle the [`super::simd`] path is tested
 //! against.
 
+use super::nudge::nudge;
 use super::{
     ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, Prior, SEED_SALT,
     SEEDS_PER_ALLOWED_TYPE, W_FREE, weigh,
@@ -10,10 +11,9 @@ use super::{
 use crate::database::appearance::{MODE1_BIAS, unpack_texel};
 use crate::database::types::SEEDS_PER_TYPE;
 use crate::hash::{below, hash4};
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::control::blend::nudge;
-use crate::synth::fixed::{Coord, FRAC_BITS, round};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, FRAC_BITS, round};
+use crate::level::state::State;
 use rayon::prelude::*;
 
 /// Reflects a coordinate at the level border by 2 (keeps parity); the

@@ -4,7 +4,7 @@
 //! must produce the same bytes (DESIGN.md §6). Everything per pixel is
 //! therefore **integer arithmetic on 32-bit values only**: no floats, no
 //! 64-bit integers (WGSL has none), no shift by 32 or more. The CPU prepares
-//! the inputs once ([`super::prepare`]); this module only consumes them.
+//! the inputs once (`render::prepare`); this module only consumes them.
 //!
 //! # Inputs
 //! - heights: `i32` per pixel in one unit throughout (the renderer uses

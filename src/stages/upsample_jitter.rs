@@ -12,14 +12,17 @@
 //! L they wrap toroidally into the start exemplar's interior, so an output
 //! larger than the exemplar starts from a jittered, tiled copy that the
 //! correction at level L then rearranges. Below L, children are clamped into
-//! their exemplar's interior (the parent's exemplar: jitter never moves a
-//! child across exemplars because exemplars are ≥ 2 texels apart).
+//! the interior of their parent's exemplar, found from the child's position
+//! before jitter: a jitter of up to 4 texels (the `--jitter` limit) can
+//! carry a child past the 2-texel margin and gap, into another exemplar or
+//! off the atlas (a crash at `--jitter 4` before this rule).
 
 use crate::database::layout::MARGIN;
 use crate::hash::hash4;
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::fixed::{Coord, FRAC_BITS};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, FRAC_BITS};
+use crate::level::state::State;
+use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 
 /// How children relate to parents at this step.
@@ -96,7 +99,7 @@ pub fn upsample_jitter(
                         x: 2 * s.x + off_x,
                         y: 2 * s.y + off_y,
                     };
-                    clamp(a, c)
+                    clamp(a, c, 2 * s.x + (cx << FRAC_BITS))
                 }
                 Step::Virtual { shift } => Coord {
                     x: s.x + (off_x << shift),
@@ -117,11 +120,12 @@ pub fn upsample_jitter(
     });
 }
 
-/// Clamps a fixed-point coordinate into the interior of the exemplar its
-/// rounded position falls in.
+/// Clamps a fixed-point coordinate into the interior of the exemplar that
+/// holds `home_x` (the child's x before jitter, inside its parent's
+/// exemplar).
 #[inline(always)]
-fn clamp(a: &AtlasLevel<'_>, c: Coord) -> Coord {
-    let tx = crate::synth::fixed::round(c.x);
+fn clamp(a: &AtlasLevel<'_>, c: Coord, home_x: i32) -> Coord {
+    let tx = crate::level::fixed::round(home_x);
     let col = &a.columns[tx as usize];
     Coord {
         x: c.x.clamp(col.min_x << FRAC_BITS, col.max_x << FRAC_BITS),
@@ -135,6 +139,34 @@ fn clamp(a: &AtlasLevel<'_>, c: Coord) -> Coord {
 fn wrap(v: i32, min: i32, max: i32) -> i32 {
     let period = (max - min + 1) << FRAC_BITS;
     (min << FRAC_BITS) + (v - (min << FRAC_BITS)).rem_euclid(period)
+}
+
+/// [`Step`] as the kernel's `step` field.
+pub const STEP_PYRAMID: u32 = 0;
+pub const STEP_VIRTUAL: u32 = 1;
+pub const STEP_WRAP: u32 = 2;
+
+/// `UpsampleParams` of `kernels/upsample_jitter.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct UpsampleUniform {
+    pub child_width: u32,
+    pub child_height: u32,
+    pub parent_width: u32,
+    pub seed: u32,
+    pub level: u32,
+    pub jitter: i32,
+    pub step: u32,
+    pub shift: u32,
+    pub min_x: i32,
+    pub max_x: i32,
+    pub min_y: i32,
+    pub max_y: i32,
+    /// `UpsampleParams::origin`.
+    pub origin_x: u32,
+    pub origin_y: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }
 
 #[cfg(test)]

@@ -42,7 +42,7 @@
 //!
 //! Scoring reads the nearest texel of each coordinate; the candidate keeps
 //! the fractional part of the S(p+Δ) it came from, so sub-texel jitter
-//! survives correction (see [`crate::synth::fixed`]).
+//! survives correction (see [`crate::level::fixed`]).
 //!
 //! Two implementations produce the same bytes: [`scalar`], the readable
 //! reference that the WGSL kernel mirrors line by line and the oracle of the
@@ -56,14 +56,18 @@
 //! the level, coordinates are extrapolated from the reflected pixel (see
 //! [`neighbour`]).
 
+pub mod nudge;
 pub mod scalar;
 pub mod simd;
+mod uniform;
 
-use crate::synth::atlas::AtlasLevel;
-use crate::synth::control::Target;
-use crate::synth::fixed::{Coord, div_floor};
-use crate::synth::state::State;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, div_floor};
+use crate::level::state::State;
+use nudge::Target;
 use rayon::prelude::*;
+
+pub use uniform::{CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, CorrectUniform, GuideCell};
 
 /// Residual clamp (in ×3 height units), see the module docs.
 pub const CLAMP: i32 = 9_459;

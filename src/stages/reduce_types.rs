@@ -7,7 +7,8 @@
 //! Sets are u32 bit masks of type ids; [`ALL_TYPES`] and `full` (every
 //! type of the database) both count as full.
 
-use crate::synth::stages::correct::ALL_TYPES;
+use crate::stages::correct::ALL_TYPES;
+use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 
 /// R^{i} (`w × h`) from R^{i−1} (`cw × ch`); children past the child
@@ -39,6 +40,22 @@ pub fn reduce_types(
         }
     });
     out
+}
+
+/// `ReduceTypesParams` of `kernels/reduce_types.wgsl` (padded to 32 bytes,
+/// a whole number of 16-byte uniform rows).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct ReduceTypesUniform {
+    pub width: u32,
+    pub height: u32,
+    pub child_width: u32,
+    pub child_height: u32,
+    /// Every type of the database (`reduce_types`' `full`).
+    pub full: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 //! larger weight (freedom to change wins a tie, so an edited region is not
 //! shrunk by the coarser levels). Weights are quarters (0, 1 = 0.25, 4 = 1).
 
+use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 
 /// W^{i} (`w × h`) from W^{i−1} (`cw × ch`); children past the edge are absent.
@@ -30,6 +31,16 @@ pub fn reduce_weights(child: &[u8], cw: usize, ch: usize, w: usize, h: usize) ->
         }
     });
     out
+}
+
+/// `ReduceWeightsParams` of `kernels/reduce_weights.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
+pub struct ReduceWeightsUniform {
+    pub width: u32,
+    pub height: u32,
+    pub child_width: u32,
+    pub child_height: u32,
 }
 
 #[cfg(test)]

@@ -1,0 +1,115 @@
+//! The kernel side of a geometric constraint (paper eq. 8–9): the
+//! blended [`Target`] of one pixel and the non-linear height nudge φ_d that
+//! `correct` applies towards it, in 32-bit integers, identical in the
+//! scalar and SIMD corrections and in WGSL. The CPU side — blending
+//! overlapping constraints into targets — is `synth::control::blend`.
+
+/// Largest tolerance handed to the kernel (keeps φ's products in 32 bits).
+/// Past it the cone stops widening: with 5 cm units that is 1.6 km of
+/// height, far outside any error φ's cubic would still act on.
+pub const MAX_TOL: i32 = 32_767;
+/// Largest |h_t − h_c| the kernel works with (keeps 3|x| in an i32).
+pub const MAX_ERROR: i32 = 1 << 24;
+
+/// A pixel's blended constraint, in database height units.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Target {
+    /// Target height h_t (units; may leave 0..65535).
+    pub height: i32,
+    /// Tolerance t = s·d (units), or −1 where no constraint reaches.
+    pub tol: i32,
+}
+
+impl Target {
+    /// No constraint here.
+    pub const NONE: Target = Target { height: 0, tol: -1 };
+}
+
+/// φ_d(x) of eq. 9 with λ = ½, in integer height units (the kernel side;
+/// identical in the scalar and SIMD corrections and in WGSL: 32-bit
+/// arithmetic only).
+///
+/// With t the tolerance: `x/2 − sign(x)·t/3` outside ±t (slope λ, offset
+/// c = 2λt/3), `x·(x/t)²/6` inside (= −b·x³ with b = −λ/(3t²)). Inside, the
+/// ratio r = |x|/t is formed in 15 fractional bits (|x| ≤ t ≤ 2^15, so
+/// |x|·2^15 < 2^31) and squared back to 15 bits; the product |x|·r² < 2^30.
+/// Both branches round to nearest (ties away from zero, by symmetry).
+#[inline(always)]
+pub fn phi(x: i32, tol: i32) -> i32 {
+    let x = x.clamp(-MAX_ERROR, MAX_ERROR);
+    let a = x.unsigned_abs();
+    let t = tol as u32;
+    let mag = if a > t {
+        (3 * a - 2 * t + 3) / 6
+    } else if a == 0 {
+        0
+    } else {
+        let r = (a << 15) / t;
+        let r2 = (r * r) >> 15;
+        (a * r2 + 3 * (1 << 15)) / (6 << 15)
+    };
+    if x < 0 { -(mag as i32) } else { mag as i32 }
+}
+
+/// V after nudging a chosen candidate of height `h_c` (units, V included)
+/// towards `target`: `v + φ(h_t − h_c)`; unchanged where no constraint.
+#[inline(always)]
+pub fn nudge(v: i32, h_c: i32, target: Target) -> i32 {
+    if target.tol < 0 {
+        return v;
+    }
+    v + phi(target.height.saturating_sub(h_c), target.tol)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eq. 8–9 in floating point, as printed.
+    fn phi_f(x: f64, t: f64) -> f64 {
+        let lambda = 0.5;
+        if t == 0.0 {
+            return lambda * x;
+        }
+        let b = -lambda / (3.0 * t * t);
+        let c = b * t * t * t + lambda * t;
+        if x < -t {
+            lambda * x + c
+        } else if x > t {
+            lambda * x - c
+        } else {
+            -b * x * x * x
+        }
+    }
+
+    #[test]
+    fn integer_phi_follows_eq_9() {
+        for t in [0, 1, 7, 100, 2_000, MAX_TOL] {
+            for x in (-70_000..=70_000).step_by(37) {
+                let want = phi_f(x as f64, t as f64);
+                let got = phi(x, t);
+                assert!(
+                    (got as f64 - want).abs() <= 1.0,
+                    "φ({x}, {t}) = {got}, eq. 9: {want}"
+                );
+                assert_eq!(phi(-x, t), -got, "odd symmetry");
+            }
+        }
+        // Small errors are nudged slightly, large ones by about half.
+        assert_eq!(phi(10, 1000), 0);
+        assert_eq!(phi(10_000, 1000), 5000 - 333);
+        assert_eq!(nudge(7, 123, Target::NONE), 7);
+        assert_eq!(
+            nudge(
+                0,
+                0,
+                Target {
+                    height: 1000,
+                    tol: 0
+                }
+            ),
+            500
+        );
+    }
+}

@@ -1,8 +1,0 @@
-//! The synthesis stages: each a pure function over flat buffers, named like
-//! its WGSL mirror in `kernels/` (DESIGN §3).
-
-pub mod correct;
-pub mod reconstruct;
-pub mod reduce_types;
-pub mod reduce_weights;
-pub mod upsample_jitter;

@@ -1,0 +1,101 @@
+//! The databases the stage and control tests run on: the embedded default
+//! one, and small ones built from two crops of the shared DEMs — one set-up
+//! for every test binary instead of a copy in each.
+
+use std::sync::{Mutex, OnceLock};
+use terrasynth::database::{self, BuildOptions, Database, default};
+use terrasynth::progress::Silent;
+
+use super::dem::{self, DEM};
+
+/// The embedded default database, built once per test binary.
+pub fn default_db() -> &'static Database {
+    static DB: OnceLock<Database> = OnceLock::new();
+    DB.get_or_init(|| default::build_default(&Silent).unwrap())
+}
+
+/// Two `side²` crops of shared DEMs, `(name, x, y)` at their top-left
+/// corners, with their type masks when `typed` (so the database has types
+/// and seeds); four levels, like every small test database.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TwoDems {
+    pub crops: [(&'static str, usize, usize); 2],
+    pub side: usize,
+    pub typed: bool,
+}
+
+/// 192² crops of the Pyrenees and the Franconian Jura, untyped: the real
+/// states of the stage cross-checks.
+pub const PYRENEES_JURA: TwoDems = TwoDems {
+    crops: [
+        ("pyrenees_andorra", 300, 200),
+        ("franconian_jura", 200, 300),
+    ],
+    side: 192,
+    typed: false,
+};
+
+/// 160² crops of the Riviera coast and the Pyrenees with their types: the
+/// real guides of the guided `correct` checks.
+pub const RIVIERA_PYRENEES: TwoDems = TwoDems {
+    crops: [("riviera_coast", 100, 150), ("pyrenees_andorra", 300, 200)],
+    side: 160,
+    typed: true,
+};
+
+/// 256² crops of the Pyrenees and the Catalan coast hills with their
+/// types: the user-control tests.
+pub const PYRENEES_CATALAN: TwoDems = TwoDems {
+    crops: [
+        ("pyrenees_andorra", 300, 200),
+        ("catalan_coast_hills", 300, 300),
+    ],
+    side: 256,
+    typed: true,
+};
+
+/// The syntheses whose real level states every level stage is checked on:
+/// `(database, size, seed)` — 256×192 of the default database (seed 3)
+/// and, where ../shared/dem is present (else saying that `what` is
+/// skipped), 200×256 of [`PYRENEES_JURA`] (seed 11).
+pub fn real_syntheses(what: &str) -> Vec<(&'static Database, (usize, usize), u32)> {
+    let mut out = vec![(default_db(), (256, 192), 3)];
+    out.extend(two_dems(PYRENEES_JURA, what).map(|db| (db, (200, 256), 11)));
+    out
+}
+
+/// The database of `spec`, built once per test binary, or `None` (saying
+/// that `what` is skipped) when ../shared/dem is absent.
+pub fn two_dems(spec: TwoDems, what: &str) -> Option<&'static Database> {
+    static BUILT: Mutex<Vec<(TwoDems, Option<&'static Database>)>> = Mutex::new(Vec::new());
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    let db = match built.iter().find(|(s, _)| *s == spec) {
+        Some(&(_, db)) => db,
+        None => {
+            // Leaked: the tests borrow it for the whole run, as from a static.
+            let db = build(spec).map(|db| &*Box::leak(Box::new(db)));
+            built.push((spec, db));
+            db
+        }
+    };
+    if db.is_none() {
+        eprintln!("{DEM} not found: {what} skipped");
+    }
+    db
+}
+
+fn build(spec: TwoDems) -> Option<Database> {
+    let mut inputs = Vec::new();
+    for (name, x, y) in spec.crops {
+        inputs.push(dem::exemplar(
+            name,
+            (x, y, spec.side, spec.side),
+            spec.typed,
+        )?);
+    }
+    let opts = BuildOptions {
+        levels: 4,
+        ..Default::default()
+    };
+    Some(database::build(inputs, &opts, &Silent).unwrap().0)
+}
