@@ -42,7 +42,9 @@ impl Gpu {
     }
 
     /// A copy of the pixels `[x0, x1) × [y0, y1)` of `st`, row by row on the
-    /// device (windowed synthesis, [`crate::backend::Backend::crop`]).
+    /// device (windowed synthesis, [`crate::backend::Backend::crop`]). The
+    /// copies go into the shared encoder after the passes recorded so far,
+    /// so they see those passes' writes.
     pub(super) fn crop_state(
         &self,
         st: &GpuState,
@@ -50,13 +52,13 @@ impl Gpu {
     ) -> Result<GpuState, BackendError> {
         let (w, h) = (x1 - x0, y1 - y0);
         let out = self.alloc_state(w, h)?;
-        let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+        let mut rec = self.ctx.recorder();
+        let enc = rec.encoder(&self.ctx.device);
         for y in 0..h {
             let (from, to, n) = (((y0 + y) * st.width + x0) as u64, (y * w) as u64, w as u64);
             enc.copy_buffer_to_buffer(&st.s, from * 8, &out.s, to * 8, n * 8);
             enc.copy_buffer_to_buffer(&st.v, from * 4, &out.v, to * 4, n * 4);
         }
-        self.ctx.queue.submit([enc.finish()]);
         Ok(out)
     }
 
