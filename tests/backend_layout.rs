@@ -326,7 +326,7 @@ fn correct_constants_match() {
     use terrasynth::database::types::SEEDS_PER_TYPE;
     use terrasynth::synth::control::blend::MAX_ERROR;
     use terrasynth::synth::stages::correct::{
-        ALL_TYPES, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE,
+        ALL_TYPES, FLAT, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };
     let src = kernels::CORRECT.source;
     for (name, v) in [
@@ -344,7 +344,11 @@ fn correct_constants_match() {
             "{name} must be {v} in correct.wgsl"
         );
     }
-    for (name, v) in [("MODE1_BIAS", MODE1_BIAS), ("MAX_ERROR", MAX_ERROR)] {
+    for (name, v) in [
+        ("MODE1_BIAS", MODE1_BIAS),
+        ("MAX_ERROR", MAX_ERROR),
+        ("FLAT_WEIGHT", FLAT.weight as i32),
+    ] {
         assert!(
             src.contains(&format!("const {name}: i32 = {v};")),
             "{name} must be {v} in correct.wgsl"
