@@ -1,6 +1,8 @@
 //! Synthesis engine: determinism, the exemplar-reproduction property,
 //! coordinate invariants, and robustness over odd sizes.
 
+mod common;
+
 use proptest::prelude::*;
 use std::sync::OnceLock;
 use terrasynth::database::layout::MARGIN;
@@ -283,26 +285,9 @@ proptest! {
 /// of about the exemplar's share.
 #[test]
 fn a_flat_sea_stays_at_sea_level() {
-    use terrasynth::database::{BuildOptions, ExemplarInput, build};
-    let hills = terrasynth::io::read(
-        std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/data/hills.png")),
-        &Default::default(),
-    )
-    .unwrap();
-    let mut heights = hills.crop(0, 0, 256, 256).unwrap();
-    let mut sorted: Vec<f32> = heights.data().to_vec();
-    sorted.sort_by(f32::total_cmp);
-    let sea = sorted[sorted.len() * 3 / 10];
-    for v in heights.data_mut() {
-        *v = v.max(sea);
-    }
-    let input = ExemplarInput {
-        name: "coast".into(),
-        heights,
-        types: None,
-    };
-    let (db, _) = build(vec![input], &BuildOptions::default(), &Silent).unwrap();
-    let s = Synthesizer::new(&db, Params::default()).unwrap();
+    let (db, sea) = common::db::coast_db();
+    let sea = *sea;
+    let s = Synthesizer::new(db, Params::default()).unwrap();
     let at_sea: Vec<f64> = (1..=3)
         .map(|seed| {
             let out = s.run(256, 256, seed).unwrap().heightfield;
