@@ -96,7 +96,7 @@ fn parent_offset(x: u32, y: u32) -> i32 {
         + parent_v[qy * w + qx] + 8) >> 4u;
 }
 
-// correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT;
+// correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight;
 // types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; blend::MAX_ERROR.
 const ALL_TYPES: u32 = 4294967295u;
 const W_FREE: u32 = 4u;
@@ -105,6 +105,7 @@ const SEED_SALT: u32 = 2120089600u;
 const SEEDS_PER_TYPE: u32 = 64u;
 const MODE1_BIAS: i32 = -32768;
 const MAX_ERROR: i32 = 16777216;
+const FLAT_WEIGHT: i32 = 8;
 
 // correct::CLAMP.
 const CLAMP: i32 = 9459;
@@ -172,20 +173,28 @@ fn score_with(
     var diag = DIAGONALS;
     var d: array<vec4<i32>, 4>;
     var sum1 = 0;
+    var heights: array<i32, 4>;
     for (var k = 0; k < 4; k++) {
         let m = texel(qx + diag[k].x, qy + diag[k].y);
         d[k] = ns[k] - 3 * m;
+        heights[k] = m.x;
         sum1 += d[k].x;
     }
+    // Prior::for_candidate: flat candidates take FLAT (weight 8 towards 0).
+    var w = i32(p.prior);
+    var anchor = prior_v;
+    if (w > 0 && heights[0] == heights[1] && heights[0] == heights[2] && heights[0] == heights[3]) {
+        w = FLAT_WEIGHT;
+        anchor = 0;
+    }
     // Prior::optimal and Prior::cost.
-    let w = i32(p.prior);
     let den = 12 + 3 * w;
-    var h = div_floor(sum1 + 3 * w * prior_v + den / 2, den);
+    var h = div_floor(sum1 + 3 * w * anchor + den / 2, den);
     if (fixed) {
         h = fixed_h;
     }
-    let rp = clamp(3 * (h - prior_v), -CLAMP, CLAMP);
-    var s = p.prior * u32(rp * rp);
+    let rp = clamp(3 * (h - anchor), -CLAMP, CLAMP);
+    var s = u32(w) * u32(rp * rp);
     for (var k = 0; k < 4; k++) {
         let r1 = clamp(d[k].x - 3 * h, -CLAMP, CLAMP);
         s += u32(r1 * r1);

@@ -340,7 +340,7 @@ fn correct_constants_match() {
     use terrasynth::database::types::SEEDS_PER_TYPE;
     use terrasynth::stages::correct::nudge::MAX_ERROR;
     use terrasynth::stages::correct::{
-        ALL_TYPES, CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, SEED_SALT,
+        ALL_TYPES, CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, SEED_SALT,
         SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };
     let src = kernels::CORRECT.source;
@@ -359,7 +359,11 @@ fn correct_constants_match() {
             "{name} must be {v} in correct.wgsl"
         );
     }
-    for (name, v) in [("MODE1_BIAS", MODE1_BIAS), ("MAX_ERROR", MAX_ERROR)] {
+    for (name, v) in [
+        ("MODE1_BIAS", MODE1_BIAS),
+        ("MAX_ERROR", MAX_ERROR),
+        ("FLAT_WEIGHT", FLAT.weight as i32),
+    ] {
         assert!(
             src.contains(&format!("const {name}: i32 = {v};")),
             "{name} must be {v} in correct.wgsl"

@@ -28,6 +28,15 @@
 //! anchor. P = 0 is the paper's pure relative matching. With it the closed
 //! form becomes `h = ⌊(Σ d₁ + 3P·V_parent + ⌊(12 + 3P)/2⌋) / (12 + 3P)⌋`.
 //!
+//! **Flat candidates** (the four diagonal texels at one height: the sea, a
+//! lake, a salt flat) take the prior [`FLAT`] instead: weight 8 towards
+//! offset 0, i.e. towards their own altitude. A flat candidate fits any
+//! height equally well, so next to land it was lifted to the land's mean,
+//! and the parent anchor carried that lift down level after level: on the
+//! coastal DEMs the sea came out as a green plain 5–130 m up (median +41 m
+//! on riviera). Its own altitude is the one thing a flat texel knows. (P = 0
+//! keeps the paper's rule for every candidate.)
+//!
 //! Integer arithmetic (DESIGN §6), identical in the WGSL mirror:
 //! - N_S is kept as the *sum* of its three vectors (×3) so no division is
 //!   needed; N_E is scaled by 3 to match.
@@ -136,6 +145,25 @@ impl Prior {
     pub fn cost(self, h: i32) -> u32 {
         let r = (3 * (h - self.v)).clamp(-CLAMP, CLAMP);
         self.weight * (r * r) as u32
+    }
+}
+
+/// The prior of flat candidates (module docs): weight 8 (the most the u32
+/// score bound allows, see [`CLAMP`]; 2 and 4 left dimples in the sea:
+/// pits ×2.6–15 on riviera) towards offset 0.
+pub const FLAT: Prior = Prior { weight: 8, v: 0 };
+
+impl Prior {
+    /// The prior that scores a candidate whose four diagonal texels have
+    /// mode-1 heights `m`: [`FLAT`] when they are all equal (and the stage
+    /// has a prior at all), else `self`.
+    #[inline(always)]
+    pub fn for_candidate(self, m: [i32; 4]) -> Prior {
+        if self.weight > 0 && m[0] == m[1] && m[0] == m[2] && m[0] == m[3] {
+            FLAT
+        } else {
+            self
+        }
     }
 }
 

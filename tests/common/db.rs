@@ -14,6 +14,31 @@ pub fn default_db() -> &'static Database {
     DB.get_or_init(|| default::build_default(&Silent).unwrap())
 }
 
+/// A coast: the embedded hills exemplar's top-left 256² flooded to its 30th
+/// height percentile, so that 30 % of it is one flat sea (the `correct`
+/// stage's flat-candidate prior acts there), and that sea level in metres.
+pub fn coast_db() -> &'static (Database, f32) {
+    static DB: OnceLock<(Database, f32)> = OnceLock::new();
+    DB.get_or_init(|| {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/hills.png");
+        let hills = terrasynth::io::read(std::path::Path::new(path), &Default::default()).unwrap();
+        let mut heights = hills.crop(0, 0, 256, 256).unwrap();
+        let mut sorted = heights.data().to_vec();
+        sorted.sort_by(f32::total_cmp);
+        let sea = sorted[sorted.len() * 3 / 10];
+        for v in heights.data_mut() {
+            *v = v.max(sea);
+        }
+        let input = database::ExemplarInput {
+            name: "coast".into(),
+            heights,
+            types: None,
+        };
+        let (db, _) = database::build(vec![input], &BuildOptions::default(), &Silent).unwrap();
+        (db, sea)
+    })
+}
+
 /// Two `side²` crops of shared DEMs, `(name, x, y)` at their top-left
 /// corners, with their type masks when `typed` (so the database has types
 /// and seeds); four levels, like every small test database.
@@ -55,11 +80,14 @@ pub const PYRENEES_CATALAN: TwoDems = TwoDems {
 };
 
 /// The syntheses whose real level states every level stage is checked on:
-/// `(database, size, seed)` — 256×192 of the default database (seed 3)
-/// and, where ../shared/dem is present (else saying that `what` is
+/// `(database, size, seed)` — 256×192 of the default database (seed 3),
+/// 160² of the flooded [`coast_db`] (seed 2) and, where ../shared/dem is present (else saying that `what` is
 /// skipped), 200×256 of [`PYRENEES_JURA`] (seed 11).
 pub fn real_syntheses(what: &str) -> Vec<(&'static Database, (usize, usize), u32)> {
-    let mut out = vec![(default_db(), (256, 192), 3)];
+    let mut out = vec![
+        (default_db(), (256, 192), 3),
+        (&coast_db().0, (160, 160), 2),
+    ];
     out.extend(two_dems(PYRENEES_JURA, what).map(|db| (db, (200, 256), 11)));
     out
 }

@@ -67,14 +67,17 @@ fn score_with(
     prior: Prior,
 ) -> (u32, i32) {
     let mut d = [[0i32; 4]; 4];
+    let mut heights = [0i32; 4];
     let mut sum1 = 0;
     for (k, &(dx, dy)) in DIAGONALS.iter().enumerate() {
         let m = unpack_texel(atlas.appearance(qx + dx, qy + dy));
         for j in 0..4 {
             d[k][j] = ns[k][j] - 3 * m[j] as i32;
         }
+        heights[k] = m[0] as i32;
         sum1 += d[k][0];
     }
+    let prior = prior.for_candidate(heights);
     let h = fixed.unwrap_or_else(|| prior.optimal(sum1));
     let mut s = prior.cost(h);
     for dk in &d {

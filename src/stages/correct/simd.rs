@@ -22,7 +22,7 @@
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 
 use super::nudge::nudge;
-use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, Guide, Prior, W_FREE, scalar, weigh};
+use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, FLAT, Guide, Prior, W_FREE, scalar, weigh};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
@@ -98,14 +98,29 @@ fn score_with<const P: u32>(
     fixed: Option<i32>,
     vp: i32,
 ) -> (u32, i32) {
-    let prior = Prior { weight: P, v: vp };
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
     let m01 = i32x8::from_i16x8(pair(app, q - s - 1, q - s + 1));
     let m23 = i32x8::from_i16x8(pair(app, q + s - 1, q + s + 1));
     let d01 = ns.ns01 - (m01 + m01 + m01);
     let d23 = ns.ns23 - (m23 + m23 + m23);
     let (a, b) = (d01.to_array(), d23.to_array());
-    let h = fixed.unwrap_or_else(|| prior.optimal(a[0] + a[4] + b[0] + b[4]));
+    let (ma, mb) = (m01.to_array(), m23.to_array());
+    let sum1 = a[0] + a[4] + b[0] + b[4];
+    // Both priors have constant weights, so each closed form divides by a
+    // constant (the branch picks one, never a run-time divisor).
+    let flat = Prior { weight: P, v: vp }.for_candidate([ma[0], ma[4], mb[0], mb[4]]) == FLAT;
+    let prior = if flat {
+        FLAT
+    } else {
+        Prior { weight: P, v: vp }
+    };
+    let h = fixed.unwrap_or_else(|| {
+        if flat {
+            FLAT.optimal(sum1)
+        } else {
+            Prior { weight: P, v: vp }.optimal(sum1)
+        }
+    });
     let h3 = 3 * h;
     let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
     // Clamping after the saturating narrowing equals clamping before it
