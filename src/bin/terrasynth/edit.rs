@@ -101,13 +101,7 @@ fn scene_session<'db>(
     scene: &Scene,
     backend: BackendArg,
 ) -> Result<Session<'db>, Box<dyn std::error::Error + Send + Sync>> {
-    let mut session = Session::new(
-        db,
-        SceneEdits::params(scene),
-        scene.width,
-        scene.height,
-        scene.seed,
-    )?;
+    let mut session = SceneEdits::session(db, scene)?;
     select_backend(session.synthesizer_mut(), backend)?;
     Ok(session)
 }
