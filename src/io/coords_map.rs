@@ -36,13 +36,7 @@ pub struct CoordsMap {
 
 impl CoordsMap {
     pub fn new(width: usize, height: usize, sources: Vec<Source>) -> Result<Self, FormatError> {
-        crate::size::check_dims(width, height)?;
-        if sources.len() != width * height {
-            return Err(FormatError::DimensionMismatch(format!(
-                "{} sources for a {width}x{height} map",
-                sources.len()
-            )));
-        }
+        FormatError::check_table(width, height, sources.len(), "sources", "map")?;
         Ok(CoordsMap {
             width,
             height,

@@ -65,6 +65,25 @@ impl FormatError {
         }
     }
 
+    /// Checks a per-pixel table of `len` entries against the grid it belongs
+    /// to (a valid size, one entry a pixel), naming the entries `what` and
+    /// the grid `grid` in the error.
+    pub(crate) fn check_table(
+        width: usize,
+        height: usize,
+        len: usize,
+        what: &str,
+        grid: &str,
+    ) -> Result<(), Self> {
+        crate::size::check_dims(width, height)?;
+        if len != width * height {
+            return Err(FormatError::DimensionMismatch(format!(
+                "{len} {what} for a {width}x{height} {grid}"
+            )));
+        }
+        Ok(())
+    }
+
     /// A bad signature, showing the first bytes that were found instead.
     pub(crate) fn bad_magic(expected: &'static str, bytes: &[u8]) -> Self {
         let s: Vec<String> = bytes.iter().take(8).map(|b| format!("{b:02X}")).collect();

@@ -340,31 +340,20 @@ fn prescan(bytes: &[u8]) -> Result<(), FormatError> {
         Some(b"MM") => false,
         _ => return Err(FormatError::bad_magic(MAGIC, bytes)),
     };
-    // Offsets come from the file: any of them may point past its end.
-    let u16_at = |o: usize| -> Option<u64> {
-        let b: [u8; 2] = bytes.get(o..o.checked_add(2)?)?.try_into().ok()?;
+    // Offsets come from the file: any of them may point past its end. An
+    // unsigned integer of `n` bytes in the file's byte order.
+    let uint_at = |o: usize, n: usize| -> Option<u64> {
+        let b = bytes.get(o..o.checked_add(n)?)?;
+        let be = |v: u64, &x: &u8| v << 8 | x as u64;
         Some(if le {
-            u16::from_le_bytes(b)
+            b.iter().rev().fold(0, be)
         } else {
-            u16::from_be_bytes(b)
-        } as u64)
-    };
-    let u32_at = |o: usize| -> Option<u64> {
-        let b: [u8; 4] = bytes.get(o..o.checked_add(4)?)?.try_into().ok()?;
-        Some(if le {
-            u32::from_le_bytes(b)
-        } else {
-            u32::from_be_bytes(b)
-        } as u64)
-    };
-    let u64_at = |o: usize| -> Option<u64> {
-        let b: [u8; 8] = bytes.get(o..o.checked_add(8)?)?.try_into().ok()?;
-        Some(if le {
-            u64::from_le_bytes(b)
-        } else {
-            u64::from_be_bytes(b)
+            b.iter().fold(0, be)
         })
     };
+    let u16_at = |o| uint_at(o, 2);
+    let u32_at = |o| uint_at(o, 4);
+    let u64_at = |o| uint_at(o, 8);
     let len = bytes.len() as u64;
     let short = |what| FormatError::Truncated {
         what,

@@ -29,13 +29,7 @@ pub struct TypeMask {
 
 impl TypeMask {
     pub fn new(width: usize, height: usize, indices: Vec<u8>) -> Result<TypeMask, FormatError> {
-        crate::size::check_dims(width, height)?;
-        if indices.len() != width * height {
-            return Err(FormatError::DimensionMismatch(format!(
-                "{} type indices for a {width}x{height} mask",
-                indices.len()
-            )));
-        }
+        FormatError::check_table(width, height, indices.len(), "type indices", "mask")?;
         Ok(TypeMask {
             width,
             height,

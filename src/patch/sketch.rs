@@ -223,13 +223,12 @@ impl Sketch {
                 height,
                 strokes,
             } => {
-                let (sx, sy) = (w as f32 / *width as f32, h as f32 / *height as f32);
-                let scale = (sx * sy).sqrt();
+                let s = Scale::new((*width, *height), (w, h));
+                let scale = (s.sx * s.sy).sqrt();
                 let mut hi = vec![0.0f32; w * h];
                 let mut lo = vec![0.0f32; w * h];
                 for k in strokes {
-                    let pts: Vec<[f32; 2]> =
-                        k.points.iter().map(|p| [p[0] * sx, p[1] * sy]).collect();
+                    let pts = s.points(k);
                     let hw = (k.width * scale * 0.5).max(1.0);
                     let target = match k.kind {
                         Kind::Ridge => &mut hi,
@@ -240,6 +239,29 @@ impl Sketch {
                 hi.iter().zip(&lo).map(|(a, b)| a - b).collect()
             }
         }
+    }
+}
+
+/// From a stroke sketch's pixels to the output's, per axis.
+struct Scale {
+    sx: f32,
+    sy: f32,
+}
+
+impl Scale {
+    fn new((width, height): (usize, usize), (w, h): (usize, usize)) -> Scale {
+        Scale {
+            sx: w as f32 / width as f32,
+            sy: h as f32 / height as f32,
+        }
+    }
+
+    /// A stroke's points in output pixels.
+    fn points(&self, k: &Stroke) -> Vec<[f32; 2]> {
+        k.points
+            .iter()
+            .map(|p| [p[0] * self.sx, p[1] * self.sy])
+            .collect()
     }
 }
 
@@ -301,11 +323,10 @@ pub fn stroke_mask(sketch: &Sketch, kind: Kind, w: usize, h: usize, radius: f32)
             height,
             strokes,
         } => {
-            let (sx, sy) = (w as f32 / *width as f32, h as f32 / *height as f32);
+            let s = Scale::new((*width, *height), (w, h));
             let mut m = vec![0.0f32; w * h];
             for k in strokes.iter().filter(|k| k.kind == kind) {
-                let pts: Vec<[f32; 2]> = k.points.iter().map(|p| [p[0] * sx, p[1] * sy]).collect();
-                draw_cone(&mut m, w, h, &pts, radius.max(0.5));
+                draw_cone(&mut m, w, h, &s.points(k), radius.max(0.5));
             }
             m.iter().map(|&v| v > 0.0).collect()
         }

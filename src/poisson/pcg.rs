@@ -20,27 +20,34 @@ fn apply(width: usize, height: usize, v: &[f64], fixed: &[bool], out: &mut [f64]
             }
             let mut acc = 0.0;
             let mut deg = 0.0;
-            let mut visit = |j: usize| {
+            neighbours(width, height, x, y, |j| {
                 deg += 1.0;
                 if !fixed[j] {
                     acc -= v[j];
                 }
-            };
-            if x > 0 {
-                visit(i - 1);
-            }
-            if x + 1 < width {
-                visit(i + 1);
-            }
-            if y > 0 {
-                visit(i - width);
-            }
-            if y + 1 < height {
-                visit(i + width);
-            }
+            });
             *o = deg * v[i] + acc;
         }
     });
+}
+
+/// Calls `f` with the index of each in-grid 4-neighbour of pixel `(x, y)`,
+/// always in the order left, right, up, down, so that sums over the
+/// neighbours round the same way wherever they are taken.
+fn neighbours(width: usize, height: usize, x: usize, y: usize, mut f: impl FnMut(usize)) {
+    let i = y * width + x;
+    if x > 0 {
+        f(i - 1);
+    }
+    if x + 1 < width {
+        f(i + 1);
+    }
+    if y > 0 {
+        f(i - width);
+    }
+    if y + 1 < height {
+        f(i + width);
+    }
 }
 
 /// Degree (neighbour count) of pixel i.
@@ -87,23 +94,11 @@ pub(super) fn cg(
                 continue;
             }
             let mut s = -f[i];
-            let mut take = |j: usize| {
+            neighbours(width, height, xi, y, |j| {
                 if fixed[j] {
                     s += x[j];
                 }
-            };
-            if xi > 0 {
-                take(i - 1);
-            }
-            if xi + 1 < width {
-                take(i + 1);
-            }
-            if y > 0 {
-                take(i - width);
-            }
-            if y + 1 < height {
-                take(i + width);
-            }
+            });
             *o = s;
         }
     });

@@ -25,6 +25,26 @@ fn max_defect(w: usize, h: usize, u: &[f32], fixed: &[bool], f: &[f32]) -> f64 {
     worst
 }
 
+/// A `w × h` problem `(u, fixed, f)` built pixel by pixel: `cell(x, y)`
+/// says whether the pixel is fixed, its value (the boundary value, or the
+/// initial guess at a free pixel) and its right-hand side.
+fn problem(
+    w: usize,
+    h: usize,
+    cell: impl Fn(usize, usize) -> (bool, f32, f32),
+) -> (Vec<f32>, Vec<bool>, Vec<f32>) {
+    let mut u = vec![0.0f32; w * h];
+    let mut fixed = vec![false; w * h];
+    let mut f = vec![0.0f32; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            (fixed[i], u[i], f[i]) = cell(x, y);
+        }
+    }
+    (u, fixed, f)
+}
+
 #[test]
 fn linear_function_is_reproduced_inside_a_hole() {
     // A plane is harmonic: filling a hole in it must give the plane back.
@@ -55,22 +75,15 @@ fn multigrid_solve_matches_the_stencil_in_few_iterations() {
     // An irregular hole (fixed ring, fixed islands, a Neumann side) on a
     // patch-window-sized grid, with a rough right-hand side.
     let (w, h) = (66, 61);
-    let mut u = vec![0.0f32; w * h];
-    let mut fixed = vec![false; w * h];
-    let mut f = vec![0.0f32; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let island = (x / 9 + y / 7) % 5 == 0 && x % 9 < 3;
-            if x < 20 - y / 4 || y == 0 || island {
-                fixed[i] = true;
-                u[i] = 100.0 + (x * 7 % 13) as f32 - y as f32 * 0.3;
-            } else {
-                u[i] = 50.0; // a poor initial guess
-            }
-            f[i] = ((x * 31 + y * 17) % 11) as f32 - 5.0;
+    let (u, fixed, f) = problem(w, h, |x, y| {
+        let island = (x / 9 + y / 7) % 5 == 0 && x % 9 < 3;
+        let f = ((x * 31 + y * 17) % 11) as f32 - 5.0;
+        if x < 20 - y / 4 || y == 0 || island {
+            (true, 100.0 + (x * 7 % 13) as f32 - y as f32 * 0.3, f)
+        } else {
+            (false, 50.0, f) // a poor initial guess
         }
-    }
+    });
     let opts = SolveOptions {
         tolerance: 1e-8,
         max_iterations: 500,
@@ -94,23 +107,18 @@ fn multigrid_solve_matches_the_stencil_in_few_iterations() {
 #[test]
 fn poisson_reaches_tolerance_and_satisfies_the_stencil() {
     let (w, h) = (300, 257);
-    let mut u = vec![0.0f32; w * h];
-    let mut fixed = vec![false; w * h];
-    let mut f = vec![0.0f32; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            if x == 0 || y == 0 {
-                fixed[i] = true;
-                u[i] = (x as f32 * 0.1).min(7.0) + y as f32 * 0.05;
-            }
-            f[i] = if (x / 37 + y / 23) % 2 == 0 {
-                0.01
-            } else {
-                -0.02
-            };
+    let (mut u, fixed, f) = problem(w, h, |x, y| {
+        let f = if (x / 37 + y / 23) % 2 == 0 {
+            0.01
+        } else {
+            -0.02
+        };
+        if x == 0 || y == 0 {
+            (true, (x as f32 * 0.1).min(7.0) + y as f32 * 0.05, f)
+        } else {
+            (false, 0.0, f)
         }
-    }
+    });
     let opts = SolveOptions {
         tolerance: 1e-8,
         max_iterations: 20_000,

@@ -16,7 +16,7 @@ use crate::database::Database;
 use crate::synth::Params;
 use crate::synth::control::curve::{self, Curve, FieldCache, Junction};
 use crate::synth::control::{self, Constraint, ConstraintId, PointConstraint};
-use crate::synth::session::Edit;
+use crate::synth::session::{Edit, Session, SessionError};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -82,6 +82,18 @@ impl SceneEdits {
             start_exemplar: scene.start_exemplar,
             ..Params::default()
         }
+    }
+
+    /// An editing session at the scene's size and seed with the parameters
+    /// it asks for, before any of its edits.
+    pub fn session<'db>(db: &'db Database, scene: &Scene) -> Result<Session<'db>, SessionError> {
+        Session::new(
+            db,
+            SceneEdits::params(scene),
+            scene.width,
+            scene.height,
+            scene.seed,
+        )
     }
 
     /// The curves of the last scene (with their ids), for overlays.

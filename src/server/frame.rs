@@ -293,14 +293,8 @@ fn start(
     let t = Instant::now();
     let list = edits.edits(scene, db)?;
     let edits_time = t.elapsed();
-    let mut session = Session::new(
-        db,
-        SceneEdits::params(scene),
-        scene.width,
-        scene.height,
-        scene.seed,
-    )
-    .map_err(|e| ApiError::invalid("$", e.to_string()))?;
+    let mut session =
+        SceneEdits::session(db, scene).map_err(|e| ApiError::invalid("$", e.to_string()))?;
     let frame = session
         .apply(list)
         .map_err(|e| ApiError::invalid("$", e.to_string()))?;

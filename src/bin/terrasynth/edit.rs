@@ -4,6 +4,7 @@
 use crate::CliResult;
 use crate::args::{BackendArg, EngineArg, load_database, select_backend, write_output};
 use std::path::{Path, PathBuf};
+use terrasynth::database::Database;
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::scene::{Scene, SceneEdits, overlay};
 use terrasynth::synth::session::Session;
@@ -57,14 +58,7 @@ pub fn synth_scene(
     let db = load_database(scene.database.as_deref())?;
     let mut edits = SceneEdits::new();
     let first = edits.edits(&scene, &db)?;
-    let mut session = Session::new(
-        &db,
-        SceneEdits::params(&scene),
-        scene.width,
-        scene.height,
-        scene.seed,
-    )?;
-    select_backend(session.synthesizer_mut(), backend)?;
+    let mut session = scene_session(&db, &scene, backend)?;
     let frame = session.apply(first)?;
     write_output(&frame.heightfield, output, None, engine, &inputs)?;
     let s = frame.heightfield.stats().expect("synthesis has no nodata");
@@ -100,6 +94,18 @@ pub fn synth_scene(
     Ok(())
 }
 
+/// An editing session at `scene`'s size, seed and parameters on `backend`,
+/// before any of its edits.
+fn scene_session<'db>(
+    db: &'db Database,
+    scene: &Scene,
+    backend: BackendArg,
+) -> Result<Session<'db>, Box<dyn std::error::Error + Send + Sync>> {
+    let mut session = SceneEdits::session(db, scene)?;
+    select_backend(session.synthesizer_mut(), backend)?;
+    Ok(session)
+}
+
 pub fn run(a: Args) -> CliResult {
     let base = Scene::read(&a.base)?;
     let db = load_database(base.database.as_deref())?;
@@ -114,15 +120,8 @@ pub fn run(a: Args) -> CliResult {
     std::fs::create_dir_all(&a.out_dir)
         .map_err(|e| format!("cannot create {}: {e}", a.out_dir.display()))?;
     let mut edits = SceneEdits::new();
-    let mut session = Session::new(
-        &db,
-        SceneEdits::params(&base),
-        base.width,
-        base.height,
-        base.seed,
-    )?;
+    let mut session = scene_session(&db, &base, a.backend)?;
     session.coherence = !a.no_coherence;
-    select_backend(session.synthesizer_mut(), a.backend)?;
     let mut report = Vec::new();
     let files: Vec<PathBuf> = std::iter::once(a.base.clone())
         .chain(a.edits.iter().cloned())

@@ -8,7 +8,7 @@ mod paint;
 mod reader;
 
 use super::*;
-use reader::{R, Reader, join};
+use reader::{R, Range, Reader, join};
 use serde_json::{Map, Value};
 
 pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
@@ -74,7 +74,7 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         u32::MAX as u64,
     )? as u32;
     let jitter = match m.get("jitter") {
-        Some(v) => r.number(v, "jitter", 0.0, 4.0, false, "0..=4 texels")?,
+        Some(v) => r.number(v, "jitter", Range::closed(0.0, 4.0, "0..=4 texels"))?,
         None => 0.4,
     };
     let passes = match m.get("passes") {
@@ -86,13 +86,17 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         None => None,
     };
     let mut ids = Vec::new();
-    let bounds = (fw, fh);
-    let points = constraints::points(&r, m, bounds, &mut ids)?;
-    let curves = constraints::curves(&r, m, bounds, &mut ids)?;
-    let junctions = constraints::junctions(&r, m, bounds)?;
-    let types = paint::types(&r, m, bounds)?;
-    let freeze = paint::freeze(&r, m, bounds)?;
-    let pastes = paint::pastes(&r, m, bounds, &mut ids)?;
+    let d = Doc {
+        r: &r,
+        m,
+        size: (fw, fh),
+    };
+    let points = constraints::points(&d, &mut ids)?;
+    let curves = constraints::curves(&d, &mut ids)?;
+    let junctions = constraints::junctions(&d)?;
+    let types = paint::types(&d)?;
+    let freeze = paint::freeze(&d)?;
+    let pastes = paint::pastes(&d, &mut ids)?;
 
     Ok(Scene {
         file: file.to_path_buf(),
@@ -110,4 +114,43 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         freeze,
         pastes,
     })
+}
+
+/// What each section of a document is read with: the reader, the
+/// document's top-level object, and the terrain size in pixels (the bound
+/// of every `[x, y]` on the terrain).
+struct Doc<'a> {
+    r: &'a Reader<'a>,
+    m: &'a Map<String, Value>,
+    size: (f64, f64),
+}
+
+impl Doc<'_> {
+    /// The objects of the optional top-level array `key` (see
+    /// [`Reader::items`]).
+    fn items<T>(
+        &self,
+        key: &str,
+        what: &str,
+        allowed: &[&str],
+        item: impl FnMut(&str, &Map<String, Value>) -> R<T>,
+    ) -> R<Vec<T>> {
+        self.r.items(self.m.get(key), key, 0, what, allowed, item)
+    }
+
+    /// The `"at"` pixel and `"height_m"` of an item that sets a height at a
+    /// place (a point constraint, a junction height).
+    fn height_at(&self, o: &Map<String, Value>, path: &str) -> R<(DVec2, f64)> {
+        let r = self.r;
+        let at = r.xy(
+            r.required(o, path, "at", "[x, y] in pixels")?,
+            &join(path, "at"),
+            self.size,
+        )?;
+        let height_m = r.height(
+            r.required(o, path, "height_m", "a height in metres")?,
+            &join(path, "height_m"),
+        )?;
+        Ok((at, height_m))
+    }
 }

@@ -9,6 +9,40 @@ use crate::synth::control::curve::{LEFT, RIGHT};
 /// keeps a hostile file from asking for unbounded work after parsing.
 const MAX_ITEMS: usize = 100_000;
 
+/// The values a number may take, and how an error names them.
+#[derive(Clone, Copy)]
+pub(super) struct Range<'e> {
+    lo: f64,
+    hi: f64,
+    /// `lo` itself is excluded (a radius or reach of 0 has no extent).
+    lo_open: bool,
+    expected: &'e str,
+}
+
+impl<'e> Range<'e> {
+    /// `lo..=hi`.
+    pub(super) fn closed(lo: f64, hi: f64, expected: &'e str) -> Self {
+        Range {
+            lo,
+            hi,
+            lo_open: false,
+            expected,
+        }
+    }
+
+    /// `lo < x <= hi`.
+    pub(super) fn above(lo: f64, hi: f64, expected: &'e str) -> Self {
+        Range {
+            lo_open: true,
+            ..Range::closed(lo, hi, expected)
+        }
+    }
+
+    fn contains(&self, x: f64) -> bool {
+        x.is_finite() && x <= self.hi && (x > self.lo || (!self.lo_open && x == self.lo))
+    }
+}
+
 pub(super) struct Reader<'a> {
     pub(super) file: &'a Path,
 }
@@ -85,18 +119,59 @@ impl Reader<'_> {
         }
     }
 
-    pub(super) fn number(
+    /// The objects of the array `v` at `path` (none when `v` is absent, at
+    /// least `min` otherwise), each with only `allowed` keys, read in order
+    /// by `item` with its path.
+    pub(super) fn items<T>(
         &self,
-        v: &Value,
+        v: Option<&Value>,
         path: &str,
-        lo: f64,
-        hi: f64,
-        lo_open: bool,
-        expected: &str,
-    ) -> R<f64> {
+        min: usize,
+        what: &str,
+        allowed: &[&str],
+        mut item: impl FnMut(&str, &Map<String, Value>) -> R<T>,
+    ) -> R<Vec<T>> {
+        let Some(v) = v else {
+            return Ok(Vec::new());
+        };
+        self.array(v, path, min, what)?
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let path = format!("{path}[{i}]");
+                item(&path, self.object(e, &path, allowed)?)
+            })
+            .collect()
+    }
+
+    /// The required array `m[key]` of at least `min` `[x, y]` points, each
+    /// within `bound`; `expected` says what is missing when it is absent.
+    pub(super) fn points(
+        &self,
+        m: &Map<String, Value>,
+        path: &str,
+        key: &str,
+        min: usize,
+        expected: &'static str,
+        bound: (f64, f64),
+    ) -> R<Vec<DVec2>> {
+        let kp = join(path, key);
+        self.array(
+            self.required(m, path, key, expected)?,
+            &kp,
+            min,
+            "[x, y] points",
+        )?
+        .iter()
+        .enumerate()
+        .map(|(k, p)| self.xy(p, &format!("{kp}[{k}]"), bound))
+        .collect()
+    }
+
+    pub(super) fn number(&self, v: &Value, path: &str, range: Range) -> R<f64> {
         match v.as_f64() {
-            Some(x) if x.is_finite() && x <= hi && (x > lo || (!lo_open && x == lo)) => Ok(x),
-            _ => Err(self.invalid(path, v, expected)),
+            Some(x) if range.contains(x) => Ok(x),
+            _ => Err(self.invalid(path, v, range.expected)),
         }
     }
 
@@ -124,46 +199,28 @@ impl Reader<'_> {
         let x = self.number(
             &a[0],
             &format!("{path}[0]"),
-            0.0,
-            w,
-            false,
-            &format!("x in 0..={w} pixels"),
+            Range::closed(0.0, w, &format!("x in 0..={w} pixels")),
         )?;
         let y = self.number(
             &a[1],
             &format!("{path}[1]"),
-            0.0,
-            h,
-            false,
-            &format!("y in 0..={h} pixels"),
+            Range::closed(0.0, h, &format!("y in 0..={h} pixels")),
         )?;
         Ok(DVec2::new(x, y))
     }
 
     /// `[left, right]`.
-    pub(super) fn pair(
-        &self,
-        v: &Value,
-        path: &str,
-        lo: f64,
-        hi: f64,
-        lo_open: bool,
-        expected: &str,
-    ) -> R<[f64; 2]> {
+    pub(super) fn pair(&self, v: &Value, path: &str, range: Range) -> R<[f64; 2]> {
         let a = match v.as_array() {
             Some(a) if a.len() == 2 => a,
-            _ => return Err(self.invalid(path, v, format!("[left, right], each {expected}"))),
+            _ => {
+                let expected = format!("[left, right], each {}", range.expected);
+                return Err(self.invalid(path, v, expected));
+            }
         };
         let mut out = [0.0; 2];
         for side in [LEFT, RIGHT] {
-            out[side] = self.number(
-                &a[side],
-                &format!("{path}[{side}]"),
-                lo,
-                hi,
-                lo_open,
-                expected,
-            )?;
+            out[side] = self.number(&a[side], &format!("{path}[{side}]"), range)?;
         }
         Ok(out)
     }
@@ -172,10 +229,11 @@ impl Reader<'_> {
         self.number(
             v,
             path,
-            -MAX_ABS_HEIGHT_M,
-            MAX_ABS_HEIGHT_M,
-            false,
-            "a height in -20000..=20000 m",
+            Range::closed(
+                -MAX_ABS_HEIGHT_M,
+                MAX_ABS_HEIGHT_M,
+                "a height in -20000..=20000 m",
+            ),
         )
     }
 
@@ -221,24 +279,11 @@ impl Reader<'_> {
     }
 
     pub(super) fn stroke(&self, m: &Map<String, Value>, path: &str, size: (f64, f64)) -> R<Stroke> {
-        let pts = self.array(
-            self.required(m, path, "points", "an array of [x, y] points")?,
-            &join(path, "points"),
-            1,
-            "[x, y] points",
-        )?;
-        let points = pts
-            .iter()
-            .enumerate()
-            .map(|(k, p)| self.xy(p, &format!("{}[{k}]", join(path, "points")), size))
-            .collect::<R<Vec<_>>>()?;
+        let points = self.points(m, path, "points", 1, "an array of [x, y] points", size)?;
         let radius_px = self.number(
             self.required(m, path, "radius_px", "a brush radius in pixels")?,
             &join(path, "radius_px"),
-            0.0,
-            4096.0,
-            true,
-            "0 < radius <= 4096 pixels",
+            Range::above(0.0, 4096.0, "0 < radius <= 4096 pixels"),
         )?;
         Ok(Stroke { points, radius_px })
     }

@@ -137,13 +137,7 @@ mod tests {
 
     #[test]
     fn finds_a_self_crossing_loop() {
-        // A loop-de-loop: a circle drawn past its start.
-        let raw: Vec<DVec2> = (0..=80)
-            .map(|k| {
-                let t = k as f64 / 80.0 * 2.4 * std::f64::consts::PI;
-                DVec2::new(30.0 + 15.0 * t.sin() + 4.0 * t, 30.0 - 15.0 * t.cos())
-            })
-            .collect();
+        let raw = super::super::tests::loop_de_loop();
         let p = resample(&raw).unwrap();
         let s = arc_lengths(&p);
         let c = find(&[(&p, &s)]);

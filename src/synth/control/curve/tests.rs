@@ -228,14 +228,20 @@ fn junctions_at_crossings_take_the_mean_height_or_the_set_one() {
     ));
 }
 
-#[test]
-fn self_crossing_curves_get_one_junction_height_at_both_passes() {
-    let pts: Vec<DVec2> = (0..=80)
+/// A loop-de-loop: a circle drawn past its start, so that it crosses
+/// itself once (also the junction finder's test case).
+pub(super) fn loop_de_loop() -> Vec<DVec2> {
+    (0..=80)
         .map(|k| {
             let t = k as f64 / 80.0 * 2.4 * std::f64::consts::PI;
             DVec2::new(30.0 + 15.0 * t.sin() + 4.0 * t, 30.0 - 15.0 * t.cos())
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn self_crossing_curves_get_one_junction_height_at_both_passes() {
+    let pts = loop_de_loop();
     let spec = CurveSpec {
         points: pts,
         widgets: vec![
