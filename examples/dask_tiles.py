@@ -22,7 +22,6 @@ See README ("Python") for Slurm/PBS (dask-jobqueue) and Kubernetes
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from typing import List, Optional, Sequence, Tuple
 

@@ -119,8 +119,14 @@ def test_scene_matches_the_cli(root, tmp_path):
     import shutil
     import subprocess
 
-    cli = shutil.which("terrasynth") or root / "target" / "release" / "terrasynth"
-    if not (shutil.which("terrasynth") or (root / "target" / "release" / "terrasynth").exists()):
+    import os
+
+    cli = root / "target" / "release" / "terrasynth"
+    if not cli.exists():
+        cli = shutil.which("terrasynth")
+    if cli is None:
+        if os.environ.get("TERRASYNTH_REQUIRE_CLI"):
+            pytest.fail("TERRASYNTH_REQUIRE_CLI is set but no terrasynth CLI was found")
         pytest.skip("no terrasynth CLI built (cargo build --release)")
     scene = root / "data" / "scenes" / "canyonlands.json"
     out = tmp_path / "cli.exr"
