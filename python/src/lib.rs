@@ -161,7 +161,8 @@ fn from_numpy(a: &Bound<'_, PyAny>, what: &str) -> PyResult<(usize, usize, Vec<f
 
 fn heightfield(a: &Bound<'_, PyAny>, cell_size: f64, what: &str) -> PyResult<Heightfield> {
     let (w, h, v) = from_numpy(a, what)?;
-    Heightfield::from_vec(w, h, cell_size, v).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
+    Heightfield::from_vec(w, h, cell_size, v)
+        .map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
 }
 
 /// `(x, y, w, h)` as a rectangle, refusing empty windows here (the
@@ -219,7 +220,11 @@ fn synthesize<'py>(
             match window {
                 Some(win) => {
                     let cone = synth.window_cone(world, win).map_err(|e| e.to_string())?;
-                    let what = format!("a {}x{} window of a {w}x{h} world", win.width(), win.height());
+                    let what = format!(
+                        "a {}x{} window of a {w}x{h} world",
+                        win.width(),
+                        win.height()
+                    );
                     io::check_memory(&what, cone.bytes()).map_err(|e| e.to_string())?;
                     synth
                         .synthesize_window(world, win, seed)
@@ -437,7 +442,11 @@ fn eval<'py>(
     reference_cell_size: Option<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let s = heightfield(synth, cell_size, "synth")?;
-    let r = heightfield(reference, reference_cell_size.unwrap_or(cell_size), "reference")?;
+    let r = heightfield(
+        reference,
+        reference_cell_size.unwrap_or(cell_size),
+        "reference",
+    )?;
     let json = py
         .allow_threads(|| -> Result<String, String> {
             let c = terrasynth::eval::compare(&s, &r).map_err(|e| e.to_string())?;
