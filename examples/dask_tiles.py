@@ -82,15 +82,27 @@ def local_georef(world: Tuple[int, int], cell: float) -> dict:
     }
 
 
-def write(heights: da.Array, path: str, world, cell: float) -> None:
-    """Writes the world: .npy and .zarr stream the tiles (memory: a few
-    tiles); other formats (.tif, .exr, ...) gather the world into memory
+def write(client, heights: da.Array, path: str, world, tile, seed, db_path, cell: float) -> None:
+    """Writes the world: .npy and .zarr stream the tiles (memory here: a
+    few tiles); other formats (.tif, .exr, ...) gather the world into memory
     here first."""
     if path.endswith(".npy"):
+        # The memory map lives in this process: tiles come here as they are
+        # done, and each is written and dropped.
+        from distributed import as_completed
+
         out = np.lib.format.open_memmap(path, mode="w+", dtype=np.float32, shape=heights.shape)
-        da.store(heights, out, lock=True)
+        futures = submit_tiles(client, world, tile, seed, db_path)
+        where = {f.key: w for f, w in zip(futures, tile_windows(world, tile))}
+        for f, t in as_completed(futures, with_results=True):
+            x, y, w, h = where[f.key]
+            out[y : y + h, x : x + w] = t
+            f.release()
         out.flush()
+        del out
     elif path.endswith(".zarr"):
+        # Each worker writes its own chunks (the store must be reachable
+        # from every worker: a shared file system or an object store URL).
         heights.to_zarr(path, overwrite=True)
     else:
         terrasynth.write_heightfield(path, heights.compute(), cell, local_georef(world, cell))
@@ -127,7 +139,7 @@ def main(argv: Optional[Sequence[str]] = None, client=None) -> int:
     try:
         heights, windows = world_array(a.world, a.tile, a.seed, a.db)
         with client.as_current():
-            write(heights, a.output, a.world, cell)
+            write(client, heights, a.output, a.world, a.tile, a.seed, a.db, cell)
         print(
             f"wrote {a.output}: {a.world[0]}x{a.world[1]} in {len(windows)} tiles of "
             f"{a.tile[0]}x{a.tile[1]} on {len(client.scheduler_info()['workers'])} workers",
