@@ -376,6 +376,9 @@ fn georef_from(d: &Bound<'_, PyDict>) -> PyResult<Georef> {
     })
 }
 
+/// `read_heightfield`'s (heights, cell size, georeference).
+type ReadResult<'py> = (Bound<'py, PyArray2<f32>>, f64, Option<Bound<'py, PyDict>>);
+
 /// Reads a heightfield file (GeoTIFF, EXR, PNG16, R16/RAW with sidecar,
 /// ESRI ASCII, SRTM .hgt, Terragen .ter; the format from the extension).
 ///
@@ -387,10 +390,7 @@ fn georef_from(d: &Bound<'_, PyDict>) -> PyResult<Georef> {
 /// ``wkt``, ``name``, ``units``, ``metres_per_unit``, ``vertical_epsg``),
 /// or None when the file places the grid nowhere.
 #[pyfunction]
-fn read_heightfield<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-) -> PyResult<(Bound<'py, PyArray2<f32>>, f64, Option<Bound<'py, PyDict>>)> {
+fn read_heightfield<'py>(py: Python<'py>, path: PathBuf) -> PyResult<ReadResult<'py>> {
     let hf = py
         .allow_threads(|| io::read(&path, &ReadOptions::default()))
         .map_err(err)?;

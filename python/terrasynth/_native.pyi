@@ -26,7 +26,8 @@ class Database:
     def open(path: _Path) -> "Database":
         """Opens a .tsdb file (from `terrasynth db build`)."""
     @property
-    def path(self) -> Optional[str]: ...
+    def path(self) -> Optional["os.PathLike[str]"]:
+        """The file it was opened from (a pathlib.Path); None for default()."""
     @property
     def exemplars(self) -> List[str]: ...
     @property
