@@ -125,6 +125,41 @@ pub fn load_database(
 }
 
 /// `--backend`: where the synthesis stages run.
+/// The synthesis parameters `synth` and `tiles` share (one definition, so
+/// the two commands cannot drift apart in flags, defaults or help).
+#[derive(ClapArgs, Debug, Clone)]
+pub struct SynthesisArgs {
+    /// Jitter amplitude r in texels (paper default 0.4; 0 reproduces the exemplar).
+    #[arg(long, default_value_t = 0.4)]
+    pub jitter: f64,
+    /// Correction passes per level.
+    #[arg(long, default_value_t = 2)]
+    pub passes: u32,
+    /// Exemplar (index) the synthesis starts from: its blocks make the
+    /// coarse structure and the output takes its cell size. Default: blocks
+    /// from every exemplar by area, exemplar 0's cell size.
+    #[arg(long)]
+    pub start_exemplar: Option<usize>,
+    /// Height prior P of the correction: 0 (the paper's pure relative
+    /// height matching), 1, 2, 4 or 8. Higher keeps candidates nearer the
+    /// altitude the coarser level chose (more relief, less drift).
+    #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
+    pub height_prior: u32,
+}
+
+impl SynthesisArgs {
+    /// The engine's parameters; `keep_levels` when the level maps are wanted.
+    pub fn params(&self, keep_levels: bool) -> terrasynth::synth::Params {
+        terrasynth::synth::Params {
+            jitter: self.jitter,
+            passes: self.passes,
+            start_exemplar: self.start_exemplar,
+            prior: self.height_prior,
+            keep_levels,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
 pub enum BackendArg {
     /// The rayon + SIMD stages (the reference).

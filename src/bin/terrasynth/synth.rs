@@ -2,15 +2,15 @@
 
 use crate::CliResult;
 use crate::args::{
-    BackendArg, EngineArg, load_database, parse_window, parse_world_size, select_backend,
-    write_output,
+    BackendArg, EngineArg, SynthesisArgs, load_database, parse_window, parse_world_size,
+    select_backend, write_output,
 };
 use std::path::{Path, PathBuf};
 use terrasynth::database::Database;
 use terrasynth::io::{self, CoordsMap};
 use terrasynth::render::{self, RenderOptions};
+use terrasynth::synth::Synthesizer;
 use terrasynth::synth::source_map::source_map;
-use terrasynth::synth::{Params, Synthesizer};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -46,22 +46,8 @@ pub struct Args {
     /// green = y within the exemplar, blue = which exemplar; paper Fig. 3).
     #[arg(long)]
     coords_preview: Option<PathBuf>,
-    /// Jitter amplitude r in texels (paper default 0.4; 0 reproduces the exemplar).
-    #[arg(long, default_value_t = 0.4)]
-    jitter: f64,
-    /// Correction passes per level.
-    #[arg(long, default_value_t = 2)]
-    passes: u32,
-    /// Exemplar (index) the synthesis starts from: its blocks make the
-    /// coarse structure and the output takes its cell size. Default: blocks
-    /// from every exemplar by area, exemplar 0's cell size.
-    #[arg(long)]
-    start_exemplar: Option<usize>,
-    /// Height prior P of the correction: 0 (the paper's pure relative
-    /// height matching), 1, 2, 4 or 8. Higher keeps candidates nearer the
-    /// altitude the coarser level chose (more relief, less drift).
-    #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
-    height_prior: u32,
+    #[command(flatten)]
+    synthesis: SynthesisArgs,
     /// Where the stages run: cpu, gpu (WGSL on Vulkan; `--features gpu`
     /// builds) or auto (the GPU if there is one). Same output bytes on each.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -141,13 +127,9 @@ pub fn run(a: Args) -> CliResult {
         check_synthesis_memory(w, h, 1.0)?;
     }
     let db = load_database(a.db.as_deref())?;
-    let params = Params {
-        jitter: a.jitter,
-        passes: a.passes,
-        start_exemplar: a.start_exemplar,
-        prior: a.height_prior,
-        keep_levels: a.coords.is_some() || a.coords_preview.is_some(),
-    };
+    let params = a
+        .synthesis
+        .params(a.coords.is_some() || a.coords_preview.is_some());
     let mut synth = Synthesizer::new(&db, params)?;
     select_backend(&mut synth, a.backend)?;
     let (result, what) = match a.window {

@@ -2,13 +2,13 @@
 //! and a GDAL mosaic (see `terrasynth::tiles`).
 
 use crate::CliResult;
-use crate::args::{BackendArg, load_database, parse_world_size, select_backend};
+use crate::args::{BackendArg, SynthesisArgs, load_database, parse_world_size, select_backend};
 use std::path::PathBuf;
 use std::time::Instant;
 use terrasynth::io::{self, Format};
 use terrasynth::scene::{Scene, WindowedScene};
+use terrasynth::synth::Synthesizer;
 use terrasynth::synth::cone::Rect;
-use terrasynth::synth::{Params, Synthesizer};
 use terrasynth::tiles::{self, Tiling, grid::Grid};
 
 #[derive(clap::Args)]
@@ -47,18 +47,8 @@ pub struct Args {
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     seed: u32,
-    /// Jitter amplitude r in texels.
-    #[arg(long, default_value_t = 0.4)]
-    jitter: f64,
-    /// Correction passes per level.
-    #[arg(long, default_value_t = 2)]
-    passes: u32,
-    /// Exemplar (index) the synthesis starts from (see `synth --help`).
-    #[arg(long)]
-    start_exemplar: Option<usize>,
-    /// Height prior P of the correction: 0, 1, 2, 4 or 8.
-    #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
-    height_prior: u32,
+    #[command(flatten)]
+    synthesis: SynthesisArgs,
     /// Where the stages run: cpu, gpu or auto. Same tiles on each.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     backend: BackendArg,
@@ -123,13 +113,7 @@ pub fn run(a: Args) -> CliResult {
             (World::Scene(Box::new(ws)), params)
         }
         None => {
-            let params = Params {
-                jitter: a.jitter,
-                passes: a.passes,
-                start_exemplar: a.start_exemplar,
-                prior: a.height_prior,
-                keep_levels: false,
-            };
+            let params = a.synthesis.params(false);
             let size = a.size.expect("clap requires --size without --scene");
             (World::Plain { size, seed: a.seed }, params)
         }
