@@ -62,47 +62,71 @@ fn mean_around(hf: &Heightfield, x: usize, y: usize, r: usize) -> f64 {
 
 #[test]
 fn point_constraint_sets_height_and_slope() {
+    // Two sites (one raised, one lowered, slopes facing +x / +y) on five
+    // terrains: a single site's error depends on what the terrain is there
+    // — a target above the exemplars' highest peak is the hard case (3.0–
+    // 3.1 % on the two such sites here; the others 0.2–1.9 %) — which every
+    // engine change moves, so the bound is on the mean of ten sites, with
+    // a looser one on the worst. Measured: mean 1.27 % before synthesis
+    // started at level 3 (its terrains never reached those peaks), 1.16 %
+    // after; with the paper's point tolerance s = ½ at level 3, 2.3 %.
     let Some(db) = db() else { return };
-    let mut s = session(db);
-    let base = s.apply(vec![]).unwrap().heightfield;
     let rel = relief(db);
-    let cell = s.synthesizer().cell_size_m();
-    let mut worst: f64 = 0.0;
-    // Raise one site and lower another, each with a slope facing +x / +y.
-    for (k, (x, y, dir, lift)) in [
-        (80.0, 90.0, 0.0, 0.25),
-        (170.0, 160.0, std::f64::consts::FRAC_PI_2, -0.2),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let h = at(&base, x, y) + lift * rel;
-        let p = PointConstraint::new((x, y), h, dir, 20f64.to_radians(), 40.0, cell).unwrap();
-        let out = s
-            .apply(vec![Edit::SetConstraint(
-                ConstraintId(k as u64),
-                Arc::new(p),
-            )])
-            .unwrap();
-        let hf = &out.heightfield;
-        let err = (at(hf, x, y) - h).abs() / rel;
-        worst = worst.max(err);
-        // Slope: the terrain descends along the direction across the site.
-        let (dx, dy) = (dir.cos(), dir.sin());
-        let o = 12.0;
-        let up = mean_around(hf, (x - o * dx) as usize, (y - o * dy) as usize, 2);
-        let down = mean_around(hf, (x + o * dx) as usize, (y + o * dy) as usize, 2);
-        println!(
-            "point {k}: target {h:.1} m, got {:.1} m (error {:.2}% of relief {rel:.0} m); uphill {up:.1} m, downhill {down:.1} m (plane: {:.1} m apart)",
-            at(hf, x, y),
-            err * 100.0,
-            2.0 * o * cell * 20f64.to_radians().tan()
-        );
-        assert!(up > down, "point {k}: no descent along the slope direction");
+    let mut errors = Vec::new();
+    for seed in 7..12 {
+        let mut s = Session::new(db, Params::default(), N, N, seed).unwrap();
+        let base = s.apply(vec![]).unwrap().heightfield;
+        let cell = s.synthesizer().cell_size_m();
+        for (k, (x, y, dir, lift)) in [
+            (80.0, 90.0, 0.0, 0.25),
+            (170.0, 160.0, std::f64::consts::FRAC_PI_2, -0.2),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let h = at(&base, x, y) + lift * rel;
+            let p = PointConstraint::new((x, y), h, dir, 20f64.to_radians(), 40.0, cell).unwrap();
+            let out = s
+                .apply(vec![Edit::SetConstraint(
+                    ConstraintId(k as u64),
+                    Arc::new(p),
+                )])
+                .unwrap();
+            let hf = &out.heightfield;
+            let err = (at(hf, x, y) - h).abs() / rel;
+            errors.push(err);
+            // Slope: the terrain descends along the direction across the site.
+            let (dx, dy) = (dir.cos(), dir.sin());
+            let o = 12.0;
+            let up = mean_around(hf, (x - o * dx) as usize, (y - o * dy) as usize, 2);
+            let down = mean_around(hf, (x + o * dx) as usize, (y + o * dy) as usize, 2);
+            println!(
+                "seed {seed} point {k}: target {h:.1} m, got {:.1} m (error {:.2}% of relief {rel:.0} m); uphill {up:.1} m, downhill {down:.1} m (plane: {:.1} m apart)",
+                at(hf, x, y),
+                err * 100.0,
+                2.0 * o * cell * 20f64.to_radians().tan()
+            );
+            assert!(
+                up > down,
+                "seed {seed} point {k}: no descent along the slope direction"
+            );
+        }
     }
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let worst = errors.iter().cloned().fold(0.0, f64::max);
+    println!(
+        "site errors: mean {:.2}%, worst {:.2}% of relief",
+        mean * 100.0,
+        worst * 100.0
+    );
     assert!(
-        worst <= 0.02,
-        "site height off by {:.2}% of relief",
+        mean <= 0.015,
+        "site heights off by {:.2}% of relief on average",
+        mean * 100.0
+    );
+    assert!(
+        worst <= 0.035,
+        "a site height off by {:.2}% of relief",
         worst * 100.0
     );
 }

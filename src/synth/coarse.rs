@@ -41,6 +41,22 @@ use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::stages::upsample_jitter;
 use crate::synth::state::{State, level_size};
 
+/// The coarsest level synthesis starts from (and corrects), whatever
+/// coarser levels the database holds.
+///
+/// Why not the database's coarsest level L: synthesis coordinates stay
+/// [`MARGIN`] texels inside every exemplar at every level, and a level-L
+/// texel is 2^L pixels across — at L = 5 (the shared DEMs) the outer 64
+/// pixels of every exemplar side, 20–29 % of its area, were never drawn
+/// (measured from `--coords`: 0.0–0.5 % of the output from the outer 64
+/// columns of franconian_jura, 8 % of its area), and that is where those
+/// DEMs keep their lowest valleys and highest ridges: the output kept
+/// 76–85 % of their relief. Starting at level 3 loses 16 pixels a side;
+/// the blocks keep their size in pixels (b grows as the level falls).
+/// Level 2 left too few levels to join the blocks: straight seams showed
+/// along block edges (looked at on thuringia).
+pub const MAX_START_LEVEL: usize = 3;
+
 /// Hash salt of the block positions (kept apart from the jitter's
 /// `hash4(seed, level, x, y)`, whose level is always < 2^16).
 const COARSE_SALT: u32 = 0xC0A5_0000;
@@ -113,23 +129,28 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
 }
 
 /// Level L of an output over `region` (absolute level-L pixels: the whole
-/// level, or a window's cone): the level-`L + bits` pixel above
-/// each 2^bits × 2^bits group of pixels picks one exemplar texel (`hash`
-/// of the seed and the group's position) uniformly over every interior
-/// texel of exemplar `from` (or of every exemplar); the group copies the
-/// exemplar from that origin, wrapping toroidally inside the exemplar's
-/// interior, and each pixel gets the level's jitter (`jitter`, fixed point,
-/// the same hash as `upsample_jitter`).
+/// level, or a window's cone): each pixel belongs to the 2^bits × 2^bits
+/// block under its [`warp`]ed position; each block picks one exemplar
+/// texel ([`block_draw`]: a hash of the seed and the block's position)
+/// uniformly over every interior texel of exemplar `from` (or of every
+/// exemplar), and its pixels copy the exemplar around that texel, mirrored
+/// at the interior's edges; each pixel gets the level's jitter (`jitter`,
+/// fixed point, the same hash as `upsample_jitter`).
 ///
-/// Why wrap: blocks that must fit the interior start only at the first
-/// `side − 2^bits + 1` texels of each axis, so a texel near an exemplar edge
-/// is covered by one origin where a central one is covered by 2^bits —
-/// measured on the shared DEMs (blocks of 32 in a 43-texel interior), the
-/// output drew 12× more from the exemplar's centre than from its edges,
-/// and real DEMs are not alike across their extent (thuringia: median slope
-/// 6.2° in its centre, 5.0° over all). Wrapping covers every interior texel
-/// equally; the wrap line is one more join, which correction repairs like
-/// the joins between blocks.
+/// Why centred and mirrored: blocks that must fit the interior start only
+/// at the first `side − 2^bits + 1` texels of each axis, so a texel near an
+/// exemplar edge is covered by one origin where a central one is covered by
+/// 2^bits — measured on the shared DEMs (blocks of 32 in a 43-texel
+/// interior), the output drew 12× more from the exemplar's centre than from
+/// its edges, and real DEMs are not alike across their extent (thuringia:
+/// median slope 6.2° in its centre, 5.0° over all). A block centred on a
+/// uniform texel and mirrored at the edges covers every interior texel
+/// equally (2^bits + 1 times near an edge, 2^bits inside), like the
+/// toroidal wrap this replaced, but the wrap put the exemplar's far side
+/// next to its near side along a straight line — on the coastal DEMs a
+/// straight coast 64 texels long wherever a block wrapped from sea to
+/// mountains. A mirror line keeps heights continuous; what shows is a
+/// symmetric landform, which correction and jitter then break up.
 pub fn blocks(
     a: &AtlasLevel<'_>,
     from: Option<usize>,
@@ -138,7 +159,6 @@ pub fn blocks(
     seed: u32,
     jitter: i32,
 ) -> State {
-    let mask = (1usize << bits) - 1;
     // Interior origin and size (x0, y0, nx, ny) per exemplar.
     let ranges: Vec<(i32, i32, i32, i32)> = interiors(a, from)
         .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
@@ -148,19 +168,27 @@ pub fn blocks(
     let st = State::new(w, h);
     for (i, y) in (region.y0..region.y1).enumerate() {
         for (j, x) in (region.x0..region.x1).enumerate() {
-            let hash = hash4(seed, COARSE_SALT, (x >> bits) as u32, (y >> bits) as u32);
-            let mut k = below(hash, total);
+            let (x, y) = (x as i32, y as i32);
+            // The block this pixel belongs to: the one under its warped
+            // position; it copies that block's exemplar from its own place
+            // relative to the block's corner.
+            let (wx, wy) = warp(seed, x, y, bits);
+            let (bx, by) = ((x + wx) >> bits, (y + wy) >> bits);
+            let mut k = block_draw(seed, bx as u32, by as u32, total);
             for &(x0, y0, nx, ny) in &ranges {
                 let n = (nx * ny) as u32;
                 if k < n {
-                    let (bx, by) = ((k % nx as u32) as i32, (k / nx as u32) as i32);
-                    let lx = bx + (x & mask) as i32;
-                    let ly = by + (y & mask) as i32;
+                    // The block is centred on its origin texel and
+                    // mirrored at the interior's edges (see below).
+                    let (ox, oy) = ((k % nx as u32) as i32, (k / nx as u32) as i32);
+                    let half = 1 << (bits - 1);
+                    let lx = mirror(ox - half + x - (bx << bits), nx);
+                    let ly = mirror(oy - half + y - (by << bits), ny);
                     let (jx, jy) =
                         upsample_jitter::jitter(seed, l as u32, x as u32, y as u32, jitter);
                     let s = Coord {
-                        x: wrap_centred(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
-                        y: wrap_centred(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
+                        x: inside(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
+                        y: inside(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
                     };
                     st.set(i * w + j, s, 0);
                     break;
@@ -172,12 +200,84 @@ pub fn blocks(
     st
 }
 
-/// Wraps fixed-point `v` into `[min − ½, min + n − ½)` texels, so that it
-/// rounds (half up) to one of the `n` texels from `min`.
-fn wrap_centred(v: i32, min: i32, n: i32) -> i32 {
+/// The interior texel (an index below `total`, over every exemplar's
+/// interior in turn) that block `(bx, by)` starts from: stratified over each
+/// aligned 2 × 2 group of blocks, whose four blocks draw one from each
+/// quarter of `0..total` in a hashed order, uniformly inside it.
+///
+/// Why stratify: an output holds few blocks (four at 1024² from the shared
+/// DEMs), and independent draws made its make-up a lottery — measured on
+/// the 8-DEM typed database at 1024², 43 % of one seed's output came from
+/// the north German plain (10 % of the exemplars), "flat" took 20–44 % of
+/// the output where it is 18 % of the exemplars. Quarters of the area
+/// spread each group over the exemplars (and over the rows of one
+/// exemplar), while groups stay independent, so like still meets like
+/// across group borders. A pure function of the seed and the block's
+/// position, as every choice of the start (windows need no neighbours).
+fn block_draw(seed: u32, bx: u32, by: u32, total: u32) -> u32 {
+    let group = hash4(seed, COARSE_SALT | 1, bx >> 1, by >> 1);
+    // The group's order of quarters: each slot's rank among four hashed
+    // bytes (ties by slot), so every order of the quarters can occur.
+    let key = |slot: u32| ((group >> (8 * slot)) & 0xFF, slot);
+    let slot = (bx & 1) | (by & 1) << 1;
+    let quarter = (0..4).filter(|&t| key(t) < key(slot)).count() as u64;
+    let within = below(hash4(seed, COARSE_SALT, bx, by), total);
+    ((quarter * u64::from(total) + u64::from(within)) / 4) as u32
+}
+
+/// How far pixel (x, y) of level L looks for its block: two octaves of
+/// value noise (lattices of 2^(bits−1) and 2^(bits−2) texels, amplitudes
+/// 2^(bits−2) and 2^(bits−3)), in level-L texels, x and y apart.
+///
+/// Why: square blocks left their edges in the output wherever unlike
+/// blocks met — straight coastlines where a land block met a sea block,
+/// a massif cut off along a grid line — because correction joins blocks
+/// only over a few texels of each level. Warped edges wander like the
+/// borders of real landforms; within a block the copy stays verbatim.
+/// No warp for blocks under 8 texels (nothing to wander in).
+fn warp(seed: u32, x: i32, y: i32, bits: usize) -> (i32, i32) {
+    if bits < 3 {
+        return (0, 0);
+    }
+    let octave = |salt: u32, g: usize, a: usize| {
+        (value_noise(seed, COARSE_SALT | salt, x, y, g) * (1 << a)) >> 15
+    };
+    (
+        octave(2, bits - 1, bits - 2) + octave(3, bits - 2, bits - 3),
+        octave(4, bits - 1, bits - 2) + octave(5, bits - 2, bits - 3),
+    )
+}
+
+/// Value noise in `[−2^15, 2^15)` at (x, y): hashed values on a lattice of
+/// 2^g texels, interpolated bilinearly in integers.
+fn value_noise(seed: u32, salt: u32, x: i32, y: i32, g: usize) -> i32 {
+    let (cx, cy, fx, fy) = (x >> g, y >> g, x & ((1 << g) - 1), y & ((1 << g) - 1));
+    let v = |dx: i32, dy: i32| {
+        let h = hash4(seed, salt, (cx + dx) as u32, (cy + dy) as u32);
+        i64::from((h >> 16) as i32 - (1 << 15))
+    };
+    let (fx, fy, n) = (i64::from(fx), i64::from(fy), 1i64 << g);
+    let top = v(0, 0) * (n - fx) + v(1, 0) * fx;
+    let bottom = v(0, 1) * (n - fx) + v(1, 1) * fx;
+    ((top * (n - fy) + bottom * fy) >> (2 * g)) as i32
+}
+
+/// Texel `t` of an axis of `n` interior texels, mirrored at both ends
+/// (…, 1, 0 | 0, 1, …, n − 1 | n − 1, n − 2, …).
+fn mirror(t: i32, n: i32) -> i32 {
+    let r = t.rem_euclid(2 * n);
+    if r < n { r } else { 2 * n - 1 - r }
+}
+
+/// Fixed-point `v` clamped to `[min − ½, min + n − ½)` texels, so that it
+/// rounds (half up) to one of the `n` interior texels from `min` (jitter may
+/// carry a mirrored edge texel half a texel out).
+fn inside(v: i32, min: i32, n: i32) -> i32 {
     let half = 1 << (FRAC_BITS - 1);
-    let base = (min << FRAC_BITS) - half;
-    base + (v - base).rem_euclid(n << FRAC_BITS)
+    v.clamp(
+        (min << FRAC_BITS) - half,
+        ((min + n) << FRAC_BITS) - half - 1,
+    )
 }
 
 /// Level `top` of a `width × height` output without blocks, over `region`

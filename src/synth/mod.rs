@@ -170,9 +170,10 @@ impl<'db> Synthesizer<'db> {
         &self.params
     }
 
-    /// The coarsest database level L.
-    fn coarsest(&self) -> usize {
-        self.db.level_count() - 1
+    /// The coarsest level L synthesis corrects: the database's coarsest,
+    /// at most [`coarse::MAX_START_LEVEL`].
+    pub(crate) fn coarsest(&self) -> usize {
+        (self.db.level_count() - 1).min(coarse::MAX_START_LEVEL)
     }
 
     /// Synthesizes a `width × height` heightfield.

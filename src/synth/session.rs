@@ -127,7 +127,7 @@ impl<'db> Session<'db> {
     ) -> Result<Session<'db>, SessionError> {
         crate::size::check_dims(width, height).map_err(SynthError::from)?;
         let synth = Synthesizer::new(db, params)?;
-        let last = (db.level_count() - 1).min(top_level(width, height));
+        let last = synth.coarsest().min(top_level(width, height));
         let pasted = (0..=last)
             .map(|i| {
                 let (w, h) = level_size(width, height, i);

@@ -65,7 +65,7 @@ impl Synthesizer<'_> {
     ) -> Result<Heightfield, SynthError> {
         check_window(world, window)?;
         let db = self.database();
-        let last = (db.level_count() - 1).min(top_level(world.0, world.1));
+        let last = self.coarsest().min(top_level(world.0, world.1));
         let cone = self.cone(world, window, &[]);
         let pastes: Vec<PasteGeometry> = c
             .pastes
