@@ -8,7 +8,7 @@
 //! Down-sampling is a 2×2 box mean and up-sampling bilinear; any size works
 //! (odd sides are handled by clamping).
 
-use super::{BlendError, check};
+use super::Inputs;
 
 fn down(w: usize, h: usize, v: &[f32]) -> (usize, usize, Vec<f32>) {
     let (cw, ch) = (w.div_ceil(2), h.div_ceil(2));
@@ -46,21 +46,14 @@ fn up(cw: usize, ch: usize, v: &[f32], w: usize, h: usize) -> Vec<f32> {
 
 /// Blends `src` into `dst` in place over `levels` pyramid levels (at least 1;
 /// levels beyond the 1×1 top are ignored).
-pub fn blend(
-    width: usize,
-    height: usize,
-    dst: &mut [f32],
-    src: &[f32],
-    mask: &[f32],
-    levels: usize,
-    band_gain: Option<&[f32]>,
-) -> Result<(), BlendError> {
-    check(
+pub fn blend(inputs: Inputs<'_>, levels: usize, band_gain: Option<&[f32]>) {
+    let Inputs {
         width,
         height,
-        &[("destination", dst.len()), ("source", src.len())],
+        dst,
+        src,
         mask,
-    )?;
+    } = inputs;
     // Gaussian pyramids of all three.
     let mut g_d = vec![(width, height, dst.to_vec())];
     let mut g_s = vec![(width, height, src.to_vec())];
@@ -100,7 +93,6 @@ pub fn blend(
         (cw, ch) = (w, h);
     }
     dst.copy_from_slice(&acc);
-    Ok(())
 }
 
 #[cfg(test)]
@@ -113,10 +105,18 @@ mod tests {
         let d: Vec<f32> = (0..w * h).map(|i| ((i * 7) % 13) as f32).collect();
         let s: Vec<f32> = (0..w * h).map(|i| ((i * 5) % 11) as f32 * 3.0).collect();
         let mut out = d.clone();
-        blend(w, h, &mut out, &s, &vec![0.0; w * h], 5, None).unwrap();
+        blend(
+            Inputs::new(w, h, &mut out, &s, &vec![0.0; w * h]).unwrap(),
+            5,
+            None,
+        );
         assert!(out.iter().zip(&d).all(|(a, b)| (a - b).abs() < 1e-3));
         let mut out = d.clone();
-        blend(w, h, &mut out, &s, &vec![1.0; w * h], 5, None).unwrap();
+        blend(
+            Inputs::new(w, h, &mut out, &s, &vec![1.0; w * h]).unwrap(),
+            5,
+            None,
+        );
         assert!(out.iter().zip(&s).all(|(a, b)| (a - b).abs() < 1e-3));
     }
 
@@ -128,7 +128,8 @@ mod tests {
             .map(|i| if i % w < 32 { 1.0 } else { 0.0 })
             .collect();
         let mut out = vec![0.0f32; w * h];
-        blend(w, h, &mut out, &vec![100.0; w * h], &mask, 6, None).unwrap();
+        let src = vec![100.0; w * h];
+        blend(Inputs::new(w, h, &mut out, &src, &mask).unwrap(), 6, None);
         let row = &out[..w];
         let max_step = row
             .windows(2)
