@@ -9,6 +9,7 @@
 //! (odd sides are handled by clamping).
 
 use super::Inputs;
+use crate::resample::bilinear;
 
 fn down(w: usize, h: usize, v: &[f32]) -> (usize, usize, Vec<f32>) {
     let (cw, ch) = (w.div_ceil(2), h.div_ceil(2));
@@ -29,16 +30,9 @@ fn down(w: usize, h: usize, v: &[f32]) -> (usize, usize, Vec<f32>) {
 fn up(cw: usize, ch: usize, v: &[f32], w: usize, h: usize) -> Vec<f32> {
     let mut out = vec![0.0f32; w * h];
     for y in 0..h {
-        let gy = ((y as f32 + 0.5) / 2.0 - 0.5).clamp(0.0, (ch - 1) as f32);
-        let y0 = gy.floor() as usize;
-        let (y1, ty) = ((y0 + 1).min(ch - 1), gy - y0 as f32);
         for x in 0..w {
-            let gx = ((x as f32 + 0.5) / 2.0 - 0.5).clamp(0.0, (cw - 1) as f32);
-            let x0 = gx.floor() as usize;
-            let (x1, tx) = ((x0 + 1).min(cw - 1), gx - x0 as f32);
-            let a = v[y0 * cw + x0] * (1.0 - tx) + v[y0 * cw + x1] * tx;
-            let b = v[y1 * cw + x0] * (1.0 - tx) + v[y1 * cw + x1] * tx;
-            out[y * w + x] = a * (1.0 - ty) + b * ty;
+            let p = [(x as f32 + 0.5) / 2.0, (y as f32 + 0.5) / 2.0];
+            out[y * w + x] = bilinear(v, cw, ch, p);
         }
     }
     out

@@ -5,6 +5,7 @@
 
 use super::pcg::cg;
 use super::{PoissonError, SolveOptions, SolveReport, check_inputs};
+use crate::resample::bilinear;
 use rayon::prelude::*;
 
 /// Solves in place. `u` holds the boundary values at fixed pixels (read) and
@@ -100,20 +101,15 @@ fn cascadic_start(width: usize, height: usize, x: &mut [f64], fixed: &[bool], f:
     };
     cg(cw, ch, &mut cx, &cfixed, &cf, &coarse_opts);
     // Bilinear prolongation of the coarse solution onto free fine pixels.
-    let sample = |fx: f64, fy: f64| -> f64 {
-        let gx = (fx - 0.5).clamp(0.0, (cw - 1) as f64);
-        let gy = (fy - 0.5).clamp(0.0, (ch - 1) as f64);
-        let (x0, y0) = (gx.floor() as usize, gy.floor() as usize);
-        let (x1, y1) = ((x0 + 1).min(cw - 1), (y0 + 1).min(ch - 1));
-        let (tx, ty) = (gx - x0 as f64, gy - y0 as f64);
-        let a = cx[y0 * cw + x0] * (1.0 - tx) + cx[y0 * cw + x1] * tx;
-        let b = cx[y1 * cw + x0] * (1.0 - tx) + cx[y1 * cw + x1] * tx;
-        a * (1.0 - ty) + b * ty
-    };
     x.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
         for (xi, v) in row.iter_mut().enumerate() {
             if !fixed[y * width + xi] {
-                *v = sample((xi as f64 + 0.5) / 2.0, (y as f64 + 0.5) / 2.0);
+                *v = bilinear(
+                    &cx,
+                    cw,
+                    ch,
+                    [(xi as f64 + 0.5) / 2.0, (y as f64 + 0.5) / 2.0],
+                );
             }
         }
     });
