@@ -101,7 +101,10 @@ mod tests {
     fn windows_must_be_inside_and_not_empty() {
         assert_eq!(check_window(2, 3, 5, 5, 7, 8), Ok(()));
         let e = check_window(3, 4, 5, 6, 7, 8).unwrap_err();
-        assert_eq!(e.to_string(), "window 5x6 at (3, 4) does not fit a 7x8 grid");
+        assert_eq!(
+            e.to_string(),
+            "window 5x6 at (3, 4) does not fit a 7x8 grid"
+        );
         assert!(check_window(0, 0, 0, 1, 7, 8).is_err());
     }
 }
