@@ -11,7 +11,7 @@
 //! the Euler–Lagrange equation of `min Σ_edges (u_n − u_p − g(p→n))²`.
 
 use super::{BlendError, Inputs, check_lengths};
-use crate::poisson::{SolveOptions, SolveReport, solve};
+use crate::poisson::{Method, SolveOptions, SolveReport, solve};
 
 /// Solves for `u` on the pixels where `free` is set, keeping the others as
 /// Dirichlet values, so that the differences of `u` best match the guidance.
@@ -36,7 +36,15 @@ pub fn solve_guided(
     )?;
     let rhs = guided_rhs(width, height, gx, gy);
     let fixed: Vec<bool> = free.iter().map(|f| !f).collect();
-    Ok(solve(width, height, u, &fixed, Some(&rhs), opts)?)
+    Ok(solve(
+        Method::Cascadic,
+        width,
+        height,
+        u,
+        &fixed,
+        Some(&rhs),
+        opts,
+    )?)
 }
 
 /// The right-hand side `f` of the solve for guidance `gx`, `gy` (both of

@@ -1,34 +1,29 @@
-//! [`solve`], the solver for large grids (whole-DEM nodata filling,
-//! blending): a cascadic start, each level solved on a 2x coarser grid
-//! first and interpolated up as the initial guess, then the parallel
+//! [`Method::Cascadic`], the solver for large grids (whole-DEM nodata
+//! filling, blending): a cascadic start, each level solved on a 2x coarser
+//! grid first and interpolated up as the initial guess, then the parallel
 //! Jacobi-preconditioned CG of `pcg` on the finest level.
+//!
+//! [`Method::Cascadic`]: super::Method::Cascadic
 
 use super::pcg::cg;
-use super::{PoissonError, SolveOptions, SolveReport, check_inputs};
+use super::{Problem, SolveOptions, SolveReport};
 use crate::resample::bilinear;
 use rayon::prelude::*;
 
-/// Solves in place. `u` holds the boundary values at fixed pixels (read) and
-/// the initial guess at free pixels (ignored: the cascadic start replaces it);
-/// on return the free pixels hold the solution. `rhs` is `f` (zero if `None`).
-pub fn solve(
-    width: usize,
-    height: usize,
-    u: &mut [f32],
-    fixed: &[bool],
-    rhs: Option<&[f32]>,
-    opts: &SolveOptions,
-) -> Result<SolveReport, PoissonError> {
-    check_inputs(width, height, u, fixed, rhs)?;
+/// Solves a checked problem in place; the initial guess at free pixels is
+/// ignored (the cascadic start replaces it).
+pub(super) fn solve(problem: Problem<'_>, opts: &SolveOptions) -> SolveReport {
+    let (width, height, fixed, rhs) = (problem.width, problem.height, problem.fixed, problem.rhs);
+    let u = problem.u;
     let n = width * height;
     let unknowns = fixed.iter().filter(|&&f| !f).count();
     if unknowns == 0 {
-        return Ok(SolveReport {
+        return SolveReport {
             unknowns,
             iterations: 0,
             relative_residual: 0.0,
             converged: true,
-        });
+        };
     }
     let mut x: Vec<f64> = u
         .iter()
@@ -45,7 +40,7 @@ pub fn solve(
             u[i] = x[i] as f32;
         }
     }
-    Ok(report)
+    report
 }
 
 /// Solves a 2× coarser problem (recursively) and interpolates it into the
