@@ -44,7 +44,7 @@ impl Backend for Gpu {
     }
 
     fn correct(&self, st: &GpuState, parent: Option<&GpuState>, level: usize, p: &CorrectParams) {
-        self.dispatch_correct(st, parent, level, p)
+        self.dispatch_correct(st, parent, level, p, None)
     }
 
     fn upload_guide(
@@ -64,7 +64,7 @@ impl Backend for Gpu {
         p: &CorrectParams,
         g: &GpuGuide,
     ) {
-        self.dispatch_correct_guided(st, parent, level, p, g)
+        self.dispatch_correct(st, parent, level, p, Some(g))
     }
 
     fn reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
