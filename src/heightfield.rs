@@ -205,17 +205,7 @@ impl Heightfield {
     }
 
     fn check_window(&self, x: usize, y: usize, w: usize, h: usize) -> Result<(), SizeError> {
-        if w == 0 || h == 0 || x + w > self.width || y + h > self.height {
-            return Err(SizeError::Window {
-                x,
-                y,
-                w,
-                h,
-                width: self.width,
-                height: self.height,
-            });
-        }
-        Ok(())
+        crate::size::check_window(x, y, w, h, self.width, self.height)
     }
 }
 

@@ -20,6 +20,7 @@ pub mod io;
 pub mod level;
 pub mod masks;
 pub mod nodata;
+pub mod order;
 pub mod patch;
 pub mod poisson;
 pub mod procedural;

@@ -6,7 +6,7 @@
 //! no detail that was not measured — synthesis, not the filler, adds detail.
 
 use crate::heightfield::Heightfield;
-use crate::poisson::{self, PoissonError, SolveOptions};
+use crate::poisson::{self, Method, PoissonError, SolveOptions};
 
 /// What a fill did.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,7 +33,7 @@ pub fn fill_nodata(hf: &mut Heightfield) -> Result<FillReport, PoissonError> {
         tolerance: 1e-7,
         ..SolveOptions::default()
     };
-    let rep = poisson::solve(w, h, hf.data_mut(), &fixed, None, &opts)?;
+    let rep = poisson::solve(Method::Cascadic, w, h, hf.data_mut(), &fixed, None, &opts)?;
     Ok(FillReport {
         filled,
         relative_residual: rep.relative_residual,

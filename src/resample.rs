@@ -3,10 +3,15 @@
 //! an area-weighted average when reducing (so shrinking never aliases ridges
 //! into stair-steps). Nodata samples carry no weight; an output sample whose
 //! whole support is nodata stays nodata.
+//!
+//! Also [`bilinear`], the one point sampler of plain grids that the patch
+//! engine's feature profiles, the Poisson solver's prolongation and the
+//! Laplacian blend's upsampling share.
 
 use crate::heightfield::Heightfield;
 use crate::size::SizeError;
 use rayon::prelude::*;
+use std::ops::{Add, Mul, Sub};
 
 /// Weights of one output sample along one axis: (first source index, weights).
 fn taps(src: usize, dst: usize) -> Vec<(usize, Vec<f32>)> {
@@ -62,6 +67,55 @@ pub fn resample(hf: &Heightfield, width: usize, height: usize) -> Result<Heightf
             }
         });
     Ok(out)
+}
+
+/// The float types [`bilinear`] samples: `f32` grids (heights) and `f64`
+/// ones (the Poisson solver's unknowns), with the same arithmetic in each.
+pub trait Real: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
+    const ZERO: Self;
+    const HALF: Self;
+    const ONE: Self;
+    /// `i` as this type (`i as f32`).
+    fn of(i: usize) -> Self;
+    /// `self.clamp(lo, hi)`.
+    fn clamped(self, lo: Self, hi: Self) -> Self;
+    /// `self.floor() as usize`.
+    fn floor_index(self) -> usize;
+}
+
+macro_rules! real {
+    ($t:ty) => {
+        impl Real for $t {
+            const ZERO: $t = 0.0;
+            const HALF: $t = 0.5;
+            const ONE: $t = 1.0;
+            fn of(i: usize) -> $t {
+                i as $t
+            }
+            fn clamped(self, lo: $t, hi: $t) -> $t {
+                self.clamp(lo, hi)
+            }
+            fn floor_index(self) -> usize {
+                self.floor() as usize
+            }
+        }
+    };
+}
+real!(f32);
+real!(f64);
+
+/// Bilinear sample of a row-major `w × h` grid at `p` (in pixels, pixel
+/// `(i, j)` centred on `(i + ½, j + ½)`), clamped to the outermost centres.
+#[inline]
+pub fn bilinear<T: Real>(field: &[T], w: usize, h: usize, p: [T; 2]) -> T {
+    let x = (p[0] - T::HALF).clamped(T::ZERO, T::of(w - 1));
+    let y = (p[1] - T::HALF).clamped(T::ZERO, T::of(h - 1));
+    let (x0, y0) = (x.floor_index(), y.floor_index());
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let (tx, ty) = (x - T::of(x0), y - T::of(y0));
+    let a = field[y0 * w + x0] * (T::ONE - tx) + field[y0 * w + x1] * tx;
+    let b = field[y1 * w + x0] * (T::ONE - tx) + field[y1 * w + x1] * tx;
+    a * (T::ONE - ty) + b * ty
 }
 
 #[cfg(test)]

@@ -28,15 +28,24 @@ pub enum SizeError {
     Infinite { x: usize, y: usize },
     #[error("cell size {0} m is invalid: expected a finite value > 0")]
     CellSize(f64),
-    #[error("window {w}x{h} at ({x}, {y}) does not fit a {width}x{height} grid")]
-    Window {
-        x: usize,
-        y: usize,
-        w: usize,
-        h: usize,
-        width: usize,
-        height: usize,
-    },
+    #[error(
+        "window {}x{} at ({}, {}) does not fit a {}x{} grid",
+        .0.w, .0.h, .0.x, .0.y, .0.width, .0.height
+    )]
+    Window(GridWindow),
+}
+
+/// A `w × h` window at `(x, y)` asked of a `width × height` grid: what a
+/// window error reports, for heightfields and masks ([`SizeError::Window`])
+/// as for windows of a synthesized world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GridWindow {
+    pub x: usize,
+    pub y: usize,
+    pub w: usize,
+    pub h: usize,
+    pub width: usize,
+    pub height: usize,
 }
 
 /// Largest accepted side, in samples. Larger grids are refused before any
@@ -59,4 +68,43 @@ pub fn check_dims(width: usize, height: usize) -> Result<(), SizeError> {
         });
     }
     Ok(())
+}
+
+/// Checks that a `w × h` window at `(x, y)` is not empty and lies inside a
+/// `width × height` grid.
+pub fn check_window(
+    x: usize,
+    y: usize,
+    w: usize,
+    h: usize,
+    width: usize,
+    height: usize,
+) -> Result<(), SizeError> {
+    if w == 0 || h == 0 || x + w > width || y + h > height {
+        return Err(SizeError::Window(GridWindow {
+            x,
+            y,
+            w,
+            h,
+            width,
+            height,
+        }));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn windows_must_be_inside_and_not_empty() {
+        assert_eq!(check_window(2, 3, 5, 5, 7, 8), Ok(()));
+        let e = check_window(3, 4, 5, 6, 7, 8).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "window 5x6 at (3, 4) does not fit a 7x8 grid"
+        );
+        assert!(check_window(0, 0, 0, 1, 7, 8).is_err());
+    }
 }

@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 use terrasynth::database::{Database, default};
 use terrasynth::progress::Silent;
+use terrasynth::size::GridWindow;
 use terrasynth::synth::cone::Rect;
 use terrasynth::synth::{Params, SynthError, Synthesizer, WindowError};
 
@@ -164,12 +165,18 @@ fn bad_worlds_and_windows_are_typed_errors() {
         other => panic!("{world:?} {win:?}: {other:?}"),
     };
     let e = window((100, 100), Rect::new(90, 0, 11, 10));
-    assert!(matches!(e, WindowError::Window { x: 90, w: 11, .. }), "{e}");
+    assert!(
+        matches!(e, WindowError::Window(GridWindow { x: 90, w: 11, .. })),
+        "{e}"
+    );
     assert!(e.to_string().contains("inside the 100x100 world"), "{e}");
     let e = window((100, 100), Rect::new(10, 10, 0, 5));
-    assert!(matches!(e, WindowError::Window { w: 0, h: 5, .. }), "{e}");
+    assert!(
+        matches!(e, WindowError::Window(GridWindow { w: 0, h: 5, .. })),
+        "{e}"
+    );
     let e = window((100, 100), Rect::new(usize::MAX, 0, 5, 5));
-    assert!(matches!(e, WindowError::Window { .. }), "{e}");
+    assert!(matches!(e, WindowError::Window(_)), "{e}");
     let e = window((0, 100), Rect::new(0, 0, 1, 1));
     assert!(matches!(e, WindowError::World { width: 0, .. }), "{e}");
     let e = window((1 << 21, 100), Rect::new(0, 0, 1, 1));

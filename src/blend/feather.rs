@@ -5,26 +5,14 @@
 //! two parts separately, keeps the destination's level and takes only the
 //! source's relief.
 
-use super::{BlendError, check};
+use super::Inputs;
 
 /// Blends `src` into `dst` in place with weights `mask` in `[0, 1]`:
 /// `dst' = lerp(dst − μ_d, src − μ_s, m) + μ_d`, where μ are the
 /// mask-weighted means. With `keep_level = false` the mean is lerped too
 /// (`+ lerp(μ_d, μ_s, m)`), which is the plain feather.
-pub fn feather(
-    width: usize,
-    height: usize,
-    dst: &mut [f32],
-    src: &[f32],
-    mask: &[f32],
-    keep_level: bool,
-) -> Result<(), BlendError> {
-    check(
-        width,
-        height,
-        &[("destination", dst.len()), ("source", src.len())],
-        mask,
-    )?;
+pub fn feather(inputs: Inputs<'_>, keep_level: bool) {
+    let Inputs { dst, src, mask, .. } = inputs;
     let (mut wsum, mut dsum, mut ssum) = (0.0f64, 0.0f64, 0.0f64);
     for ((&d, &s), &m) in dst.iter().zip(src).zip(mask) {
         wsum += m as f64;
@@ -32,7 +20,7 @@ pub fn feather(
         ssum += m as f64 * s as f64;
     }
     if wsum == 0.0 {
-        return Ok(());
+        return;
     }
     let (md, ms) = (dsum / wsum, ssum / wsum);
     for ((d, &s), &m) in dst.iter_mut().zip(src).zip(mask) {
@@ -45,12 +33,12 @@ pub fn feather(
         };
         *d = (detail + level) as f32;
     }
-    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::blend::BlendError;
 
     #[test]
     fn keeps_the_destination_level_and_takes_the_source_relief() {
@@ -60,7 +48,7 @@ mod tests {
             .map(|x| 500.0 + if x % 2 == 0 { 1.0 } else { -1.0 })
             .collect();
         let mask = vec![1.0f32; w];
-        feather(w, h, &mut dst, &src, &mask, true).unwrap();
+        feather(Inputs::new(w, h, &mut dst, &src, &mask).unwrap(), true);
         for (x, v) in dst.iter().enumerate() {
             let want = 100.0 + if x % 2 == 0 { 1.0 } else { -1.0 };
             assert!((v - want).abs() < 1e-4, "{x}: {v}");
@@ -70,9 +58,12 @@ mod tests {
     #[test]
     fn zero_mask_changes_nothing_and_bad_mask_is_refused() {
         let mut dst = vec![1.0f32, 2.0, 3.0];
-        feather(3, 1, &mut dst, &[9.0; 3], &[0.0; 3], true).unwrap();
+        feather(
+            Inputs::new(3, 1, &mut dst, &[9.0; 3], &[0.0; 3]).unwrap(),
+            true,
+        );
         assert_eq!(dst, [1.0, 2.0, 3.0]);
-        let e = feather(3, 1, &mut dst, &[9.0; 3], &[0.0, 1.5, 0.0], true).unwrap_err();
+        let e = Inputs::new(3, 1, &mut dst, &[9.0; 3], &[0.0, 1.5, 0.0]).unwrap_err();
         assert!(matches!(e, BlendError::Mask { x: 1, y: 0, .. }), "{e}");
     }
 }

@@ -10,8 +10,8 @@
 //! equation at a free pixel p is `Σ_n (u_n − u_p) = Σ_n g(p→n)`, which is
 //! the Euler–Lagrange equation of `min Σ_edges (u_n − u_p − g(p→n))²`.
 
-use super::{BlendError, check};
-use crate::poisson::{SolveOptions, SolveReport, solve};
+use super::{BlendError, Inputs, check_lengths};
+use crate::poisson::{Method, SolveOptions, SolveReport, solve};
 
 /// Solves for `u` on the pixels where `free` is set, keeping the others as
 /// Dirichlet values, so that the differences of `u` best match the guidance.
@@ -24,26 +24,27 @@ pub fn solve_guided(
     gy: &[f32],
     opts: &SolveOptions,
 ) -> Result<SolveReport, BlendError> {
-    let n = width * height;
-    for (what, len) in [
-        ("heights", u.len()),
-        ("free mask", free.len()),
-        ("gx", gx.len()),
-        ("gy", gy.len()),
-    ] {
-        if len != n {
-            return Err(BlendError::Length {
-                what,
-                width,
-                height,
-                expected: n,
-                found: len,
-            });
-        }
-    }
+    check_lengths(
+        width,
+        height,
+        &[
+            ("heights", u.len()),
+            ("free mask", free.len()),
+            ("gx", gx.len()),
+            ("gy", gy.len()),
+        ],
+    )?;
     let rhs = guided_rhs(width, height, gx, gy);
     let fixed: Vec<bool> = free.iter().map(|f| !f).collect();
-    Ok(solve(width, height, u, &fixed, Some(&rhs), opts)?)
+    Ok(solve(
+        Method::Cascadic,
+        width,
+        height,
+        u,
+        &fixed,
+        Some(&rhs),
+        opts,
+    )?)
 }
 
 /// The right-hand side `f` of the solve for guidance `gx`, `gy` (both of
@@ -75,22 +76,10 @@ pub fn guided_rhs(width: usize, height: usize, gx: &[f32], gy: &[f32]) -> Vec<f3
 
 /// Seamless cloning: inside `mask > 0.5` take the gradients of `src`, keep
 /// `dst` elsewhere (the boundary of the mask is matched exactly).
-pub fn blend(
-    width: usize,
-    height: usize,
-    dst: &mut [f32],
-    src: &[f32],
-    mask: &[f32],
-    opts: &SolveOptions,
-) -> Result<SolveReport, BlendError> {
-    check(
-        width,
-        height,
-        &[("destination", dst.len()), ("source", src.len())],
-        mask,
-    )?;
+pub fn blend(inputs: Inputs<'_>, opts: &SolveOptions) -> Result<SolveReport, BlendError> {
+    let (width, height, src) = (inputs.width, inputs.height, inputs.src);
     let n = width * height;
-    let free: Vec<bool> = mask.iter().map(|&m| m > 0.5).collect();
+    let free: Vec<bool> = inputs.mask.iter().map(|&m| m > 0.5).collect();
     let mut gx = vec![0.0f32; n];
     let mut gy = vec![0.0f32; n];
     for y in 0..height {
@@ -104,7 +93,7 @@ pub fn blend(
             }
         }
     }
-    solve_guided(width, height, dst, &free, &gx, &gy, opts)
+    solve_guided(width, height, inputs.dst, &free, &gx, &gy, opts)
 }
 
 #[cfg(test)]
@@ -137,7 +126,7 @@ mod tests {
             tolerance: 1e-7,
             max_iterations: 5000,
         };
-        let r = blend(w, h, &mut out, &src, &mask, &opts).unwrap();
+        let r = blend(Inputs::new(w, h, &mut out, &src, &mask).unwrap(), &opts).unwrap();
         assert!(r.converged && r.relative_residual <= 1e-7, "{r:?}");
         // Outside untouched, the bump's relief kept, no 490 m step.
         assert_eq!(out[0], 10.0);

@@ -8,7 +8,8 @@
 //! Down-sampling is a 2×2 box mean and up-sampling bilinear; any size works
 //! (odd sides are handled by clamping).
 
-use super::{BlendError, check};
+use super::Inputs;
+use crate::resample::bilinear;
 
 fn down(w: usize, h: usize, v: &[f32]) -> (usize, usize, Vec<f32>) {
     let (cw, ch) = (w.div_ceil(2), h.div_ceil(2));
@@ -29,16 +30,9 @@ fn down(w: usize, h: usize, v: &[f32]) -> (usize, usize, Vec<f32>) {
 fn up(cw: usize, ch: usize, v: &[f32], w: usize, h: usize) -> Vec<f32> {
     let mut out = vec![0.0f32; w * h];
     for y in 0..h {
-        let gy = ((y as f32 + 0.5) / 2.0 - 0.5).clamp(0.0, (ch - 1) as f32);
-        let y0 = gy.floor() as usize;
-        let (y1, ty) = ((y0 + 1).min(ch - 1), gy - y0 as f32);
         for x in 0..w {
-            let gx = ((x as f32 + 0.5) / 2.0 - 0.5).clamp(0.0, (cw - 1) as f32);
-            let x0 = gx.floor() as usize;
-            let (x1, tx) = ((x0 + 1).min(cw - 1), gx - x0 as f32);
-            let a = v[y0 * cw + x0] * (1.0 - tx) + v[y0 * cw + x1] * tx;
-            let b = v[y1 * cw + x0] * (1.0 - tx) + v[y1 * cw + x1] * tx;
-            out[y * w + x] = a * (1.0 - ty) + b * ty;
+            let p = [(x as f32 + 0.5) / 2.0, (y as f32 + 0.5) / 2.0];
+            out[y * w + x] = bilinear(v, cw, ch, p);
         }
     }
     out
@@ -46,21 +40,14 @@ fn up(cw: usize, ch: usize, v: &[f32], w: usize, h: usize) -> Vec<f32> {
 
 /// Blends `src` into `dst` in place over `levels` pyramid levels (at least 1;
 /// levels beyond the 1×1 top are ignored).
-pub fn blend(
-    width: usize,
-    height: usize,
-    dst: &mut [f32],
-    src: &[f32],
-    mask: &[f32],
-    levels: usize,
-    band_gain: Option<&[f32]>,
-) -> Result<(), BlendError> {
-    check(
+pub fn blend(inputs: Inputs<'_>, levels: usize, band_gain: Option<&[f32]>) {
+    let Inputs {
         width,
         height,
-        &[("destination", dst.len()), ("source", src.len())],
+        dst,
+        src,
         mask,
-    )?;
+    } = inputs;
     // Gaussian pyramids of all three.
     let mut g_d = vec![(width, height, dst.to_vec())];
     let mut g_s = vec![(width, height, src.to_vec())];
@@ -100,7 +87,6 @@ pub fn blend(
         (cw, ch) = (w, h);
     }
     dst.copy_from_slice(&acc);
-    Ok(())
 }
 
 #[cfg(test)]
@@ -113,10 +99,18 @@ mod tests {
         let d: Vec<f32> = (0..w * h).map(|i| ((i * 7) % 13) as f32).collect();
         let s: Vec<f32> = (0..w * h).map(|i| ((i * 5) % 11) as f32 * 3.0).collect();
         let mut out = d.clone();
-        blend(w, h, &mut out, &s, &vec![0.0; w * h], 5, None).unwrap();
+        blend(
+            Inputs::new(w, h, &mut out, &s, &vec![0.0; w * h]).unwrap(),
+            5,
+            None,
+        );
         assert!(out.iter().zip(&d).all(|(a, b)| (a - b).abs() < 1e-3));
         let mut out = d.clone();
-        blend(w, h, &mut out, &s, &vec![1.0; w * h], 5, None).unwrap();
+        blend(
+            Inputs::new(w, h, &mut out, &s, &vec![1.0; w * h]).unwrap(),
+            5,
+            None,
+        );
         assert!(out.iter().zip(&s).all(|(a, b)| (a - b).abs() < 1e-3));
     }
 
@@ -128,7 +122,8 @@ mod tests {
             .map(|i| if i % w < 32 { 1.0 } else { 0.0 })
             .collect();
         let mut out = vec![0.0f32; w * h];
-        blend(w, h, &mut out, &vec![100.0; w * h], &mask, 6, None).unwrap();
+        let src = vec![100.0; w * h];
+        blend(Inputs::new(w, h, &mut out, &src, &mask).unwrap(), 6, None);
         let row = &out[..w];
         let max_step = row
             .windows(2)

@@ -15,8 +15,8 @@
 //! The patch engine ([`crate::patch`]) merges with the Poisson variant; the
 //! other two are for tools (copy brushes) and comparison.
 //!
-//! All three take row-major `f32` grids of one size and a mask in `[0, 1]`
-//! (`1` = take the source).
+//! All three take their grids as one [`Inputs`]: row-major `f32` grids of
+//! one size and a mask in `[0, 1]` (`1` = take the source).
 
 pub mod feather;
 pub mod gradient_domain;
@@ -42,31 +42,70 @@ pub enum BlendError {
     Poisson(#[from] crate::poisson::PoissonError),
 }
 
-/// Checks that every buffer has `width * height` samples and the mask is in `[0, 1]`.
-pub(crate) fn check(
+/// The inputs every blend takes: a destination blended in place, a source
+/// and a mask in `[0, 1]` (`1` = take the source), row-major grids of one
+/// size. One type, checked once when it is made ([`Inputs::new`]), so
+/// that the three methods agree on what they accept.
+#[derive(Debug)]
+pub struct Inputs<'a> {
+    width: usize,
+    height: usize,
+    dst: &'a mut [f32],
+    src: &'a [f32],
+    mask: &'a [f32],
+}
+
+impl<'a> Inputs<'a> {
+    /// Checks that every buffer has `width * height` samples and the mask
+    /// is in `[0, 1]`.
+    pub fn new(
+        width: usize,
+        height: usize,
+        dst: &'a mut [f32],
+        src: &'a [f32],
+        mask: &'a [f32],
+    ) -> Result<Inputs<'a>, BlendError> {
+        check_lengths(
+            width,
+            height,
+            &[
+                ("destination", dst.len()),
+                ("source", src.len()),
+                ("mask", mask.len()),
+            ],
+        )?;
+        if let Some(i) = mask.iter().position(|m| !(0.0..=1.0).contains(m)) {
+            return Err(BlendError::Mask {
+                x: i % width,
+                y: i / width,
+                value: mask[i],
+            });
+        }
+        Ok(Inputs {
+            width,
+            height,
+            dst,
+            src,
+            mask,
+        })
+    }
+}
+
+/// Checks that each named buffer has `width * height` samples.
+fn check_lengths(
     width: usize,
     height: usize,
     bufs: &[(&'static str, usize)],
-    mask: &[f32],
 ) -> Result<(), BlendError> {
     let expected = width * height;
-    for &(what, found) in bufs.iter().chain([("mask", mask.len())].iter()) {
-        if found != expected {
-            return Err(BlendError::Length {
-                what,
-                width,
-                height,
-                expected,
-                found,
-            });
-        }
+    match bufs.iter().find(|&&(_, found)| found != expected) {
+        Some(&(what, found)) => Err(BlendError::Length {
+            what,
+            width,
+            height,
+            expected,
+            found,
+        }),
+        None => Ok(()),
     }
-    if let Some(i) = mask.iter().position(|m| !(0.0..=1.0).contains(m)) {
-        return Err(BlendError::Mask {
-            x: i % width,
-            y: i / width,
-            value: mask[i],
-        });
-    }
-    Ok(())
 }

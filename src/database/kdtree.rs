@@ -15,7 +15,8 @@
 //! index) and queries visit a fixed number of leaves in best-bin-first order,
 //! so results are deterministic and independent of the thread count.
 
-use std::cmp::Ordering;
+use crate::order::Ranked;
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// Dimensions of the search space (top principal directions).
@@ -75,12 +76,10 @@ impl KdTree {
             return;
         }
         let mut heap = BinaryHeap::new();
-        heap.push(Bin {
-            bound: 0.0,
-            node: 0,
-        });
+        // Pending subtrees by their lower distance bound, smallest first.
+        heap.push(Reverse(Ranked(0.0f32, 0)));
         let mut leaves = 0;
-        while let Some(Bin { node, .. }) = heap.pop() {
+        while let Some(Reverse(Ranked(_, node))) = heap.pop() {
             let mut n = node;
             loop {
                 match self.nodes[n as usize] {
@@ -108,10 +107,7 @@ impl KdTree {
                         } else {
                             (right, left)
                         };
-                        heap.push(Bin {
-                            bound: d * d,
-                            node: far,
-                        });
+                        heap.push(Reverse(Ranked(d * d, far)));
                         n = near;
                     }
                 }
@@ -120,30 +116,6 @@ impl KdTree {
                 return;
             }
         }
-    }
-}
-
-/// A pending subtree, ordered by its lower distance bound (then node index).
-struct Bin {
-    bound: f32,
-    node: u32,
-}
-
-impl PartialEq for Bin {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Bin {}
-impl PartialOrd for Bin {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Bin {
-    // Max-heap: the smallest bound must compare greatest.
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.bound.total_cmp(&self.bound).then(o.node.cmp(&self.node))
     }
 }
 

@@ -246,8 +246,7 @@ pub fn load_bytes(
         Format::Tiff => tiff::decode(bytes, opts.band)?,
         Format::Hgt => hgt::decode(bytes)?,
         Format::Asc => asc::decode(bytes)?,
-        Format::R16 => raw::decode16(bytes, sc, opts.size)?,
-        Format::R32 => raw::decode32(bytes, sc, opts.size)?,
+        Format::R16 | Format::R32 => raw::decode(format, bytes, sc, opts.size)?,
         Format::Ter => ter::decode(bytes)?,
     };
     if format != Format::Tiff && opts.band.is_some_and(|b| b != 1) {

@@ -20,24 +20,35 @@ use super::{Encoded, Format, FormatError};
 use crate::heightfield::Heightfield;
 use crate::size::check_dims;
 
-pub(super) fn decode16(
+/// Decodes an R16 or R32 file (`format`): its grid size from `size`, the
+/// sidecar or a square sample count (see the module docs), then its samples
+/// as the format stores them.
+pub(super) fn decode(
+    format: Format,
     bytes: &[u8],
     sidecar: Option<&Sidecar>,
     size: Option<(usize, usize)>,
 ) -> Result<Heightfield, FormatError> {
-    let (w, h) = dimensions(bytes.len(), 2, "R16", sidecar, size)?;
-    let codes = bytes
-        .chunks_exact(2)
-        .map(|c| u16::from_le_bytes([c[0], c[1]]));
-    dequantize(w, h, codes, 16, sidecar)
+    let r16 = format == Format::R16;
+    let (sample_bytes, name) = if r16 { (2, "R16") } else { (4, "R32") };
+    let (w, h) = dimensions(bytes.len(), sample_bytes, name, sidecar, size)?;
+    if r16 {
+        let codes = bytes
+            .chunks_exact(2)
+            .map(|c| u16::from_le_bytes([c[0], c[1]]));
+        dequantize(w, h, codes, 16, sidecar)
+    } else {
+        metres32(w, h, bytes, sidecar)
+    }
 }
 
-pub(super) fn decode32(
+/// R32 samples: metres, through the sidecar's mapping when it has one.
+fn metres32(
+    w: usize,
+    h: usize,
     bytes: &[u8],
     sidecar: Option<&Sidecar>,
-    size: Option<(usize, usize)>,
 ) -> Result<Heightfield, FormatError> {
-    let (w, h) = dimensions(bytes.len(), 4, "R32", sidecar, size)?;
     let mapping = sidecar.map_or(
         HeightMapping {
             offset_m: 0.0,

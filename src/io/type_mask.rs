@@ -47,16 +47,7 @@ impl TypeMask {
         w: usize,
         h: usize,
     ) -> Result<TypeMask, crate::size::SizeError> {
-        if w == 0 || h == 0 || x + w > self.width || y + h > self.height {
-            return Err(crate::size::SizeError::Window {
-                x,
-                y,
-                w,
-                h,
-                width: self.width,
-                height: self.height,
-            });
-        }
+        crate::size::check_window(x, y, w, h, self.width, self.height)?;
         let indices = (y..y + h)
             .flat_map(|r| &self.indices[r * self.width + x..][..w])
             .copied()

@@ -18,6 +18,7 @@ use super::costs::noise_levels;
 use super::graph::{FeatureGraph, dist, point_at};
 use super::ppa::{self, PpaParams};
 use super::sketch::Kind;
+use crate::resample::bilinear;
 use crate::stages::fill_ssd::centre_cells;
 use rayon::prelude::*;
 
@@ -28,18 +29,6 @@ pub struct FeatureNode {
     pub cps: Vec<Cp>,
     /// Prominence in height units (metres for sources).
     pub prominence: f32,
-}
-
-/// Bilinear sample with clamping.
-pub fn sample(field: &[f32], w: usize, h: usize, p: [f32; 2]) -> f32 {
-    let x = (p[0] - 0.5).clamp(0.0, (w - 1) as f32);
-    let y = (p[1] - 0.5).clamp(0.0, (h - 1) as f32);
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-    let (tx, ty) = (x - x0 as f32, y - y0 as f32);
-    let a = field[y0 * w + x0] * (1.0 - tx) + field[y0 * w + x1] * tx;
-    let b = field[y1 * w + x0] * (1.0 - tx) + field[y1 * w + x1] * tx;
-    a * (1.0 - ty) + b * ty
 }
 
 /// Control points and profiles at `c` on `field` (ridges high). `None` when
@@ -56,7 +45,7 @@ pub fn describe(
     if exits.is_empty() || exits.len() > 8 {
         return None;
     }
-    let hc = sample(field, w, h, c);
+    let hc = bilinear(field, w, h, c);
     type Raw = ([f32; 2], f32, [f32; ALONG], [f32; ACROSS]);
     let mut raw: Vec<Raw> = Vec::new();
     let mut prom = 0.0f32;
@@ -66,13 +55,13 @@ pub fn describe(
         let mut along = [0.0f32; ALONG];
         for (k, a) in along.iter_mut().enumerate() {
             let t = r * (k + 1) as f32 / ALONG as f32;
-            *a = sample(field, w, h, [c[0] + dx * t, c[1] + dy * t]) - hc;
+            *a = bilinear(field, w, h, [c[0] + dx * t, c[1] + dy * t]) - hc;
         }
-        let hq = sample(field, w, h, q);
+        let hq = bilinear(field, w, h, q);
         let mut across = [0.0f32; ACROSS];
         for (k, a) in across.iter_mut().enumerate() {
             let t = (k as f32 - 3.0) * r / 4.0;
-            *a = sample(field, w, h, [q[0] - dy * t, q[1] + dx * t]) - hq;
+            *a = bilinear(field, w, h, [q[0] - dy * t, q[1] + dx * t]) - hq;
         }
         prom += -(across[0] + across[ACROSS - 1]) * 0.5;
         let angle = dy.atan2(dx) / std::f32::consts::TAU * TURN as f32;

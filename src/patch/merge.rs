@@ -8,11 +8,11 @@
 //!    correction fades out over `R` = patch/4;
 //! 3. a Poisson solve for heights with those gradients, the old pixels as
 //!    Dirichlet values (the crate's multigrid-preconditioned solver for
-//!    small grids, [`crate::poisson::solve_mg`], started from the patch).
+//!    small grids, [`crate::poisson::Method::Multigrid`], started from the patch).
 
 use super::graphcut::{Label, Seam, kwatra, min_cut};
 use crate::blend::gradient_domain::guided_rhs;
-use crate::poisson::{SolveOptions, SolveReport, solve_mg};
+use crate::poisson::{Method, SolveOptions, SolveReport, solve};
 
 /// The output being synthesized.
 #[derive(Debug, Clone, PartialEq)]
@@ -441,7 +441,7 @@ pub fn apply(
         }
     }
     // Initial guess: the patch itself, continued into the free ring outside
-    // the window by its nearest pixel ([`solve_mg`] starts from `u`).
+    // the window by its nearest pixel ([`Method::Multigrid`] starts from `u`).
     for g in 0..gw * gh {
         if class[g] == 2 {
             let x = (g % gw + gx0).clamp(win.x0, win.x0 + n - 1) - win.x0;
@@ -451,7 +451,7 @@ pub fn apply(
     }
     let fixed: Vec<bool> = class.iter().map(|&k| k == 1).collect();
     let rhs = guided_rhs(gw, gh, &gxv, &gyv);
-    let report = solve_mg(gw, gh, &mut u, &fixed, Some(&rhs), opts).ok();
+    let report = solve(Method::Multigrid, gw, gh, &mut u, &fixed, Some(&rhs), opts).ok();
     for gy in 0..gh {
         for gx in 0..gw {
             if in_win(gx, gy) && class[gy * gw + gx] == 0 {

@@ -218,12 +218,8 @@ impl Sketch {
                 hf.map(|hf| hf.into_vec())
                     .unwrap_or_else(|_| vec![0.0; w * h])
             }
-            Sketch::Strokes {
-                width,
-                height,
-                strokes,
-            } => {
-                let s = Scale::new((*width, *height), (w, h));
+            Sketch::Strokes { strokes, .. } => {
+                let s = Scale::new(self.size(), (w, h));
                 let scale = (s.sx * s.sy).sqrt();
                 let mut hi = vec![0.0f32; w * h];
                 let mut lo = vec![0.0f32; w * h];
@@ -318,12 +314,8 @@ pub fn stroke_mask(sketch: &Sketch, kind: Kind, w: usize, h: usize, radius: f32)
                 })
                 .collect()
         }
-        Sketch::Strokes {
-            width,
-            height,
-            strokes,
-        } => {
-            let s = Scale::new((*width, *height), (w, h));
+        Sketch::Strokes { strokes, .. } => {
+            let s = Scale::new(sketch.size(), (w, h));
             let mut m = vec![0.0f32; w * h];
             for k in strokes.iter().filter(|k| k.kind == kind) {
                 draw_cone(&mut m, w, h, &s.points(k), radius.max(0.5));

@@ -2,9 +2,10 @@
 //! warp onto a user patch, sampling the warped source, and the removal of
 //! the tilt every patch brings from its source.
 
-use super::candidates::{self, FeatureNode, PreparedSource};
+use super::candidates::{FeatureNode, PreparedSource};
 use super::costs::{Tps, transform_angle};
 use super::merge::Window;
+use crate::resample::bilinear;
 
 /// Builds the warp of a feature candidate onto a user patch: a TPS from
 /// output coordinates (relative to the user centre, in units of r) to
@@ -96,7 +97,7 @@ pub fn sample_warped(
             if !(q[0] >= 0.5 && q[1] >= 0.5 && q[0] <= w - 0.5 && q[1] <= h - 0.5) {
                 return None;
             }
-            out[y * n + x] = candidates::sample(&src.heights, src.width, src.height, q);
+            out[y * n + x] = bilinear(&src.heights, src.width, src.height, q);
         }
     }
     Some(out)

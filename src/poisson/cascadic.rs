@@ -1,33 +1,29 @@
-//! [`solve`], the solver for large grids (whole-DEM nodata filling,
-//! blending): a cascadic start, each level solved on a 2x coarser grid
-//! first and interpolated up as the initial guess, then the parallel
+//! [`Method::Cascadic`], the solver for large grids (whole-DEM nodata
+//! filling, blending): a cascadic start, each level solved on a 2x coarser
+//! grid first and interpolated up as the initial guess, then the parallel
 //! Jacobi-preconditioned CG of `pcg` on the finest level.
+//!
+//! [`Method::Cascadic`]: super::Method::Cascadic
 
 use super::pcg::cg;
-use super::{PoissonError, SolveOptions, SolveReport, check_inputs};
+use super::{Problem, SolveOptions, SolveReport};
+use crate::resample::bilinear;
 use rayon::prelude::*;
 
-/// Solves in place. `u` holds the boundary values at fixed pixels (read) and
-/// the initial guess at free pixels (ignored: the cascadic start replaces it);
-/// on return the free pixels hold the solution. `rhs` is `f` (zero if `None`).
-pub fn solve(
-    width: usize,
-    height: usize,
-    u: &mut [f32],
-    fixed: &[bool],
-    rhs: Option<&[f32]>,
-    opts: &SolveOptions,
-) -> Result<SolveReport, PoissonError> {
-    check_inputs(width, height, u, fixed, rhs)?;
+/// Solves a checked problem in place; the initial guess at free pixels is
+/// ignored (the cascadic start replaces it).
+pub(super) fn solve(problem: Problem<'_>, opts: &SolveOptions) -> SolveReport {
+    let (width, height, fixed, rhs) = (problem.width, problem.height, problem.fixed, problem.rhs);
+    let u = problem.u;
     let n = width * height;
     let unknowns = fixed.iter().filter(|&&f| !f).count();
     if unknowns == 0 {
-        return Ok(SolveReport {
+        return SolveReport {
             unknowns,
             iterations: 0,
             relative_residual: 0.0,
             converged: true,
-        });
+        };
     }
     let mut x: Vec<f64> = u
         .iter()
@@ -44,7 +40,7 @@ pub fn solve(
             u[i] = x[i] as f32;
         }
     }
-    Ok(report)
+    report
 }
 
 /// Solves a 2× coarser problem (recursively) and interpolates it into the
@@ -100,20 +96,15 @@ fn cascadic_start(width: usize, height: usize, x: &mut [f64], fixed: &[bool], f:
     };
     cg(cw, ch, &mut cx, &cfixed, &cf, &coarse_opts);
     // Bilinear prolongation of the coarse solution onto free fine pixels.
-    let sample = |fx: f64, fy: f64| -> f64 {
-        let gx = (fx - 0.5).clamp(0.0, (cw - 1) as f64);
-        let gy = (fy - 0.5).clamp(0.0, (ch - 1) as f64);
-        let (x0, y0) = (gx.floor() as usize, gy.floor() as usize);
-        let (x1, y1) = ((x0 + 1).min(cw - 1), (y0 + 1).min(ch - 1));
-        let (tx, ty) = (gx - x0 as f64, gy - y0 as f64);
-        let a = cx[y0 * cw + x0] * (1.0 - tx) + cx[y0 * cw + x1] * tx;
-        let b = cx[y1 * cw + x0] * (1.0 - tx) + cx[y1 * cw + x1] * tx;
-        a * (1.0 - ty) + b * ty
-    };
     x.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
         for (xi, v) in row.iter_mut().enumerate() {
             if !fixed[y * width + xi] {
-                *v = sample((xi as f64 + 0.5) / 2.0, (y as f64 + 0.5) / 2.0);
+                *v = bilinear(
+                    &cx,
+                    cw,
+                    ch,
+                    [(xi as f64 + 0.5) / 2.0, (y as f64 + 0.5) / 2.0],
+                );
             }
         }
     });

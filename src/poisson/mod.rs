@@ -16,10 +16,11 @@
 //! Speed: plain CG needs O(hole diameter) iterations. A cascadic start
 //! (solve a 2× coarser problem first, recursively, and interpolate it as the
 //! initial guess) removes the low frequencies that CG is slow on, so large
-//! holes converge in tens of iterations per level. For many small solves
-//! (the patch engine's windows), [`solve_mg`] instead preconditions CG with
-//! a multigrid V-cycle and runs sequentially, which needs several times
-//! fewer iterations and no fork-join per vector operation.
+//! holes converge in tens of iterations per level ([`Method::Cascadic`]).
+//! For many small solves (the patch engine's windows),
+//! [`Method::Multigrid`] instead preconditions CG with a multigrid V-cycle
+//! and runs sequentially, which needs several times fewer iterations and no
+//! fork-join per vector operation.
 //!
 //! Determinism: every reduction sums fixed-size chunks in index order, so the
 //! result is bit-identical for any number of threads.
@@ -29,9 +30,6 @@ mod multigrid;
 mod pcg;
 #[cfg(test)]
 mod tests;
-
-pub use cascadic::solve;
-pub use multigrid::solve_mg;
 
 use thiserror::Error;
 
@@ -51,6 +49,63 @@ pub enum PoissonError {
         "value at pixel ({x}, {y}) is not finite: fixed values and the right-hand side must be finite"
     )]
     NotFinite { x: usize, y: usize },
+}
+
+/// Which solver runs: the same equation, stopping rule and report, for
+/// grids of different sizes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// For large grids (whole-DEM nodata filling, blending): a cascadic
+    /// start, each level solved on a 2x coarser grid first and interpolated
+    /// up as the initial guess (the given one at free pixels is ignored),
+    /// then parallel Jacobi-preconditioned CG on the finest level.
+    Cascadic,
+    /// For small grids (a few thousand unknowns, such as the patch windows
+    /// of [`crate::patch`]): CG preconditioned by one aggregation-multigrid
+    /// V-cycle per iteration, sequential, starting from the given `u` at
+    /// free pixels (0 where it is not finite). A V-cycle removes the smooth
+    /// error that Jacobi-preconditioned CG needs O(grid side) iterations
+    /// for, so a 66² window takes tens of iterations instead of over a
+    /// hundred, and without fork-join overhead per vector operation.
+    /// Deterministic (one fixed order of every operation), independent of
+    /// the thread pool.
+    Multigrid,
+}
+
+/// Solves in place with `method`. `u` holds the boundary values at fixed
+/// pixels (read) and the initial guess at free pixels (see [`Method`]); on
+/// return the free pixels hold the solution. `rhs` is `f` (zero if `None`).
+/// The inputs are checked first, for both methods alike.
+pub fn solve(
+    method: Method,
+    width: usize,
+    height: usize,
+    u: &mut [f32],
+    fixed: &[bool],
+    rhs: Option<&[f32]>,
+    opts: &SolveOptions,
+) -> Result<SolveReport, PoissonError> {
+    check_inputs(width, height, u, fixed, rhs)?;
+    let problem = Problem {
+        width,
+        height,
+        u,
+        fixed,
+        rhs,
+    };
+    Ok(match method {
+        Method::Cascadic => cascadic::solve(problem, opts),
+        Method::Multigrid => multigrid::solve(problem, opts),
+    })
+}
+
+/// A checked problem, as [`solve`] hands it to either method.
+struct Problem<'a> {
+    width: usize,
+    height: usize,
+    u: &'a mut [f32],
+    fixed: &'a [bool],
+    rhs: Option<&'a [f32]>,
 }
 
 /// Stopping rule.
@@ -85,7 +140,7 @@ pub struct SolveReport {
     pub converged: bool,
 }
 
-/// The checks both solvers make before touching anything: every slice
+/// The checks [`solve`] makes before touching anything: every slice
 /// `width × height` long, fixed values and `f` finite, at least one fixed
 /// pixel (otherwise the solution is defined only up to a constant).
 fn check_inputs(

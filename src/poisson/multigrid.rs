@@ -1,11 +1,13 @@
-//! [`solve_mg`], the solver for many small grids (the patch engine's
-//! windows): CG preconditioned by an aggregation-multigrid V-cycle, all
-//! sequential, so a solve has no fork-join overhead.
+//! [`Method::Multigrid`], the solver for many small grids (the patch
+//! engine's windows): CG preconditioned by an aggregation-multigrid
+//! V-cycle, all sequential, so a solve has no fork-join overhead.
+//!
+//! [`Method::Multigrid`]: super::Method::Multigrid
 
 use super::pcg::degree;
-use super::{PoissonError, SolveOptions, SolveReport, check_inputs};
+use super::{Problem, SolveOptions, SolveReport};
 
-/// One level of the multigrid hierarchy of [`solve_mg`]: a 5-point
+/// One level of the multigrid hierarchy of [`solve`]: a 5-point
 /// operator with variable coefficients on the active (free) cells,
 /// `(A v)_p = diag_p·v_p − Σ_n w_pn·v_n`.
 struct Level {
@@ -19,9 +21,8 @@ struct Level {
 }
 
 impl Level {
-    /// The finest level: the operator of [`solve`] restricted to free pixels.
-    ///
-    /// [`solve`]: super::solve
+    /// The finest level: the operator of every method restricted to free
+    /// pixels.
     fn finest(w: usize, h: usize, fixed: &[bool]) -> Level {
         let active: Vec<bool> = fixed.iter().map(|f| !f).collect();
         let mut east = vec![0.0; w * h];
@@ -188,26 +189,11 @@ fn v_cycle(levels: &[Level], b: &[f64]) -> Vec<f64> {
     x
 }
 
-/// [`solve`] for small grids (a few thousand unknowns, such as the patch
-/// windows of [`crate::patch`]): conjugate gradients preconditioned by one
-/// aggregation-multigrid V-cycle per iteration, sequential, starting from
-/// the given `u` at free pixels (0 where it is not finite). Same equation,
-/// same stopping rule and report as [`solve`]; a V-cycle removes the smooth
-/// error that Jacobi-preconditioned CG needs O(grid side) iterations for,
-/// so a 66² window takes tens of iterations instead of over a hundred, and
-/// without fork-join overhead per vector operation. Deterministic (one
-/// fixed order of every operation), independent of the thread pool.
-///
-/// [`solve`]: super::solve
-pub fn solve_mg(
-    width: usize,
-    height: usize,
-    u: &mut [f32],
-    fixed: &[bool],
-    rhs: Option<&[f32]>,
-    opts: &SolveOptions,
-) -> Result<SolveReport, PoissonError> {
-    check_inputs(width, height, u, fixed, rhs)?;
+/// Solves a checked problem in place, starting from the given `u` at free
+/// pixels (0 where it is not finite).
+pub(super) fn solve(problem: Problem<'_>, opts: &SolveOptions) -> SolveReport {
+    let (width, height, fixed, rhs) = (problem.width, problem.height, problem.fixed, problem.rhs);
+    let u = problem.u;
     let n = width * height;
     let mut levels = vec![Level::finest(width, height, fixed)];
     while let Some(l) = levels.last()
@@ -291,10 +277,10 @@ pub fn solve_mg(
             u[i] = x[i] as f32;
         }
     }
-    Ok(SolveReport {
+    SolveReport {
         unknowns,
         iterations,
         relative_residual: rel,
         converged: rel <= opts.tolerance,
-    })
+    }
 }

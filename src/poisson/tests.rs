@@ -61,7 +61,8 @@ fn linear_function_is_reproduced_inside_a_hole() {
             }
         }
     }
-    let rep = solve(w, h, &mut u, &fixed, None, &SolveOptions::default()).unwrap();
+    let opts = SolveOptions::default();
+    let rep = solve(Method::Cascadic, w, h, &mut u, &fixed, None, &opts).unwrap();
     assert!(rep.converged, "{rep:?}");
     for y in 0..h {
         for x in 0..w {
@@ -89,19 +90,20 @@ fn multigrid_solve_matches_the_stencil_in_few_iterations() {
         max_iterations: 500,
     };
     let mut v = u.clone();
-    let rep = solve_mg(w, h, &mut v, &fixed, Some(&f), &opts).unwrap();
+    let rep = solve(Method::Multigrid, w, h, &mut v, &fixed, Some(&f), &opts).unwrap();
     assert!(rep.converged && rep.relative_residual <= 1e-8, "{rep:?}");
     assert!(rep.iterations <= 40, "{rep:?}");
     assert!(max_defect(w, h, &v, &fixed, &f) < 5e-3);
     let mut c = u.clone();
-    solve(w, h, &mut c, &fixed, Some(&f), &opts).unwrap();
+    solve(Method::Cascadic, w, h, &mut c, &fixed, Some(&f), &opts).unwrap();
     let diff = v
         .iter()
         .zip(&c)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f32::max);
     assert!(diff < 1e-3, "multigrid and Jacobi CG differ by {diff}");
-    assert!(solve_mg(w, h, &mut v, &vec![false; w * h], None, &opts).is_err());
+    let none_fixed = vec![false; w * h];
+    assert!(solve(Method::Multigrid, w, h, &mut v, &none_fixed, None, &opts).is_err());
 }
 
 #[test]
@@ -123,7 +125,7 @@ fn poisson_reaches_tolerance_and_satisfies_the_stencil() {
         tolerance: 1e-8,
         max_iterations: 20_000,
     };
-    let rep = solve(w, h, &mut u, &fixed, Some(&f), &opts).unwrap();
+    let rep = solve(Method::Cascadic, w, h, &mut u, &fixed, Some(&f), &opts).unwrap();
     assert!(rep.converged && rep.relative_residual <= 1e-8, "{rep:?}");
     // f32 output rounding limits the achievable pointwise defect.
     assert!(max_defect(w, h, &u, &fixed, &f) < 5e-3);
@@ -131,6 +133,7 @@ fn poisson_reaches_tolerance_and_satisfies_the_stencil() {
 
 #[test]
 fn same_bits_for_any_thread_count() {
+    let opts = SolveOptions::default();
     let (w, h) = (180, 140);
     let mut u0 = vec![0.0f32; w * h];
     let mut fixed = vec![false; w * h];
@@ -144,7 +147,7 @@ fn same_bits_for_any_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| solve(w, h, &mut u, &fixed, None, &SolveOptions::default()))
+            .install(|| solve(Method::Cascadic, w, h, &mut u, &fixed, None, &opts))
             .unwrap();
         u.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
     };
@@ -153,25 +156,27 @@ fn same_bits_for_any_thread_count() {
 
 #[test]
 fn refuses_undetermined_and_bad_input() {
+    let opts = SolveOptions::default();
     let mut u = vec![0.0f32; 4];
     assert_eq!(
-        solve(2, 2, &mut u, &[false; 4], None, &SolveOptions::default()),
+        solve(Method::Cascadic, 2, 2, &mut u, &[false; 4], None, &opts),
         Err(PoissonError::NothingFixed)
     );
     let mut u = vec![f32::NAN, 0.0, 0.0, 0.0];
     assert_eq!(
         solve(
+            Method::Cascadic,
             2,
             2,
             &mut u,
             &[true, false, false, false],
             None,
-            &SolveOptions::default()
+            &opts
         ),
         Err(PoissonError::NotFinite { x: 0, y: 0 })
     );
     assert!(matches!(
-        solve(2, 2, &mut u, &[true; 3], None, &SolveOptions::default()),
+        solve(Method::Cascadic, 2, 2, &mut u, &[true; 3], None, &opts),
         Err(PoissonError::Length { .. })
     ));
 }

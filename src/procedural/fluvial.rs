@@ -39,8 +39,9 @@ use super::error::{ProceduralError, check_range};
 use super::grid::{MOORE, neighbour, store, to_f64};
 use super::noise::{hash2, pcg, unit};
 use crate::heightfield::Heightfield;
+use crate::order::Ranked;
 use crate::progress::Progress;
-use std::cmp::{Ordering, Reverse};
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// Parameters of [`fluvial_erode`].
@@ -82,22 +83,6 @@ impl FluvialParams {
     }
 }
 
-/// A heap key: height, then index, both ascending.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Key(f64, u32);
-
-impl Eq for Key {}
-impl PartialOrd for Key {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Key {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
-    }
-}
-
 /// Drainage of one terrain state.
 struct Drainage {
     /// Cells from the lowest (outlets) up; every receiver comes before its donors.
@@ -126,12 +111,12 @@ fn route(
             if x == 0 || y == 0 || x + 1 == width || y + 1 == height {
                 let i = y * width + x;
                 done[i] = true;
-                heap.push(Reverse(Key(h[i], i as u32)));
+                heap.push(Reverse(Ranked(h[i], i as u32)));
             }
         }
     }
     let mut order = Vec::with_capacity(n);
-    while let Some(Reverse(Key(hp, p))) = heap.pop() {
+    while let Some(Reverse(Ranked(hp, p))) = heap.pop() {
         order.push(p);
         let (x, y) = (p as usize % width, p as usize / width);
         for &(dx, dy, d) in &MOORE {
@@ -143,7 +128,7 @@ fn route(
                 if h[q] < floor {
                     h[q] = floor;
                 }
-                heap.push(Reverse(Key(h[q], q as u32)));
+                heap.push(Reverse(Ranked(h[q], q as u32)));
             }
         }
     }

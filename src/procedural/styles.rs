@@ -29,6 +29,8 @@ use super::warp::Warp;
 use crate::heightfield::Heightfield;
 use crate::progress::Progress;
 use crate::size::check_dims;
+use serde::Deserialize;
+use std::collections::BTreeMap;
 
 /// Cell size of the generated terrain, in metres (a typical DEM posting).
 pub const CELL_SIZE_M: f64 = 30.0;
@@ -111,11 +113,35 @@ impl Style {
                 allowed: "at least 32 cells",
             });
         }
-        let hf = match self {
-            Style::Alpine => alpine(size, seed, progress)?,
-            Style::Canyon => canyon(size, seed, progress)?,
-            Style::Hills => hills(size, seed, progress)?,
-        };
+        let recipe = Recipe::of(self);
+        progress.start(self.name(), recipe.work());
+        let mut hf = evolve(&recipe, size, seed, progress)?;
+        match self {
+            // Ridged detail noise on every level, then the finishing talus
+            // at ~35° with strong variation (scree aprons between rock
+            // ribs), then rock ribs and gullies on the steep ground.
+            Style::Alpine => {
+                recipe.finish(&mut hf, seed, progress)?;
+                roughen(&mut hf, 15.0, 400.0, sub_seed(seed, 5));
+                remap::map(&mut hf, |h| h + 500.0);
+            }
+            // A deeply incised drainage network, range-mapped into mesas
+            // and cliff bands, whose cliffs the finishing erosion with
+            // strongly varying talus breaks into buttresses above talus
+            // aprons.
+            Style::Canyon => {
+                terrace_canyons(&mut hf, seed);
+                recipe.finish(&mut hf, seed, progress)?;
+            }
+            // Weak uplift, a coarse start (480 m cells: valleys a few km
+            // apart), gentle talus and soil creep on the finer levels for
+            // rounded crests.
+            Style::Hills => {
+                recipe.finish(&mut hf, seed, progress)?;
+                remap::map(&mut hf, |h| h + 200.0);
+            }
+        }
+        progress.finish();
         let mask = TypeMask::classify(&hf);
         Ok((hf, mask))
     }
@@ -137,12 +163,21 @@ fn sub_seed(seed: u32, part: u32) -> u32 {
     pcg(seed ^ pcg(part))
 }
 
+/// The styles' recipes. They are numbers only, so they live in
+/// `data/styles.json` (one object per [`Style::name`], fields as in
+/// [`Recipe`]) where the three can be compared and tuned side by side.
+const RECIPES: &str = include_str!("../../data/styles.json");
+
 /// A landscape-evolution recipe: tectonic uplift against fluvial incision,
-/// thermal erosion and soil creep, from coarse to fine (see [`evolve`]).
+/// thermal erosion and soil creep, from coarse to fine (see [`evolve`]),
+/// then a finishing thermal pass.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct Recipe {
     /// Seed namespace of the style, so styles do not share layouts.
     part: u32,
-    /// Number of levels; the coarsest has cells of `30 m · 2^(levels−1)`.
+    /// Number of levels (at most 6); the coarsest has cells of
+    /// `30 m · 2^(levels−1)`.
     levels: usize,
     /// Uplift per fluvial step in metres, where the uplift pattern is highest.
     uplift_m: f64,
@@ -162,16 +197,52 @@ struct Recipe {
     creep: [u32; 6],
     detail_m: [f64; 6],
     ridged_detail: bool,
+    finish: Finish,
+}
+
+/// The thermal erosion that finishes a style (scree, soil or cliff walls,
+/// each at its own talus).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Finish {
+    talus: f64,
+    variation: f64,
+    iterations: u32,
 }
 
 impl Recipe {
+    fn of(style: Style) -> Recipe {
+        let mut all: BTreeMap<String, Recipe> =
+            serde_json::from_str(RECIPES).expect("data/styles.json parses (see the tests)");
+        all.remove(style.name())
+            .expect("data/styles.json has every style (see the tests)")
+    }
+
+    /// Progress units: every fluvial, thermal and creep iteration.
     fn work(&self) -> u64 {
         (0..self.levels)
             .map(|l| {
                 self.rounds[l] as u64 * (self.fluvial_steps[l] + self.thermal_steps) as u64
                     + self.creep[l] as u64
             })
-            .sum()
+            .sum::<u64>()
+            + self.finish.iterations as u64
+    }
+
+    /// Runs the finishing thermal erosion on `hf`.
+    fn finish(
+        &self,
+        hf: &mut Heightfield,
+        seed: u32,
+        progress: &dyn Progress,
+    ) -> Result<(), ProceduralError> {
+        let params = ThermalParams {
+            talus: self.finish.talus,
+            rate: 0.5,
+            variation: self.finish.variation,
+            seed: sub_seed(seed, 4),
+        };
+        thermal_erode(hf, &params, self.finish.iterations, &Inner(progress))
     }
 }
 
@@ -301,100 +372,10 @@ fn roughen(hf: &mut Heightfield, amplitude_m: f64, feature_m: f64, seed: u32) {
     });
 }
 
-fn alpine(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield, ProceduralError> {
-    let recipe = Recipe {
-        part: 1,
-        levels: 4,
-        uplift_m: 18.0,
-        uplift_min: 0.1,
-        pattern_m: 9000.0,
-        erodibility: 0.05,
-        talus: 0.8,
-        talus_variation: 0.4,
-        rounds: [2, 6, 10, 30, 0, 0],
-        fluvial_steps: [2, 2, 3, 5, 0, 0],
-        thermal_steps: 3,
-        creep: [0; 6],
-        detail_m: [10.0, 20.0, 40.0, 50.0, 0.0, 0.0],
-        ridged_detail: true,
-    };
-    // Talus at ~35° with strong variation: scree aprons between rock ribs.
-    let scree = ThermalParams {
-        talus: 0.7,
-        rate: 0.5,
-        variation: 0.4,
-        seed: sub_seed(seed, 4),
-    };
-    progress.start("alpine", recipe.work() + 10);
-    let mut hf = evolve(&recipe, size, seed, progress)?;
-    thermal_erode(&mut hf, &scree, 10, &Inner(progress))?;
-    roughen(&mut hf, 15.0, 400.0, sub_seed(seed, 5));
-    remap::map(&mut hf, |h| h + 500.0);
-    progress.finish();
-    Ok(hf)
-}
-
-fn hills(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield, ProceduralError> {
-    // Weak uplift, a coarse start (480 m cells: valleys a few km apart),
-    // gentle talus and soil creep on the finer levels for rounded crests.
-    let recipe = Recipe {
-        part: 2,
-        levels: 5,
-        uplift_m: 6.0,
-        uplift_min: 0.3,
-        pattern_m: 14000.0,
-        erodibility: 0.05,
-        talus: 0.4,
-        talus_variation: 0.3,
-        rounds: [0, 0, 2, 5, 30, 0],
-        fluvial_steps: [0, 0, 3, 5, 5, 0],
-        thermal_steps: 3,
-        creep: [6, 12, 6, 2, 0, 0],
-        detail_m: [1.5, 3.0, 0.0, 0.0, 50.0, 0.0],
-        ridged_detail: false,
-    };
-    let soil = ThermalParams {
-        talus: 0.35,
-        rate: 0.5,
-        variation: 0.3,
-        seed: sub_seed(seed, 4),
-    };
-    progress.start("hills", recipe.work() + 10);
-    let mut hf = evolve(&recipe, size, seed, progress)?;
-    thermal_erode(&mut hf, &soil, 10, &Inner(progress))?;
-    remap::map(&mut hf, |h| h + 200.0);
-    progress.finish();
-    Ok(hf)
-}
-
-fn canyon(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield, ProceduralError> {
-    // A deeply incised drainage network, then range-mapped: bias lifts most
-    // of the land onto the plateau (the seed's "canyon" effect), terracing
-    // turns the valley sides into treads and cliff bands, and thermal
-    // erosion with strongly varying talus breaks the cliffs into buttresses
-    // above talus aprons.
-    let recipe = Recipe {
-        part: 3,
-        levels: 4,
-        uplift_m: 40.0,
-        uplift_min: 0.6,
-        pattern_m: 20000.0,
-        erodibility: 0.1,
-        talus: 0.8,
-        talus_variation: 0.3,
-        rounds: [0, 2, 6, 30, 0, 0],
-        fluvial_steps: [0, 2, 3, 5, 0, 0],
-        thermal_steps: 3,
-        creep: [0; 6],
-        detail_m: [0.0, 10.0, 20.0, 50.0, 0.0, 0.0],
-        ridged_detail: false,
-    };
-    let walls = ThermalParams {
-        talus: 1.5,
-        rate: 0.5,
-        variation: 0.6,
-        seed: sub_seed(seed, 4),
-    };
+/// The canyon style's range mapping: bias lifts most of the land onto the
+/// plateau (the seed's "canyon" effect), terracing turns the valley sides
+/// into treads and cliff bands; then metre-scale unevenness of the rock.
+fn terrace_canyons(hf: &mut Heightfield, seed: u32) {
     const FLOOR_M: f64 = 1200.0;
     const DEPTH_M: f64 = 900.0;
     const STEPS: u32 = 5;
@@ -404,10 +385,8 @@ fn canyon(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield
     const RISER: f64 = 0.2;
     /// Share of the unterraced surface kept, so treads are not dead flat.
     const TREAD_SLOPE: f64 = 0.1;
-    progress.start("canyon", recipe.work() + 20);
-    let mut hf = evolve(&recipe, size, seed, progress)?;
-    remap::normalize(&mut hf);
-    remap::map(&mut hf, |t| {
+    remap::normalize(hf);
+    remap::map(hf, |t| {
         let b = (remap::bias(0.65, t) * LIFT).min(1.0);
         let t = remap::terrace(b, STEPS, RISER) * (1.0 - TREAD_SLOPE) + b * TREAD_SLOPE;
         FLOOR_M + DEPTH_M * t
@@ -426,7 +405,19 @@ fn canyon(size: usize, seed: u32, progress: &dyn Progress) -> Result<Heightfield
         );
         6.0 * texture.sample(xm, ym)
     });
-    thermal_erode(&mut hf, &walls, 20, &Inner(progress))?;
-    progress.finish();
-    Ok(hf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `data/styles.json` gives every style a recipe that [`evolve`] can
+    /// index (at most 6 levels).
+    #[test]
+    fn every_style_has_a_recipe() {
+        for style in Style::ALL {
+            let r = Recipe::of(style);
+            assert!((1..=6).contains(&r.levels), "{}", style.name());
+        }
+    }
 }

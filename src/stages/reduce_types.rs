@@ -58,6 +58,21 @@ pub struct ReduceTypesUniform {
     pub pad2: u32,
 }
 
+impl ReduceTypesUniform {
+    /// The parameters of reducing a `child` raster (width, height) to
+    /// `width × height`.
+    pub fn new(width: usize, height: usize, child: (usize, usize), full: u32) -> Self {
+        ReduceTypesUniform {
+            width: width as u32,
+            height: height as u32,
+            child_width: child.0 as u32,
+            child_height: child.1 as u32,
+            full,
+            ..Default::default()
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -43,6 +43,19 @@ pub struct ReduceWeightsUniform {
     pub child_height: u32,
 }
 
+impl ReduceWeightsUniform {
+    /// The parameters of reducing a `child` raster (width, height) to
+    /// `width × height`.
+    pub fn new(width: usize, height: usize, child: (usize, usize)) -> Self {
+        ReduceWeightsUniform {
+            width: width as u32,
+            height: height as u32,
+            child_width: child.0 as u32,
+            child_height: child.1 as u32,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,11 +1,14 @@
 //! [`Backend`] for [`Gpu`]: each method hands over to the stage's own
-//! module.
+//! module, except the two reductions, which are one shared dispatch
+//! (`rasters`) with the stage's parameter block.
 
 use super::{Gpu, GpuGuide, GpuRaster, GpuState};
 use crate::backend::{Backend, BackendError, StageTime};
 use crate::level::fixed::Coord;
 use crate::level::state::State;
 use crate::stages::correct::{CorrectParams, Guide};
+use crate::stages::reduce_types::ReduceTypesUniform;
+use crate::stages::reduce_weights::ReduceWeightsUniform;
 use crate::stages::upsample_jitter::UpsampleParams;
 
 impl Backend for Gpu {
@@ -41,7 +44,7 @@ impl Backend for Gpu {
     }
 
     fn correct(&self, st: &GpuState, parent: Option<&GpuState>, level: usize, p: &CorrectParams) {
-        self.dispatch_correct(st, parent, level, p)
+        self.dispatch_correct(st, parent, level, p, None)
     }
 
     fn upload_guide(
@@ -61,7 +64,7 @@ impl Backend for Gpu {
         p: &CorrectParams,
         g: &GpuGuide,
     ) {
-        self.dispatch_correct_guided(st, parent, level, p, g)
+        self.dispatch_correct(st, parent, level, p, Some(g))
     }
 
     fn reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
@@ -97,7 +100,15 @@ impl Backend for Gpu {
         height: usize,
         full: u32,
     ) -> Result<GpuRaster, BackendError> {
-        self.dispatch_reduce_types(child, width, height, full)
+        let u = ReduceTypesUniform::new(width, height, (child.width, child.height), full);
+        self.reduce(
+            "type sets",
+            &self.ctx.reduce_types,
+            &u,
+            child,
+            width,
+            height,
+        )
     }
 
     fn reduce_weights(
@@ -106,7 +117,15 @@ impl Backend for Gpu {
         width: usize,
         height: usize,
     ) -> Result<GpuRaster, BackendError> {
-        self.dispatch_reduce_weights(child, width, height)
+        let u = ReduceWeightsUniform::new(width, height, (child.width, child.height));
+        self.reduce(
+            "coherence weights",
+            &self.ctx.reduce_weights,
+            &u,
+            child,
+            width,
+            height,
+        )
     }
 
     fn download_types(&self, r: &GpuRaster) -> Result<Vec<u32>, BackendError> {

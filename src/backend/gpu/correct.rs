@@ -20,23 +20,6 @@ pub struct GpuGuide {
 }
 
 impl Gpu {
-    pub(super) fn dispatch_correct(
-        &self,
-        st: &GpuState,
-        parent: Option<&GpuState>,
-        level: usize,
-        p: &CorrectParams,
-    ) {
-        let none = GpuGuide {
-            level: level as u32,
-            origin: [0, 0],
-            window: None,
-            flags: 0,
-            cells: None,
-        };
-        self.dispatch_correct_guided(st, parent, level, p, &none);
-    }
-
     pub(super) fn make_guide(
         &self,
         g: &Guide<'_>,
@@ -86,14 +69,24 @@ impl Gpu {
         })
     }
 
-    pub(super) fn dispatch_correct_guided(
+    /// One subpass of stage `correct`, with the control inputs `g` (`None`:
+    /// no controls, the whole level).
+    pub(super) fn dispatch_correct(
         &self,
         st: &GpuState,
         parent: Option<&GpuState>,
         level: usize,
         p: &CorrectParams,
-        g: &GpuGuide,
+        g: Option<&GpuGuide>,
     ) {
+        let none = GpuGuide {
+            level: level as u32,
+            origin: [0, 0],
+            window: None,
+            flags: 0,
+            cells: None,
+        };
+        let g = g.unwrap_or(&none);
         let [x0, y0, x1, y1] = g.window.unwrap_or([0, 0, st.width, st.height]);
         let mut u = CorrectUniform {
             width: st.width as u32,

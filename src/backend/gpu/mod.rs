@@ -16,9 +16,10 @@
 //! The parts: `context` (device and pipelines), `buffers` (storage
 //! buffers and read-back), `dispatch` (one compute pass), `timing`
 //! (timestamp queries), `database` (the atlas on the device), `state`
-//! and `rasters` (per-level data), one module per stage, named like its
-//! kernel and its CPU mirror in `stages` (`upsample_jitter`, `correct`,
-//! `reduce_types`, `reduce_weights`, `reconstruct`, `shade`, and the patch
+//! and `rasters` (per-level data, and the one dispatch of the two
+//! reductions, `reduce_types` and `reduce_weights`), one module per other
+//! stage, named like its kernel and its CPU mirror in `stages`
+//! (`upsample_jitter`, `correct`, `reconstruct`, `shade`, and the patch
 //! engine's [`fill_ssd`]) and `backend` (the [`super::Backend`] trait on
 //! [`Gpu`]).
 
@@ -31,8 +32,6 @@ mod dispatch;
 pub mod fill_ssd;
 mod rasters;
 mod reconstruct;
-mod reduce_types;
-mod reduce_weights;
 mod shade;
 mod state;
 mod timing;

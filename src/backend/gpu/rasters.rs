@@ -49,13 +49,14 @@ impl Gpu {
         Ok(wide.into_iter().map(|w| w as u8).collect())
     }
 
-    /// One dispatch of a reduction from `child` into a new `width × height`
-    /// raster.
+    /// One dispatch of a reduction (`reduce_types`, `reduce_weights`) from
+    /// `child` into a new `width × height` raster; `uniform` is the
+    /// kernel's parameter block.
     pub(super) fn reduce(
         &self,
         what: &'static str,
         pipeline: &wgpu::ComputePipeline,
-        uniform: &[u8],
+        uniform: &impl bytemuck::Pod,
         child: &GpuRaster,
         width: usize,
         height: usize,
@@ -68,7 +69,7 @@ impl Gpu {
         self.ctx.dispatch(
             None,
             pipeline,
-            uniform,
+            bytemuck::bytes_of(uniform),
             &[&child.buf, &buf],
             (groups(width), groups(height)),
         );

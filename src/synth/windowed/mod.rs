@@ -22,7 +22,7 @@ use super::cone::{Cone, Rect};
 use super::{SynthError, Synthesis, Synthesizer};
 use crate::georef::Georef;
 use crate::heightfield::Heightfield;
-use crate::size::MAX_SIDE;
+use crate::size::{GridWindow, MAX_SIDE};
 
 /// Why a world size or window cannot be synthesized.
 #[non_exhaustive]
@@ -31,16 +31,10 @@ pub enum WindowError {
     #[error("world size {width}x{height} is invalid: expected 1..={MAX_SIDE} pixels per side")]
     World { width: usize, height: usize },
     #[error(
-        "window {w}x{h} at ({x}, {y}) is invalid: expected at least 1x1 pixels inside the {width}x{height} world"
+        "window {}x{} at ({}, {}) is invalid: expected at least 1x1 pixels inside the {}x{} world",
+        .0.w, .0.h, .0.x, .0.y, .0.width, .0.height
     )]
-    Window {
-        x: usize,
-        y: usize,
-        w: usize,
-        h: usize,
-        width: usize,
-        height: usize,
-    },
+    Window(GridWindow),
     #[error("{what} gave {got} values for a rectangle of {expected} pixels")]
     Paint {
         what: &'static str,
@@ -114,14 +108,14 @@ pub fn check_window((width, height): (usize, usize), window: Rect) -> Result<(),
         return Err(WindowError::World { width, height });
     }
     if window.x1 <= window.x0 || window.y1 <= window.y0 || window.x1 > width || window.y1 > height {
-        return Err(WindowError::Window {
+        return Err(WindowError::Window(GridWindow {
             x: window.x0,
             y: window.y0,
             w: window.x1.saturating_sub(window.x0),
             h: window.y1.saturating_sub(window.y0),
             width,
             height,
-        });
+        }));
     }
     Ok(())
 }

@@ -75,9 +75,7 @@ pub struct Curve {
     /// Resampled points and arc length at each.
     points: Vec<DVec2>,
     cum: Vec<f64>,
-    height: Track,
-    slope: [Track; 2],
-    reach: [Track; 2],
+    tracks: Tracks,
     cell_m: f64,
     /// Effective reach per field node (see [`envelope`]).
     reach_eff: Vec<f32>,
@@ -85,6 +83,14 @@ pub struct Curve {
     envelope: Vec<Vec<DVec2>>,
     /// The raw envelope boundary before smoothing, output pixels.
     raw_envelope: Vec<Vec<DVec2>>,
+}
+
+/// A curve's height, left/right slope and left/right reach along its arc
+/// length: from its widgets alone, then with the junctions' heights.
+struct Tracks {
+    height: Track,
+    slope: [Track; 2],
+    reach: [Track; 2],
 }
 
 impl std::fmt::Debug for Curve {
@@ -125,7 +131,7 @@ pub fn build(
             let mean = c
                 .members
                 .iter()
-                .map(|&(k, s)| tracks[k].0.at(s))
+                .map(|&(k, s)| tracks[k].height.at(s))
                 .sum::<f64>()
                 / c.members.len() as f64;
             Junction {
@@ -155,7 +161,7 @@ pub fn build(
         .into_iter()
         .zip(tracks)
         .enumerate()
-        .map(|(k, ((points, cum), (_, slope, reach)))| {
+        .map(|(k, ((points, cum), tracks))| {
             let total = *cum.last().expect("non-empty");
             let mut keys: Vec<(f64, f64)> = specs[k]
                 .widgets
@@ -170,23 +176,18 @@ pub fn build(
                         .map(|m| (m.1, j.height_m)),
                 );
             }
-            Curve::new(
-                k,
-                points,
-                cum,
-                Track::new(&keys),
-                slope,
-                reach,
-                cell_m,
-                cache,
-            )
+            let tracks = Tracks {
+                height: Track::new(&keys),
+                ..tracks
+            };
+            Curve::new(k, points, cum, tracks, cell_m, cache)
         })
         .collect::<Result<_, _>>()?;
     Ok((curves, junctions))
 }
 
 /// Height, slope and reach tracks from a spec's widgets alone.
-fn widget_tracks(spec: &CurveSpec, total: f64) -> (Track, [Track; 2], [Track; 2]) {
+fn widget_tracks(spec: &CurveSpec, total: f64) -> Tracks {
     let keys = |f: &dyn Fn(&Widget) -> f64| -> Track {
         Track::new(
             &spec
@@ -196,25 +197,23 @@ fn widget_tracks(spec: &CurveSpec, total: f64) -> (Track, [Track; 2], [Track; 2]
                 .collect::<Vec<_>>(),
         )
     };
-    (
-        keys(&|w| w.height_m),
-        [keys(&|w| w.slope_deg[LEFT]), keys(&|w| w.slope_deg[RIGHT])],
-        [keys(&|w| w.reach_px[LEFT]), keys(&|w| w.reach_px[RIGHT])],
-    )
+    Tracks {
+        height: keys(&|w| w.height_m),
+        slope: [keys(&|w| w.slope_deg[LEFT]), keys(&|w| w.slope_deg[RIGHT])],
+        reach: [keys(&|w| w.reach_px[LEFT]), keys(&|w| w.reach_px[RIGHT])],
+    }
 }
 
 impl Curve {
-    #[allow(clippy::too_many_arguments)]
     fn new(
         index: usize,
         points: Vec<DVec2>,
         cum: Vec<f64>,
-        height: Track,
-        slope: [Track; 2],
-        reach: [Track; 2],
+        tracks: Tracks,
         cell_m: f64,
         cache: &FieldCache,
     ) -> Result<Curve, CurveError> {
+        let reach = &tracks.reach;
         let max_reach = reach[LEFT].max().max(reach[RIGHT].max());
         let sigma = envelope::sigma(max_reach);
         // Smoothing may push the boundary outward by up to ~σ where it fills
@@ -228,9 +227,7 @@ impl Curve {
             field,
             points,
             cum,
-            height,
-            slope,
-            reach,
+            tracks,
             cell_m,
             reach_eff: Vec::new(),
             envelope: Vec::new(),
@@ -307,7 +304,7 @@ impl Curve {
 
     /// Height at arc length `s`, metres (widgets and junctions).
     pub fn height_at(&self, s: f64) -> f64 {
-        self.height.at(s)
+        self.tracks.height.at(s)
     }
 
     /// The smoothed area-of-effect boundary (closed loops), output pixels.
@@ -379,9 +376,9 @@ impl Curve {
         Props {
             s,
             right,
-            height_m: self.height.at(s),
-            slope_deg: mix(&self.slope),
-            reach_px: mix(&self.reach),
+            height_m: self.tracks.height.at(s),
+            slope_deg: mix(&self.tracks.slope),
+            reach_px: mix(&self.tracks.reach),
         }
     }
 
