@@ -55,14 +55,19 @@ impl Sample {
     /// Mean and (population) standard deviation.
     pub fn mean_std(&self) -> (f64, f64) {
         let n = self.len().max(1) as f64;
-        let mean = self.sorted.par_iter().map(|&v| v as f64).sum::<f64>() / n;
-        let var = self
-            .sorted
-            .par_iter()
-            .map(|&v| (v as f64 - mean).powi(2))
-            .sum::<f64>()
-            / n;
+        let mean = self.sum_by(|v| v) / n;
+        let var = self.sum_by(|v| (v - mean).powi(2)) / n;
         (mean, var.sqrt())
+    }
+
+    /// Σ f(v) over the sample: fixed chunks in parallel, their sums added in
+    /// order. Why not rayon's `sum`: it splits by work stealing, so its
+    /// rounding — and `eval`'s last digits — changed from run to run.
+    fn sum_by(&self, f: impl Fn(f64) -> f64 + Sync) -> f64 {
+        let parts: Vec<f64> = (self.sorted.par_chunks(1 << 14))
+            .map(|c| c.iter().map(|&v| f(v as f64)).sum())
+            .collect();
+        parts.iter().sum()
     }
 }
 

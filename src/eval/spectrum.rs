@@ -76,38 +76,36 @@ pub fn spectrum(hf: &Heightfield) -> Spectrum {
     let f_min = 1.0 / pw.max(ph) as f64;
     let bin_of = |f: f64| ((f / f_min).log10() * BINS_PER_DECADE).floor() as usize;
     let bins = bin_of(std::f64::consts::SQRT_2 * 0.5) + 1;
-    let sums = (0..ph)
+    // Per row in parallel, rows added in order: a rayon fold/reduce
+    // groups rows by work stealing, and its rounding changed between runs.
+    let rows: Vec<Vec<(f64, f64, u64)>> = (0..ph)
         .into_par_iter()
-        .fold(
-            || vec![(0.0f64, 0.0f64, 0u64); bins],
-            |mut acc, v| {
-                let fy = signed(v, ph) as f64 / ph as f64;
-                for u in 0..pw {
-                    let fx = signed(u, pw) as f64 / pw as f64;
-                    let f = (fx * fx + fy * fy).sqrt();
-                    if f < f_min {
-                        continue; // the mean (removed) and sub-bin frequencies
-                    }
-                    let k = v * pw + u;
-                    let b = &mut acc[bin_of(f).min(bins - 1)];
-                    b.0 += f;
-                    b.1 += re[k] * re[k] + im[k] * im[k];
-                    b.2 += 1;
+        .map(|v| {
+            let mut acc = vec![(0.0f64, 0.0f64, 0u64); bins];
+            let fy = signed(v, ph) as f64 / ph as f64;
+            for u in 0..pw {
+                let fx = signed(u, pw) as f64 / pw as f64;
+                let f = (fx * fx + fy * fy).sqrt();
+                if f < f_min {
+                    continue; // the mean (removed) and sub-bin frequencies
                 }
-                acc
-            },
-        )
-        .reduce(
-            || vec![(0.0, 0.0, 0); bins],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(b) {
-                    x.0 += y.0;
-                    x.1 += y.1;
-                    x.2 += y.2;
-                }
-                a
-            },
-        );
+                let k = v * pw + u;
+                let b = &mut acc[bin_of(f).min(bins - 1)];
+                b.0 += f;
+                b.1 += re[k] * re[k] + im[k] * im[k];
+                b.2 += 1;
+            }
+            acc
+        })
+        .collect();
+    let mut sums = vec![(0.0f64, 0.0f64, 0u64); bins];
+    for row in rows {
+        for (x, y) in sums.iter_mut().zip(row) {
+            x.0 += y.0;
+            x.1 += y.1;
+            x.2 += y.2;
+        }
+    }
     let (freq, power): (Vec<f64>, Vec<f64>) = sums
         .iter()
         .filter(|b| b.2 > 0)
@@ -149,7 +147,9 @@ fn plane(hf: &Heightfield) -> (f64, f64, f64) {
                     (s + v, sx + v * (x as f64 - cx), sy + v * dy)
                 })
         })
-        .reduce(|| (0.0, 0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold((0.0, 0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
     let n = (w * h) as f64;
     // Σ (x − cx)² over the grid = h · w(w² − 1)/12.
     let vx = h as f64 * w as f64 * (w as f64 * w as f64 - 1.0) / 12.0;
