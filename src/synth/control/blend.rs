@@ -17,9 +17,9 @@
 //!
 //! **Units of t = s·d.** The paper does not say; we take the literal,
 //! physical reading: d is horizontal distance in metres (output pixels ×
-//! cell size), so with s = ½ the terrain may leave the target by half its
-//! distance to the site — a 1:2 tolerance cone around the site, the same
-//! at every level (a curve's s is 0.1, see *Curves hold their profile*).
+//! cell size), so with a point's s = ¼ ([`S`]) the terrain may leave the
+//! target by a quarter of its distance to the site — a 1:4 tolerance cone
+//! around the site, the same at every level (a curve's s is 0.1, see *Curves hold their profile*).
 //! A pixel far from the site is nudged only where its error exceeds that
 //! cone (eq. 9's cubic leaves smaller errors almost
 //! alone), so the constraint pins the site and lets the exemplar decide the
