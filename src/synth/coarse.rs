@@ -1,5 +1,6 @@
 //! The coarse start: the state synthesis begins from, above or at the
-//! database's coarsest level L.
+//! coarsest corrected level L — the database's coarsest level, at most
+//! [`MAX_START_LEVEL`].
 //!
 //! **Without jitter** (the reproduction property): level M holds the start
 //! exemplar's centre, spread so that each level halves the spacing — at
@@ -7,10 +8,10 @@
 //! is larger than the exemplar.
 //!
 //! **With jitter**, level L starts as a mosaic of *blocks* of 2^b × 2^b
-//! texels, each copied verbatim from a hash-chosen origin in any exemplar,
-//! drawn uniformly over every interior texel (so every exemplar, every
-//! terrain type and every part of an exemplar is drawn by its area), plus
-//! the paper's jitter; from L down, jitter and correction rearrange them.
+//! texels, each copied verbatim around a hash-chosen texel of any exemplar
+//! ([`blocks`]), drawn uniformly over every interior texel (so every
+//! exemplar, every terrain type and every part of an exemplar is drawn by
+//! its area), plus the paper's jitter; from L down, jitter and correction rearrange them.
 //!
 //! Why blocks, and why as large as the exemplars allow (b = ⌊log₂⌋ of the
 //! smallest exemplar interior side at L): pixel-based correction can join
