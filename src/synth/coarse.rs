@@ -131,8 +131,8 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
 
 /// Level L of an output over `region` (absolute level-L pixels: the whole
 /// level, or a window's cone): each pixel belongs to the 2^bits × 2^bits
-/// block under its [`warp`]ed position; each block picks one exemplar
-/// texel ([`block_draw`]: a hash of the seed and the block's position)
+/// block under its `warp`ed position; each block picks one exemplar
+/// texel (`block_draw`: a hash of the seed and the block's position)
 /// uniformly over every interior texel of exemplar `from` (or of every
 /// exemplar), and its pixels copy the exemplar around that texel, mirrored
 /// at the interior's edges; each pixel gets the level's jitter (`jitter`,
