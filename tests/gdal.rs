@@ -18,23 +18,8 @@ use terrasynth::georef::{Crs, Georef, PixelIs, Units};
 use terrasynth::io::{self, ReadOptions};
 use terrasynth::{Heightfield, io::Format};
 
-const REQUIRE: &str = "TERRASYNTH_REQUIRE_GDAL";
-
-/// Whether GDAL's tools are here; panics when required and absent.
-fn have_gdal() -> bool {
-    let ok = Command::new("gdalinfo")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            std::env::var_os(REQUIRE).is_none(),
-            "{REQUIRE} is set but gdalinfo is missing (apt-get install gdal-bin python3-gdal)"
-        );
-        println!("SKIP: GDAL is absent (apt-get install gdal-bin python3-gdal)");
-    }
-    ok
-}
+mod common;
+use common::have_gdal;
 
 /// Runs a GDAL tool; panics with its stderr on failure.
 fn run(tool: &str, args: &[&str]) -> String {

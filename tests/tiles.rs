@@ -15,6 +15,9 @@ use terrasynth::synth::cone::Rect;
 use terrasynth::synth::{Params, Synthesizer};
 use terrasynth::tiles::{self, TilesError, Tiling, grid::Grid, manifest::Manifest};
 
+mod common;
+use common::have_gdal;
+
 fn db() -> &'static Database {
     static DB: OnceLock<Database> = OnceLock::new();
     DB.get_or_init(|| default::build_default(&Silent).unwrap())
@@ -141,22 +144,6 @@ fn bad_tilings_are_typed_errors() {
     t.height_range_m = Some((5.0, 5.0));
     let e = write(&t, dir.path()).unwrap_err();
     assert!(matches!(e, TilesError::HeightRange(..)), "{e}");
-}
-
-/// Whether GDAL's tools are here; panics when required and absent.
-fn have_gdal() -> bool {
-    let ok = Command::new("gdalinfo")
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            std::env::var_os("TERRASYNTH_REQUIRE_GDAL").is_none(),
-            "TERRASYNTH_REQUIRE_GDAL is set but gdalinfo is missing (apt-get install gdal-bin)"
-        );
-        println!("SKIP: GDAL is absent (apt-get install gdal-bin)");
-    }
-    ok
 }
 
 #[test]

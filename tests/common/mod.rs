@@ -119,3 +119,21 @@ pub fn sample(width: usize, height: usize, cell: f64, nodata: bool) -> Heightfie
     }
     hf
 }
+
+/// Whether GDAL's tools are here; panics when `TERRASYNTH_REQUIRE_GDAL` is
+/// set and they are absent (CI installs them, so a skip there is a failure).
+pub fn have_gdal() -> bool {
+    const REQUIRE: &str = "TERRASYNTH_REQUIRE_GDAL";
+    let ok = std::process::Command::new("gdalinfo")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        assert!(
+            std::env::var_os(REQUIRE).is_none(),
+            "{REQUIRE} is set but gdalinfo is missing (apt-get install gdal-bin python3-gdal)"
+        );
+        println!("SKIP: GDAL is absent (apt-get install gdal-bin python3-gdal)");
+    }
+    ok
+}
