@@ -318,3 +318,45 @@ pub fn centre(
     }
     st
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_group_of_four_blocks_draws_from_the_four_quarters() {
+        let total = 5_003;
+        for seed in 0..50 {
+            for (gx, gy) in [(0u32, 0u32), (7, 3), (u32::MAX >> 1, 2)] {
+                let mut quarters: Vec<u32> = (0..4)
+                    .map(|s| block_draw(seed, 2 * gx + (s & 1), 2 * gy + (s >> 1), total))
+                    .map(|k| {
+                        assert!(k < total);
+                        k * 4 / total
+                    })
+                    .collect();
+                quarters.sort();
+                assert_eq!(quarters, [0, 1, 2, 3], "seed {seed}, group ({gx}, {gy})");
+            }
+        }
+    }
+
+    #[test]
+    fn warp_stays_within_three_eighths_of_a_block_and_moves() {
+        let bits = 6;
+        let mut moved = 0;
+        for y in (-200..200).step_by(7) {
+            for x in (-200..200).step_by(5) {
+                let (wx, wy) = warp(3, x, y, bits);
+                let bound = 3 << (bits - 3);
+                assert!(
+                    wx.abs() <= bound && wy.abs() <= bound,
+                    "({x},{y}): {wx},{wy}"
+                );
+                moved += usize::from(wx != 0 || wy != 0);
+            }
+        }
+        assert!(moved > 3000, "{moved}");
+        assert_eq!(warp(3, 10, 10, 2), (0, 0), "no warp under 8 texels");
+    }
+}
