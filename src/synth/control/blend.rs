@@ -61,8 +61,10 @@
 //! s = 0.1 the face is 0.85 m/m and the top edge within 2 % of relief
 //! (`tests/scene_session.rs`); the curve profile test's mean error went
 //! 1.24 → 1.17 % of relief and the fine relief within 2 px of the curve
-//! stays 79 % of the unconstrained terrain's (80 % before). Points keep the
-//! loose hold: they pin a site and let the exemplar shape its surroundings.
+//! stays 79 % of the unconstrained terrain's (80 % before). A sloped point
+//! holds its plane over its reach the same way (with s = ¼); a flat point
+//! keeps the loose hold: it pins a site and lets the exemplar shape its
+//! surroundings ([`super::point`]).
 //!
 //! **All levels, the finest two included.** The paper disables geometric
 //! constraints on the two finest levels because they "locally
@@ -317,20 +319,32 @@ mod tests {
         }
     }
 
+    /// A flat point (the level cap applies).
     fn point(x: f64, y: f64, h: f64, r: f64) -> PointConstraint {
-        PointConstraint::new((x, y), h, 0.3, 0.2, r, 30.0).unwrap()
+        PointConstraint::new((x, y), h, 0.3, 0.0, r, 30.0).unwrap()
     }
 
     #[test]
     fn a_lone_point_targets_its_plane_within_its_reach() {
+        for slope in [0.0, 0.2] {
+            lone_point(PointConstraint::new((100.0, 60.0), 400.0, 0.3, slope, 40.0, 30.0).unwrap());
+        }
+    }
+
+    /// A flat point reaches min(40, 4·2^i) px at level i, a sloped one its
+    /// whole 40 px at every level.
+    fn lone_point(p: PointConstraint) {
         let mut b = Blend::new(256, 256, 6, q());
         assert!(b.targets(2, 30.0).is_none());
-        let p = point(100.0, 60.0, 400.0, 40.0);
         b.add(&p);
         for level in 0..=6 {
             let t = b.targets(level, 30.0).unwrap();
             let s = (1 << level) as f64;
-            let reach = 40f64.min(4.0 * s);
+            let reach = if p.slope_angle == 0.0 {
+                40f64.min(4.0 * s)
+            } else {
+                40.0
+            };
             for y in 0..t.height {
                 for x in 0..t.width {
                     let (ox, oy) = ((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
@@ -343,7 +357,7 @@ mod tests {
                                 (c.height as f64 - want).abs() <= 0.5 + 1.0 / 16.0,
                                 "{c:?} {want}"
                             );
-                            // A 1:2 cone in metres from the pixel's footprint.
+                            // A 1:4 cone in metres from the pixel's footprint.
                             let d = (smp.distance - s / 2.0).max(0.0);
                             let tol = S * d * 30.0 / q().scale_m;
                             assert!((c.tol as f64 - tol.min(MAX_TOL as f64)).abs() <= 1.0);
