@@ -172,7 +172,7 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     let start = coarse::blocks(
         &atlas,
         None,
-        Rect::new(0, 0, side, side),
+        (Rect::new(0, 0, side, side), (side, side)),
         (l, bits),
         5,
         jitter,
@@ -218,7 +218,7 @@ fn blocks_cover_every_interior_texel_alike_and_stay_inside() {
     let start = coarse::blocks(
         &atlas,
         Some(0),
-        Rect::new(0, 0, side, side),
+        (Rect::new(0, 0, side, side), (side, side)),
         (l, bits),
         9,
         100,

@@ -152,10 +152,13 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
 /// straight coast 64 texels long wherever a block wrapped from sea to
 /// mountains. A mirror line keeps heights continuous; what shows is a
 /// symmetric landform, which correction and jitter then break up.
+///
+/// The block grid is shifted so that the world's centre is the centre of
+/// a 2 × 2 group ([`grid_shift`]).
 pub fn blocks(
     a: &AtlasLevel<'_>,
     from: Option<usize>,
-    region: Rect,
+    (region, world): (Rect, (usize, usize)),
     (l, bits): (usize, usize),
     seed: u32,
     jitter: i32,
@@ -167,14 +170,15 @@ pub fn blocks(
     let total: u32 = ranges.iter().map(|r| (r.2 * r.3) as u32).sum();
     let (w, h) = (region.width(), region.height());
     let st = State::new(w, h);
-    for (i, y) in (region.y0..region.y1).enumerate() {
-        for (j, x) in (region.x0..region.x1).enumerate() {
-            let (x, y) = (x as i32, y as i32);
+    let shift = (grid_shift(world.0, bits), grid_shift(world.1, bits));
+    for (i, ay) in (region.y0..region.y1).enumerate() {
+        for (j, ax) in (region.x0..region.x1).enumerate() {
+            let (ax, ay) = (ax as i32, ay as i32);
             // The block this pixel belongs to: the one under its warped
-            // position; it copies that block's exemplar from its own place
-            // relative to the block's corner.
-            let (wx, wy) = warp(seed, x, y, bits);
-            let (bx, by) = ((x + wx) >> bits, (y + wy) >> bits);
+            // position on the shifted grid; it copies that block's
+            // exemplar from its own place relative to the block's corner.
+            let (x, y) = (ax + shift.0, ay + shift.1);
+            let (bx, by) = block_of(seed, x, y, bits);
             let mut k = block_draw(seed, bx as u32, by as u32, total);
             for &(x0, y0, nx, ny) in &ranges {
                 let n = (nx * ny) as u32;
@@ -186,7 +190,7 @@ pub fn blocks(
                     let lx = mirror(ox - half + x - (bx << bits), nx);
                     let ly = mirror(oy - half + y - (by << bits), ny);
                     let (jx, jy) =
-                        upsample_jitter::jitter(seed, l as u32, x as u32, y as u32, jitter);
+                        upsample_jitter::jitter(seed, l as u32, ax as u32, ay as u32, jitter);
                     let s = Coord {
                         x: inside(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
                         y: inside(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
@@ -199,6 +203,29 @@ pub fn blocks(
         }
     }
     st
+}
+
+/// How far the block grid is shifted along an axis of `n` level-L pixels:
+/// the axis' centre falls on the border between the two blocks of a 2 × 2
+/// group (block index 1 | 2 of the shifted grid's first group pair).
+///
+/// Why: with the grid at the origin, an output the size of its exemplar
+/// lay mostly in one block — blocks are as large as the exemplars allow,
+/// and the 600² riviera DEM's 512-pixel blocks gave 73 % of the output to
+/// the block at the origin — so its make-up was one draw: its sea share ran
+/// 11–74 % over 9 seeds (exemplar 39 %), its relief kept 75 %, its
+/// realism ratio 1.32. Centred, the four blocks of one stratified group
+/// share the output (20–52 % sea, relief 91 %, ratio 0.67); north German
+/// plain relief 82 → 85 %. At 1024² from the shared DEMs the shift is 0.
+fn grid_shift(n: usize, bits: usize) -> i32 {
+    ((1i32 << bits) - (n / 2) as i32).rem_euclid(1 << (bits + 1))
+}
+
+/// The block (on the shifted grid) that pixel (x, y) of the shifted grid
+/// belongs to: the one under its warped position.
+fn block_of(seed: u32, x: i32, y: i32, bits: usize) -> (i32, i32) {
+    let (wx, wy) = warp(seed, x, y, bits);
+    ((x + wx) >> bits, (y + wy) >> bits)
 }
 
 /// The interior texel (an index below `total`, over every exemplar's
@@ -339,6 +366,27 @@ mod tests {
                 assert_eq!(quarters, [0, 1, 2, 3], "seed {seed}, group ({gx}, {gy})");
             }
         }
+    }
+
+    #[test]
+    fn an_output_the_size_of_its_exemplar_shares_four_blocks() {
+        // Riviera at level 3: 75 × 75 pixels, blocks of 64.
+        let (n, bits) = (75, 6);
+        for seed in 0..20 {
+            let shift = grid_shift(n, bits);
+            let mut count = std::collections::HashMap::new();
+            for y in 0..n as i32 {
+                for x in 0..n as i32 {
+                    let b = block_of(seed, x + shift, y + shift, bits);
+                    *count.entry(b).or_insert(0usize) += 1;
+                }
+            }
+            let largest = *count.values().max().unwrap() as f64 / (n * n) as f64;
+            assert!(largest < 0.4, "seed {seed}: one block holds {largest:.2}");
+            let (c, s) = (n as i32 / 2 + shift, 1 << bits);
+            assert_eq!(c % (2 * s), s, "the centre is a group's centre");
+        }
+        assert_eq!(grid_shift(128, 6), 0, "1024² from level 3: no shift");
     }
 
     #[test]

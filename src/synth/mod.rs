@@ -531,7 +531,9 @@ impl<'db> Synthesizer<'db> {
         match start {
             Start::Blocks { bits } => {
                 let from = self.params.start_exemplar;
-                coarse::blocks(&self.atlas[l], from, region, (l, bits), seed, self.jitter)
+                let world = level_size(width, height, l);
+                let at = (region, world);
+                coarse::blocks(&self.atlas[l], from, at, (l, bits), seed, self.jitter)
             }
             Start::Centre => {
                 let top = start.top(m, l);
