@@ -10,7 +10,7 @@ use terrasynth::heightfield::Heightfield;
 use terrasynth::progress::Silent;
 use terrasynth::synth::Params;
 use terrasynth::synth::control::{
-    Constraint, ConstraintId, Paste, PasteSource, PointConstraint, UNCONSTRAINED,
+    Constraint, ConstraintId, PASTE_FEATHER, Paste, PasteSource, PointConstraint, UNCONSTRAINED,
 };
 use terrasynth::synth::session::{Edit, Session};
 
@@ -357,8 +357,15 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
         .unwrap()
         .heightfield;
     let q = db.quantization();
-    let d = (delta / q.scale_m).round() * q.scale_m;
-    let mut n = 0;
+    let units = (delta / q.scale_m).round();
+    // The offset rises from 0 at the lasso to δ at PASTE_FEATHER inside
+    // (a smoothstep of the distance), so the paste stands on a slope, not
+    // on a wall δ high along its outline.
+    let feather = |x: f64, y: f64| {
+        let t = (distance_to(&lasso, x, y) / PASTE_FEATHER).min(1.0);
+        (units * t * t * (3.0 - 2.0 * t)).round() * q.scale_m
+    };
+    let (mut n, mut full, mut rim, mut rim_n) = (0, 0, 0.0, 0);
     for y in 0..N {
         for x in 0..N {
             // Pixels whose 3×3 neighbourhood lies in the paste: reconstruct
@@ -370,14 +377,36 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
                 .iter()
                 .all(|&dy| [-1.0, 0.0, 1.0].iter().all(|&dx| within(dx, dy)))
             {
-                let want = base.get(x, y) as f64 + d;
+                let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+                // Reconstruct averages the 3×3 neighbours' offsets.
+                let mut lift = 0.0;
+                for dy in [-1.0, 0.0, 1.0] {
+                    for dx in [-1.0, 0.0, 1.0] {
+                        lift += feather(cx + dx, cy + dy) / 9.0;
+                    }
+                }
+                let want = base.get(x, y) as f64 + lift;
                 let got = out.get(x + ox as usize, y + oy as usize) as f64;
-                assert!((got - want).abs() < 0.01, "({x}, {y}): {got} vs {want}");
+                assert!((got - want).abs() < 0.02, "({x}, {y}): {got} vs {want}");
                 n += 1;
+                full += usize::from(distance_to(&lasso, cx, cy) > PASTE_FEATHER + 1.5);
+                if distance_to(&lasso, cx, cy) < 3.0 {
+                    rim += got - base.get(x, y) as f64;
+                    rim_n += 1;
+                }
             }
         }
     }
-    assert!(n > 2000);
+    let rim = rim / rim_n as f64;
+    println!("paste: {full} pixels lifted by the full δ; the rim within 3 px by {rim:.1} m");
+    assert!(
+        n > 2000 && full > 100,
+        "{n} pixels checked, {full} at full δ"
+    );
+    assert!(
+        rim < 0.15 * delta,
+        "the rim is lifted by {rim:.1} m of {delta} m"
+    );
     // Outside the paste and its blend margin, the terrain stays put.
     let far = moved_outside(
         &base,
@@ -390,6 +419,18 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
         "paste: {n} pixels exact; {:.2}% of far pixels moved > 1% of relief",
         far * 100.0
     );
+}
+
+/// Distance from (x, y) to the nearest edge of a closed polygon.
+fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
+    let mut best = f64::INFINITY;
+    for (i, &a) in poly.iter().enumerate() {
+        let b = poly[(i + 1) % poly.len()];
+        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+        let t = (((x - a.0) * ex + (y - a.1) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
+        best = best.min((x - a.0 - t * ex).hypot(y - a.1 - t * ey));
+    }
+    best
 }
 
 #[test]

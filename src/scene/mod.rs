@@ -50,7 +50,7 @@
 //!     "exemplar": 2,                    // with "exemplar": its index in the database
 //!     "lasso": [[10, 10], [80, 12], [60, 90]],  // >= 3 points: the region, in source pixels
 //!     "to": [700, 300],                 // where the lasso's centroid goes, output pixels
-//!     "delta_m": 0                      // optional, -20000..=20000: height offset δ
+//!     "delta_m": 0                      // optional, -20000..=20000: height offset δ (rising over 16 px inside the lasso)
 //!   }]
 //! }
 //! ```

@@ -479,6 +479,7 @@ impl Session<'_> {
                     continue;
                 }
                 let t = ty as usize * tw + tx as usize;
+                let delta = p.delta_at(delta, level, x as usize, y as usize);
                 let values: Vec<(Coord, i32)> = match p.source {
                     PasteSource::Terrain => passes
                         .iter()

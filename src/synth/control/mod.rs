@@ -142,6 +142,53 @@ pub struct Controls {
     pub pastes: Vec<Paste>,
 }
 
+/// Width of a paste's height feather, output pixels: δ rises from 0 at the
+/// lasso to its full value this far inside ([`Paste::delta_at`]).
+pub const PASTE_FEATHER: f64 = 16.0;
+
+impl Paste {
+    /// The height offset (database units; `delta` is δ in units) that the
+    /// paste adds at source pixel (x, y) of level `level`: δ·w with w a
+    /// smoothstep of the pixel centre's distance inside the lasso over
+    /// [`PASTE_FEATHER`] (0 outside it — coarse levels' masks take any
+    /// pixel with a child inside).
+    ///
+    /// Why: a region raised or lowered by δ all the way to its lasso stood
+    /// on a straight wall δ high along it — the unweighted margin around a
+    /// paste is a few pixels, too narrow for correction to bridge a large
+    /// step (issue 14). Feathered, the paste keeps its source's relief and
+    /// the offset comes in over a slope like a real rise. Host-side f64,
+    /// one function for sessions and windows, so both write the same V.
+    pub fn delta_at(&self, delta: i32, level: usize, x: usize, y: usize) -> i32 {
+        let s = (1u64 << level) as f64;
+        let (px, py) = ((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
+        if delta == 0 || !inside(&self.lasso, px, py) {
+            return 0;
+        }
+        let d = distance_to_polygon(&self.lasso, px, py);
+        let t = (d / PASTE_FEATHER).min(1.0);
+        (f64::from(delta) * t * t * (3.0 - 2.0 * t)).round() as i32
+    }
+}
+
+/// Distance from (x, y) to the nearest edge of the closed polygon.
+fn distance_to_polygon(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let ((ax, ay), (bx, by)) = (poly[i], poly[(i + 1) % n]);
+            let (ex, ey) = (bx - ax, by - ay);
+            let len2 = ex * ex + ey * ey;
+            let t = if len2 > 0.0 {
+                (((x - ax) * ex + (y - ay) * ey) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (x - ax - t * ex).hypot(y - ay - t * ey)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Whether (x, y) lies inside the closed polygon (even-odd rule).
 pub fn inside(poly: &[(f64, f64)], x: f64, y: f64) -> bool {
     let mut odd = false;

@@ -39,6 +39,8 @@ pub(super) struct PasteGeometry {
     terrain: bool,
     /// δ in database units.
     delta: i32,
+    /// The paste (its feather: [`Paste::delta_at`]).
+    paste: Paste,
 }
 
 impl PasteGeometry {
@@ -115,6 +117,7 @@ impl PasteGeometry {
             levels,
             terrain: p.source == PasteSource::Terrain,
             delta: (p.delta_m / db.quantization().scale_m).round() as i32,
+            paste: p.clone(),
         }
     }
 
@@ -229,6 +232,7 @@ pub(super) fn write(pastes: &[PasteGeometry], frames: &mut Frames, regions: &[Re
                     let Some((sx, sy)) = p.source_of(i, x, y) else {
                         continue;
                     };
+                    let delta = p.paste.delta_at(p.delta, i, sx, sy);
                     let values: Vec<(Coord, i32)> = match p.levels[i].exemplar {
                         None => {
                             if !(r.x0..r.x1).contains(&sx) || !(r.y0..r.y1).contains(&sy) {
@@ -237,12 +241,12 @@ pub(super) fn write(pastes: &[PasteGeometry], frames: &mut Frames, regions: &[Re
                             let k = index(sx, sy);
                             passes
                                 .iter()
-                                .map(|q| (q.coords[k], q.offsets[k] + p.delta))
+                                .map(|q| (q.coords[k], q.offsets[k] + delta))
                                 .collect()
                         }
                         Some((x0, _, _)) => {
                             let c = Coord::from_texel(x0 as i32 + sx as i32, sy as i32);
-                            vec![(c, p.delta); passes.len()]
+                            vec![(c, delta); passes.len()]
                         }
                     };
                     writes.push((index(x, y), values));
