@@ -19,10 +19,11 @@ use common::db::{PYRENEES_CATALAN, two_dems};
 use common::dem::{self, DEM};
 /// The output side, the crops' side.
 const N: usize = PYRENEES_CATALAN.side;
-/// Least slope across sloped points (median and least of the ten sites of
-/// `point_constraint_sets_height_and_slope`, degrees; 20° asked). Measured:
-/// 16.2° and 13.5° since a sloped point holds its plane over its whole
-/// reach; 11.4° and 4.3° under the paper's level cap.
+/// Least slope across sloped points (median and least of the twenty sites
+/// of `point_constraint_sets_height_and_slope`, degrees; 20° asked).
+/// Measured on ten of them: 16.2° and 13.5° since a sloped point holds its
+/// plane over its whole reach, 11.4° and 4.3° under the paper's level cap;
+/// on the twenty with the Z-ordered coarse start, 15.9° and 13.4°.
 const SLOPE_MEDIAN_MIN: f64 = 14.0;
 const SLOPE_MIN: f64 = 10.0;
 
@@ -68,20 +69,23 @@ fn mean_around(hf: &Heightfield, x: usize, y: usize, r: usize) -> f64 {
 
 #[test]
 fn point_constraint_sets_height_and_slope() {
-    // Two sites (one raised, one lowered, slopes facing +x / +y) on five
+    // Two sites (one raised, one lowered, slopes facing +x / +y) on ten
     // terrains: a single site's error depends on what the terrain is there
-    // — a target above the exemplars' highest peak is the hard case (3.0–
-    // 3.1 % on the two such sites here; the others 0.2–1.9 %) — which every
-    // engine change moves, so the bound is on the mean of ten sites, with
-    // a looser one on the worst. Measured: mean 1.27 % before synthesis
-    // started at level 3 (its terrains never reached those peaks), 1.16 %
-    // after; with the paper's point tolerance s = ½ at level 3, 2.3 %;
-    // 0.92 % (worst 2.83 %) since sloped points hold their whole reach.
+    // — a target above the exemplars' highest peak is the hard case (2–3 %
+    // of relief) — which every engine change moves, so the bound is on
+    // the mean of twenty sites, with a looser one on the worst. Measured
+    // (on the first ten): mean 1.27 % before synthesis started at level 3
+    // (its terrains never reached those peaks), 1.16 % after; with the
+    // paper's point tolerance s = ½ at level 3, 2.3 %; 0.92 % (worst
+    // 2.83 %) since sloped points hold their whole reach; 1.56 % on the
+    // terrains of the Z-ordered coarse start, whose twenty give 1.27 %
+    // (worst 2.90 %) — over 144 points on the Pyrenees the Z order's sites
+    // are closer (1.59 → 1.42 %), so ten sites were too few to judge by.
     let Some(db) = db() else { return };
     let rel = relief(db);
     let mut errors = Vec::new();
     let mut slopes = Vec::new();
-    for seed in 7..12 {
+    for seed in 7..17 {
         let mut s = Session::new(db, Params::default(), N, N, seed).unwrap();
         let base = s.apply(vec![]).unwrap().heightfield;
         let cell = s.synthesizer().cell_size_m();
@@ -122,7 +126,7 @@ fn point_constraint_sets_height_and_slope() {
         }
     }
     slopes.sort_by(f64::total_cmp);
-    let median = (slopes[4] + slopes[5]) / 2.0;
+    let median = (slopes[9] + slopes[10]) / 2.0;
     println!("slopes across the sites (20° asked): {slopes:.1?}, median {median:.1}°");
     assert!(
         median >= SLOPE_MEDIAN_MIN && slopes[0] >= SLOPE_MIN,
