@@ -267,6 +267,7 @@ impl<'db> Synthesizer<'db> {
         let mut kept = Vec::new();
         let mut frames = control.filter(|c| c.record).map(|_| Frames {
             levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
+            heights: Vec::new(),
         });
         // Without a device clock, the loop waits after each stage so that
         // wall clock measures it; with one, stages queue back to back.
@@ -279,9 +280,15 @@ impl<'db> Synthesizer<'db> {
         // Bounds of the pixels of the level above that differ from the
         // previous frame (restricted re-synthesis only).
         let mut changed_parent: Option<[usize; 4]> = None;
+        // The window corrected at level 0 (restricted re-synthesis only).
+        let mut window0 = None;
         for level in (0..=top).rev() {
             let region = cone.region(level);
             let (w, h) = (region.width(), region.height());
+            let window = match control {
+                Some(c) if level <= l => self.window(c, level, (w, h), changed_parent),
+                _ => None,
+            };
             if level < top {
                 let t = Instant::now();
                 let above = match cone.parent_crop(level) {
@@ -290,7 +297,19 @@ impl<'db> Synthesizer<'db> {
                 };
                 let child = b.alloc(w, h)?;
                 let p = self.upsample_params(seed, level, region);
-                b.upsample_jitter(&above, &child, level, &p);
+                // Correcting a window with coherence reads the upsampled
+                // pixels within a subpass's reach of it; the rest take the
+                // previous frame's results before anything reads them.
+                let coherent = control
+                    .and_then(|c| c.guides.levels.get(level))
+                    .is_some_and(|g| g.weights.is_some());
+                match window.filter(|_| coherent) {
+                    Some(win) => {
+                        let read = widen(win, REACH_PER_SUBPASS, w, h);
+                        b.upsample_jitter_rect(&above, &child, level, &p, read);
+                    }
+                    None => b.upsample_jitter(&above, &child, level, &p),
+                }
                 if !device_clock {
                     b.finish()?;
                 }
@@ -319,9 +338,10 @@ impl<'db> Synthesizer<'db> {
                             (&state, parent.as_ref()),
                             (level, region),
                             c,
-                            changed_parent,
+                            window,
                             frames.as_mut(),
                         )?;
+                        window0 = window;
                     }
                 }
                 if !device_clock {
@@ -343,8 +363,24 @@ impl<'db> Synthesizer<'db> {
         }
         kept.reverse();
         let t = Instant::now();
-        let fixed = b.reconstruct(&state)?;
+        let prev_heights = control
+            .and_then(|c| c.prev)
+            .map(|f| &f.heights)
+            .filter(|h| h.len() == cone.region(0).width() * cone.region(0).height());
+        let fixed = match (window0, prev_heights) {
+            // Heights depend on their 3×3 neighbourhood's S and V, which
+            // differ from the previous frame's only inside the window.
+            (Some(win), Some(prev)) => {
+                let r = cone.region(0);
+                let read = widen(win, 1, r.width(), r.height());
+                b.reconstruct_rect(&state, prev, read)?
+            }
+            _ => b.reconstruct(&state)?,
+        };
         let heightfield = self.to_metres(&fixed, cone)?;
+        if let Some(f) = frames.as_mut() {
+            f.heights = fixed;
+        }
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
         if let Some(times) = b.device_times()? {
@@ -371,6 +407,28 @@ impl<'db> Synthesizer<'db> {
         ))
     }
 
+    /// The window of a `w × h` level that restricted re-synthesis corrects
+    /// ([`Guides::restrict`], with a previous frame of the level): the
+    /// pixels whose own inputs changed and the children of the parent's
+    /// changed pixels, widened by how far the level's subpasses carry a
+    /// change. None: the whole level.
+    fn window(
+        &self,
+        c: &Control<'_>,
+        level: usize,
+        (w, h): (usize, usize),
+        changed_parent: Option<[usize; 4]>,
+    ) -> Option<[usize; 4]> {
+        let before = c.prev.and_then(|f| f.levels.get(level))?;
+        if !c.guides.restrict || before.is_empty() {
+            return None;
+        }
+        let dirty = c.guides.levels.get(level).and_then(|g| g.dirty);
+        let seeds = union(dirty, changed_parent.map(double));
+        let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
+        Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
+    }
+
     /// The correction passes of one `w × h` level under control: each
     /// pass's guide uploaded to the backend, its result recorded into
     /// `frames`. With [`Guides::restrict`] and a previous frame, only the
@@ -383,20 +441,12 @@ impl<'db> Synthesizer<'db> {
         (state, parent): (&B::State, Option<&B::State>),
         (level, region): (usize, Rect),
         c: &Control<'_>,
-        changed_parent: Option<[usize; 4]>,
+        window: Option<[usize; 4]>,
         mut frames: Option<&mut Frames>,
     ) -> Result<Option<[usize; 4]>, SynthError> {
         let (w, h) = (region.width(), region.height());
         let lg = c.guides.levels.get(level);
         let before = c.prev.and_then(|f| f.levels.get(level));
-        let window = match (c.guides.restrict, before) {
-            (true, Some(b)) if !b.is_empty() => {
-                let seeds = union(lg.and_then(|g| g.dirty), changed_parent.map(double));
-                let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
-                Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
-            }
-            _ => None,
-        };
         let mut last_result = None;
         for pass in 0..self.params.passes as usize {
             let last = before.and_then(|b| b.get(pass));
@@ -439,7 +489,7 @@ impl<'db> Synthesizer<'db> {
             .as_ref()
             .or_else(|| frames.and_then(|f| f.levels[level].last()));
         Ok(match (window, before.and_then(|b| b.last()), current) {
-            (Some(_), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r),
+            (Some(win), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r, win),
             _ => Some([0, 0, w, h]),
         })
     }
