@@ -18,6 +18,7 @@ pub mod coarse;
 pub mod cone;
 pub mod control;
 mod params;
+mod restricted;
 pub mod session;
 pub mod source_map;
 mod window;
@@ -33,12 +34,13 @@ use atlas::AtlasLevel;
 use coarse::Start;
 use cone::{Cone, Rect};
 use fixed::FRAC_BITS;
+use restricted::LevelBuffers;
 use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
-use window::{REACH_PER_SUBPASS, changed_bounds, double, widen};
+use window::{REACH_PER_SUBPASS, changed_bounds, widen};
 
 pub use params::{
     Guides, LevelGuide, LevelMaps, LevelTiming, Params, SynthError, Synthesis, Timings,
@@ -277,6 +279,7 @@ impl<'db> Synthesizer<'db> {
         // The level above, kept through this level's correction: its
         // offsets anchor the height prior (`correct` module docs).
         let mut parent: Option<B::State> = None;
+        let mut parent_size = (0, 0);
         // Bounds of the pixels of the level above that differ from the
         // previous frame (restricted re-synthesis only).
         let mut changed_parent: Option<[usize; 4]> = None;
@@ -292,8 +295,15 @@ impl<'db> Synthesizer<'db> {
             if level < top {
                 let t = Instant::now();
                 let above = match cone.parent_crop(level) {
-                    Some(c) => b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?,
-                    None => state,
+                    Some(c) => {
+                        parent_size = (c.width(), c.height());
+                        b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?
+                    }
+                    None => {
+                        let r = cone.region(level + 1);
+                        parent_size = (r.width(), r.height());
+                        state
+                    }
                 };
                 let child = b.alloc(w, h)?;
                 let p = self.upsample_params(seed, level, region);
@@ -333,14 +343,28 @@ impl<'db> Synthesizer<'db> {
                         }
                     }
                     Some(c) => {
-                        changed_parent = self.correct_level(
-                            b,
-                            (&state, parent.as_ref()),
-                            (level, region),
-                            c,
-                            window,
-                            frames.as_mut(),
-                        )?;
+                        changed_parent = match window.filter(|_| self.can_crop(b, c, level)) {
+                            Some(win) => {
+                                let buf = LevelBuffers {
+                                    state: &state,
+                                    parent: parent.as_ref().map(|p| (p, parent_size)),
+                                    level,
+                                    region,
+                                };
+                                let (changed, corrected) =
+                                    self.correct_cropped(b, buf, c, win, frames.as_mut())?;
+                                state = corrected;
+                                changed
+                            }
+                            None => self.correct_level(
+                                b,
+                                (&state, parent.as_ref()),
+                                (level, region),
+                                c,
+                                window,
+                                frames.as_mut(),
+                            )?,
+                        };
                         window0 = window;
                     }
                 }
@@ -405,28 +429,6 @@ impl<'db> Synthesizer<'db> {
             },
             frames,
         ))
-    }
-
-    /// The window of a `w × h` level that restricted re-synthesis corrects
-    /// ([`Guides::restrict`], with a previous frame of the level): the
-    /// pixels whose own inputs changed and the children of the parent's
-    /// changed pixels, widened by how far the level's subpasses carry a
-    /// change. None: the whole level.
-    fn window(
-        &self,
-        c: &Control<'_>,
-        level: usize,
-        (w, h): (usize, usize),
-        changed_parent: Option<[usize; 4]>,
-    ) -> Option<[usize; 4]> {
-        let before = c.prev.and_then(|f| f.levels.get(level))?;
-        if !c.guides.restrict || before.is_empty() {
-            return None;
-        }
-        let dirty = c.guides.levels.get(level).and_then(|g| g.dirty);
-        let seeds = union(dirty, changed_parent.map(double));
-        let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
-        Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
     }
 
     /// The correction passes of one `w × h` level under control: each
