@@ -35,12 +35,12 @@ use coarse::Start;
 use cone::{Cone, Rect};
 use fixed::FRAC_BITS;
 use restricted::LevelBuffers;
-use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
+use stages::correct::{CorrectParams, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
-use window::{REACH_PER_SUBPASS, changed_bounds, widen};
+use window::{REACH_PER_SUBPASS, widen};
 
 pub use params::{
     Guides, LevelGuide, LevelMaps, LevelTiming, Params, SynthError, Synthesis, Timings,
@@ -429,71 +429,6 @@ impl<'db> Synthesizer<'db> {
             },
             frames,
         ))
-    }
-
-    /// The correction passes of one `w × h` level under control: each
-    /// pass's guide uploaded to the backend, its result recorded into
-    /// `frames`. With [`Guides::restrict`] and a previous frame, only the
-    /// window that can differ is corrected (the stage gives the rest the
-    /// previous result). Returns the bounds of the pixels that differ from
-    /// the previous frame's, for the level below.
-    fn correct_level<B: Backend>(
-        &self,
-        b: &B,
-        (state, parent): (&B::State, Option<&B::State>),
-        (level, region): (usize, Rect),
-        c: &Control<'_>,
-        window: Option<[usize; 4]>,
-        mut frames: Option<&mut Frames>,
-    ) -> Result<Option<[usize; 4]>, SynthError> {
-        let (w, h) = (region.width(), region.height());
-        let lg = c.guides.levels.get(level);
-        let before = c.prev.and_then(|f| f.levels.get(level));
-        let mut last_result = None;
-        for pass in 0..self.params.passes as usize {
-            let last = before.and_then(|b| b.get(pass));
-            let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
-                (Some(r), Some(weights)) => Some(Coherence {
-                    coords: &r.coords,
-                    offsets: &r.offsets,
-                    weights,
-                }),
-                _ => None,
-            };
-            let guide = Guide {
-                level: level as u32,
-                targets: lg.and_then(|g| g.targets.as_deref()),
-                allowed: lg.and_then(|g| g.allowed.as_deref()),
-                coherence,
-                window,
-                origin: [region.x0 as u32, region.y0 as u32],
-            };
-            let g = b.upload_guide(&guide, w, h)?;
-            for &(px, py) in &SUBPASSES {
-                let p = CorrectParams {
-                    px,
-                    py,
-                    prior: self.params.prior,
-                };
-                b.correct_guided(state, parent, level, &p, &g);
-            }
-            let is_last = pass + 1 == self.params.passes as usize;
-            if frames.is_some() || (is_last && window.is_some()) {
-                let (coords, offsets) = b.download(state)?;
-                let r = PassResult { coords, offsets };
-                match frames.as_deref_mut() {
-                    Some(f) => f.levels[level].push(r),
-                    None => last_result = Some(r),
-                }
-            }
-        }
-        let current = last_result
-            .as_ref()
-            .or_else(|| frames.and_then(|f| f.levels[level].last()));
-        Ok(match (window, before.and_then(|b| b.last()), current) {
-            (Some(win), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r, win),
-            _ => Some([0, 0, w, h]),
-        })
     }
 
     /// The database this synthesizer draws from.

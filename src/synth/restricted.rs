@@ -1,4 +1,6 @@
-//! Restricted re-synthesis ([`Guides::restrict`](super::Guides::restrict)): an edit corrects, at
+//! A level's correction under control ([`Synthesizer::correct_level`]),
+//! and restricted re-synthesis
+//! ([`Guides::restrict`](super::Guides::restrict)): an edit corrects, at
 //! each level, only the window that can differ from the previous frame.
 //!
 //! On a backend that asks for it ([`Backend::crops_windows`]: the CPU),
@@ -74,6 +76,71 @@ impl Synthesizer<'_> {
                 .levels
                 .get(level)
                 .is_some_and(|g| g.weights.is_some())
+    }
+
+    /// The correction passes of one `w × h` level under control: each
+    /// pass's guide uploaded to the backend, its result recorded into
+    /// `frames`. With [`Guides::restrict`] and a previous frame, only the
+    /// window that can differ is corrected (the stage gives the rest the
+    /// previous result). Returns the bounds of the pixels that differ from
+    /// the previous frame's, for the level below.
+    pub(super) fn correct_level<B: Backend>(
+        &self,
+        b: &B,
+        (state, parent): (&B::State, Option<&B::State>),
+        (level, region): (usize, Rect),
+        c: &Control<'_>,
+        window: Option<[usize; 4]>,
+        mut frames: Option<&mut Frames>,
+    ) -> Result<Option<[usize; 4]>, SynthError> {
+        let (w, h) = (region.width(), region.height());
+        let lg = c.guides.levels.get(level);
+        let before = c.prev.and_then(|f| f.levels.get(level));
+        let mut last_result = None;
+        for pass in 0..self.params.passes as usize {
+            let last = before.and_then(|b| b.get(pass));
+            let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
+                (Some(r), Some(weights)) => Some(Coherence {
+                    coords: &r.coords,
+                    offsets: &r.offsets,
+                    weights,
+                }),
+                _ => None,
+            };
+            let guide = Guide {
+                level: level as u32,
+                targets: lg.and_then(|g| g.targets.as_deref()),
+                allowed: lg.and_then(|g| g.allowed.as_deref()),
+                coherence,
+                window,
+                origin: [region.x0 as u32, region.y0 as u32],
+            };
+            let g = b.upload_guide(&guide, w, h)?;
+            for &(px, py) in &SUBPASSES {
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: self.params.prior,
+                };
+                b.correct_guided(state, parent, level, &p, &g);
+            }
+            let is_last = pass + 1 == self.params.passes as usize;
+            if frames.is_some() || (is_last && window.is_some()) {
+                let (coords, offsets) = b.download(state)?;
+                let r = PassResult { coords, offsets };
+                match frames.as_deref_mut() {
+                    Some(f) => f.levels[level].push(r),
+                    None => last_result = Some(r),
+                }
+            }
+        }
+        let current = last_result
+            .as_ref()
+            .or_else(|| frames.and_then(|f| f.levels[level].last()));
+        Ok(match (window, before.and_then(|b| b.last()), current) {
+            (Some(win), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r, win),
+            _ => Some([0, 0, w, h]),
+        })
     }
 
     /// The correction passes of one level's `window` on a crop of the level

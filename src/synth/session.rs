@@ -21,6 +21,7 @@ use super::state::{level_size, top_level};
 use super::{Frames, Guides, LevelGuide, Params, SynthError, Synthesizer, union};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
+use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::Arc;
 use std::time::Duration;
@@ -527,16 +528,16 @@ fn dirty_bounds(
     let a = |g: &LevelGuide, k: usize| g.allowed.as_ref().map_or(ALL_TYPES, |a| a[k]);
     let wt = |g: &LevelGuide, k: usize| g.weights.as_ref().map_or(W_FREE, |w| w[k]);
     let fresh_at = |k: usize| fresh.is_some_and(|f| f[k]);
-    let mut b: Option<[usize; 4]> = None;
-    for y in 0..h {
+    let row = |y: usize| {
         let r = y * w..(y + 1) * w;
         if same(&g.targets, &p.targets, r.clone())
             && same(&g.allowed, &p.allowed, r.clone())
             && same(&g.weights, &p.weights, r.clone())
             && !fresh.is_some_and(|f| f[r.clone()].contains(&true))
         {
-            continue;
+            return None;
         }
+        let mut b = None;
         for k in r {
             if t(g, k) != t(p, k)
                 || a(g, k) != a(p, k)
@@ -547,8 +548,9 @@ fn dirty_bounds(
                 b = union(b, Some([x, y, x + 1, y + 1]));
             }
         }
-    }
-    b
+        b
+    };
+    (0..h).into_par_iter().map(row).reduce(|| None, union)
 }
 
 /// Marks level-0 pixels within a constraint's reach unweighted.
