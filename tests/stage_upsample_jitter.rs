@@ -3,12 +3,17 @@
 //! parents (proptest: pyramid, virtual and wrapping steps) and on the real
 //! levels of syntheses from the default database and from a database of
 //! ../shared/dem crops. Without a GPU there is nothing to compare against:
-//! every test says so and passes.
+//! every test says so and passes. The CPU stage over a rectangle (an
+//! edit's re-synthesis) is checked against the whole level's on the CPU
+//! alone.
 
 use proptest::prelude::*;
 use terrasynth::database::layout::MARGIN;
+use terrasynth::level::state::State;
 use terrasynth::level::state::level_size;
-use terrasynth::stages::upsample_jitter::{Step, UpsampleParams};
+use terrasynth::stages::upsample_jitter::{
+    Step, UpsampleParams, upsample_jitter, upsample_jitter_rect,
+};
 
 mod common;
 use common::db::{default_db, real_syntheses};
@@ -54,6 +59,29 @@ proptest! {
         let p = UpsampleParams { seed, level: level as u32, jitter, step, origin };
         let runs = rig.upsample_jitter(&parent, (cw.max(2), ch.max(2)), level, &p);
         assert_agree(&runs, &format!("upsample_jitter to level {level} ({step:?})"));
+    }
+
+    #[test]
+    fn upsample_jitter_rect_is_the_whole_level_inside_and_keeps_the_rest(
+        w in 2usize..40, h in 2usize..40, r in prop::array::uniform4(0usize..84),
+        seed in any::<u32>(), bits in prop::collection::vec(any::<u32>(), 64),
+    ) {
+        let rig = rig(default_db());
+        let level = 0;
+        let parent = random_state(&rig.atlas[level + 1], w, h, &bits, 0);
+        let p = UpsampleParams { seed, level: 0, jitter: 102, step: Step::Pyramid, origin: [0, 0] };
+        let (cw, ch) = (2 * w, 2 * h);
+        let (whole, part) = (State::new(cw, ch), State::new(cw, ch));
+        upsample_jitter(&parent, &whole, Some(&rig.atlas[level]), &p);
+        let rect = [r[0].min(r[1]), r[2].min(r[3]), r[0].max(r[1]), r[2].max(r[3])];
+        upsample_jitter_rect(&parent, &part, Some(&rig.atlas[level]), &p, rect);
+        let untouched = State::new(1, 1);
+        for k in 0..cw * ch {
+            let (x, y) = (k % cw, k / cw);
+            let inside = (rect[0]..rect[2]).contains(&x) && (rect[1]..rect[3]).contains(&y);
+            let want = if inside { (whole.s(k), whole.v(k)) } else { (untouched.s(0), untouched.v(0)) };
+            prop_assert_eq!((part.s(k), part.v(k)), want, "pixel ({}, {})", x, y);
+        }
     }
 }
 

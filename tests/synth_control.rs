@@ -316,6 +316,17 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
         vec![Edit::SetConstraint(ConstraintId(1), p1b)],
         vec![Edit::RemoveConstraint(ConstraintId(2))],
         vec![],
+        // A paste rewrites the previous frame's results under it, and a
+        // freeze keeps them: the restricted frame must still match.
+        vec![Edit::Paste(Paste {
+            source: PasteSource::Terrain,
+            lasso: vec![(20.0, 150.0), (60.0, 150.0), (40.0, 190.0)],
+            offset: (110, -30),
+            delta_m: 80.0,
+        })],
+        vec![Edit::Freeze(Some(
+            (0..N * N).map(|k| (k % N) < 40 && (k / N) < 40).collect(),
+        ))],
     ];
     let mut fast = session(db);
     let mut full = session(db);

@@ -41,8 +41,24 @@ impl Backend for Cpu<'_, '_> {
     }
 
     fn upsample_jitter(&self, parent: &State, child: &State, level: usize, p: &UpsampleParams) {
+        let whole = [0, 0, child.width, child.height];
+        self.upsample_jitter_rect(parent, child, level, p, whole);
+    }
+
+    fn upsample_jitter_rect(
+        &self,
+        parent: &State,
+        child: &State,
+        level: usize,
+        p: &UpsampleParams,
+        rect: [usize; 4],
+    ) {
         let atlas = matches!(p.step, Step::Pyramid).then(|| &self.atlas[level]);
-        upsample_jitter::upsample_jitter(parent, child, atlas, p);
+        upsample_jitter::upsample_jitter_rect(parent, child, atlas, p, rect);
+    }
+
+    fn crops_windows(&self) -> bool {
+        true
     }
 
     fn correct(&self, st: &State, parent: Option<&State>, level: usize, p: &CorrectParams) {
@@ -72,6 +88,17 @@ impl Backend for Cpu<'_, '_> {
 
     fn reconstruct(&self, st: &State) -> Result<Vec<i32>, BackendError> {
         Ok(reconstruct::reconstruct(&self.atlas[0], self.heights, st))
+    }
+
+    fn reconstruct_rect(
+        &self,
+        st: &State,
+        prev: &[i32],
+        rect: [usize; 4],
+    ) -> Result<Vec<i32>, BackendError> {
+        let mut out = prev.to_vec();
+        reconstruct::reconstruct_rect(&self.atlas[0], self.heights, st, &mut out, rect);
+        Ok(out)
     }
 
     fn download(&self, st: &State) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {

@@ -83,6 +83,28 @@ pub trait Backend {
         level: usize,
         p: &UpsampleParams,
     );
+    /// [`Backend::upsample_jitter`] of which only the child pixels in
+    /// `rect` are read before being overwritten (an edit's restricted
+    /// re-synthesis); a backend may fill more. Default: the whole child.
+    fn upsample_jitter_rect(
+        &self,
+        parent: &Self::State,
+        child: &Self::State,
+        level: usize,
+        p: &UpsampleParams,
+        rect: [usize; 4],
+    ) {
+        let _ = rect;
+        self.upsample_jitter(parent, child, level, p);
+    }
+    /// Whether an edit's restricted re-synthesis should correct a level's
+    /// window on a crop of the level (`synth::restricted`) rather than on
+    /// the whole level: on the CPU the stage's writes outside the window
+    /// sweep the whole level in every subpass; a GPU does them in-kernel
+    /// and would pay a host round trip for the crop. Default: no.
+    fn crops_windows(&self) -> bool {
+        false
+    }
     /// One subpass of stage `correct` at database level `level`, in place;
     /// `parent` is the level above (the height prior's anchor), none at the
     /// coarsest corrected level.
@@ -115,6 +137,18 @@ pub trait Backend {
     /// Stage `reconstruct` of a level-0 state: fixed-point heights (see
     /// `stages::reconstruct`), row-major.
     fn reconstruct(&self, st: &Self::State) -> Result<Vec<i32>, BackendError>;
+    /// [`Backend::reconstruct`] where the heights can differ from `prev`
+    /// (the previous frame's, level-sized) only in `rect`: an edit's
+    /// re-synthesis. Default: the whole level.
+    fn reconstruct_rect(
+        &self,
+        st: &Self::State,
+        prev: &[i32],
+        rect: [usize; 4],
+    ) -> Result<Vec<i32>, BackendError> {
+        let _ = (prev, rect);
+        self.reconstruct(st)
+    }
     /// A copy of a state's coordinates and offsets, row-major.
     fn download(&self, st: &Self::State) -> Result<(Vec<Coord>, Vec<i32>), BackendError>;
     /// Moves a `width × height` raster of type sets to the backend.

@@ -39,33 +39,62 @@ const ROWS: usize = 16;
 
 /// Heights of level 0, row-major, in units × 2^8.
 pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
+    let mut out = vec![0i32; st.width * st.height];
+    reconstruct_rect(atlas, heights, st, &mut out, [0, 0, st.width, st.height]);
+    out
+}
+
+/// [`reconstruct`] of the pixels in `[x0, y0, x1, y1)` only, into `out`
+/// (level-sized; the rest is left as it is). An edit's re-synthesis
+/// changes S and V in a window, and a height depends on its 3×3
+/// neighbourhood only, so the previous frame's heights with the window
+/// widened by one pixel recomputed are the whole reconstruction.
+pub fn reconstruct_rect(
+    atlas: &AtlasLevel<'_>,
+    heights: &[u16],
+    st: &State,
+    out: &mut [i32],
+    [x0, y0, x1, y1]: [usize; 4],
+) {
     let (w, h) = (st.width, st.height);
-    let mut out = vec![0i32; w * h];
-    out.par_chunks_mut(w * ROWS)
+    assert_eq!(out.len(), w * h, "a level-sized output");
+    let (x1, y1) = (x1.min(w), y1.min(h));
+    if x0 >= x1 || y0 >= y1 {
+        return;
+    }
+    // The columns whose S and V the rect's predictions read.
+    let (xa, xb) = (x0.saturating_sub(1), (x1 + 1).min(w));
+    out[y0 * w..y1 * w]
+        .par_chunks_mut(w * ROWS)
         .enumerate()
         .for_each(|(b, block)| {
-            let y0 = b * ROWS;
-            let (ya, yb) = (y0.saturating_sub(1), (y0 + block.len() / w + 1).min(h));
-            // Per pixel of rows ya..yb: the index of its rounded texel, its
-            // exemplar's row stride, and its offset V.
-            let base: Vec<(i32, i32, i32)> = (ya * w..yb * w)
-                .map(|n| {
+            let y_start = y0 + b * ROWS;
+            let (ya, yb) = (
+                y_start.saturating_sub(1),
+                (y_start + block.len() / w + 1).min(h),
+            );
+            // Per pixel of rows ya..yb, columns xa..xb: the index of its
+            // rounded texel, its exemplar's row stride, and its offset V.
+            let cols = xb - xa;
+            let mut base: Vec<(i32, i32, i32)> = Vec::with_capacity((yb - ya) * cols);
+            for y in ya..yb {
+                base.extend((y * w + xa..y * w + xb).map(|n| {
                     let s = st.s(n);
                     let (tx, ty) = (round(s.x), round(s.y));
                     let stride = atlas.columns[tx as usize].stride as i32;
                     (atlas.index(tx, ty) as i32, stride, st.v(n))
-                })
-                .collect();
+                }));
+            }
             for (r, row) in block.chunks_mut(w).enumerate() {
-                let y = y0 + r;
-                for (x, o) in row.iter_mut().enumerate() {
+                let y = y_start + r;
+                for (x, o) in row.iter_mut().enumerate().take(x1).skip(x0) {
                     let (mut sum, mut count) = (0i32, 0i32);
                     for dy in -1..=1i32 {
                         let ny = y as i32 + dy;
                         if ny < 0 || ny >= h as i32 {
                             continue;
                         }
-                        let line = &base[(ny as usize - ya) * w..(ny as usize - ya + 1) * w];
+                        let line = &base[(ny as usize - ya) * cols..(ny as usize - ya + 1) * cols];
                         for dx in -1..=1i32 {
                             let nx = x as i32 + dx;
                             if nx < 0 || nx >= w as i32 {
@@ -74,7 +103,7 @@ pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i
                             // S(n) is interior (two texels from every
                             // exemplar edge), so the texel one step away is
                             // in its exemplar, at index − dx − dy·stride.
-                            let (k, stride, v) = line[nx as usize];
+                            let (k, stride, v) = line[nx as usize - xa];
                             let e = heights[(k - dx - dy * stride) as usize] as i32;
                             sum += (e + v) << HEIGHT_FRAC_BITS;
                             count += 1;
@@ -84,7 +113,6 @@ pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i
                 }
             }
         });
-    out
 }
 
 /// `ReconstructParams` of `kernels/reconstruct.wgsl` (padded to 16 bytes,

@@ -80,11 +80,26 @@ pub fn upsample_jitter(
     atlas: Option<&AtlasLevel<'_>>,
     p: &UpsampleParams,
 ) {
+    let rect = [0, 0, child.width, child.height];
+    upsample_jitter_rect(parent, child, atlas, p, rect);
+}
+
+/// [`upsample_jitter`] of the child pixels in `[x0, y0, x1, y1)` only (the
+/// rest keep their state): an edit's restricted re-synthesis reads the
+/// upsampled values only around the window it corrects.
+pub fn upsample_jitter_rect(
+    parent: &State,
+    child: &State,
+    atlas: Option<&AtlasLevel<'_>>,
+    p: &UpsampleParams,
+    [x0, y0, x1, y1]: [usize; 4],
+) {
     let (cw, pw) = (child.width, parent.width);
     let [ox, oy] = p.origin;
     debug_assert!(ox % 2 == 0 && oy % 2 == 0, "odd origin {:?}", p.origin);
-    (0..child.height).into_par_iter().for_each(|y| {
-        for x in 0..cw {
+    let x1 = x1.min(cw);
+    (y0..y1.min(child.height)).into_par_iter().for_each(|y| {
+        for x in x0..x1 {
             let pi = (y / 2) * pw + x / 2;
             let (cx, cy) = ((x & 1) as i32, (y & 1) as i32);
             let s = parent.s(pi);

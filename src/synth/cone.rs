@@ -106,7 +106,7 @@ impl Rect {
     }
 
     /// The corner moved down to even coordinates (see the module docs).
-    fn even(self) -> Rect {
+    pub(super) fn even(self) -> Rect {
         Rect {
             x0: self.x0 & !1,
             y0: self.y0 & !1,
@@ -115,11 +115,23 @@ impl Rect {
     }
 }
 
+/// `data` (over `from`) cropped to `to` (inside `from`).
+pub(crate) fn crop<T: Copy>(data: &[T], from: Rect, to: Rect) -> Vec<T> {
+    let r = to.within(from);
+    (r.y0..r.y1)
+        .flat_map(|y| {
+            data[y * from.width() + r.x0..y * from.width() + r.x1]
+                .iter()
+                .copied()
+        })
+        .collect()
+}
+
 /// The pixels of the level above a level-`i` region that its stages read
 /// (module docs): `[x0 / 2, ⌈x1 / 2⌉)`, to the parent level's edge when the
 /// region reaches the world's edge. `size` and `parent` are the two
 /// levels' world sizes.
-fn parent_view(r: Rect, size: (usize, usize), parent: (usize, usize)) -> Rect {
+pub(super) fn parent_view(r: Rect, size: (usize, usize), parent: (usize, usize)) -> Rect {
     let end = |v: usize, n: usize, pn: usize| if v == n { pn } else { v.div_ceil(2) };
     Rect {
         x0: r.x0 / 2,

@@ -18,6 +18,7 @@ pub mod coarse;
 pub mod cone;
 pub mod control;
 mod params;
+mod restricted;
 pub mod session;
 pub mod source_map;
 mod window;
@@ -33,12 +34,13 @@ use atlas::AtlasLevel;
 use coarse::Start;
 use cone::{Cone, Rect};
 use fixed::FRAC_BITS;
-use stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
+use restricted::LevelBuffers;
+use stages::correct::{CorrectParams, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::time::{Duration, Instant};
-use window::{REACH_PER_SUBPASS, changed_bounds, double, widen};
+use window::{REACH_PER_SUBPASS, widen};
 
 pub use params::{
     Guides, LevelGuide, LevelMaps, LevelTiming, Params, SynthError, Synthesis, Timings,
@@ -267,6 +269,7 @@ impl<'db> Synthesizer<'db> {
         let mut kept = Vec::new();
         let mut frames = control.filter(|c| c.record).map(|_| Frames {
             levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
+            heights: Vec::new(),
         });
         // Without a device clock, the loop waits after each stage so that
         // wall clock measures it; with one, stages queue back to back.
@@ -276,21 +279,47 @@ impl<'db> Synthesizer<'db> {
         // The level above, kept through this level's correction: its
         // offsets anchor the height prior (`correct` module docs).
         let mut parent: Option<B::State> = None;
+        let mut parent_size = (0, 0);
         // Bounds of the pixels of the level above that differ from the
         // previous frame (restricted re-synthesis only).
         let mut changed_parent: Option<[usize; 4]> = None;
+        // The window corrected at level 0 (restricted re-synthesis only).
+        let mut window0 = None;
         for level in (0..=top).rev() {
             let region = cone.region(level);
             let (w, h) = (region.width(), region.height());
+            let window = match control {
+                Some(c) if level <= l => self.window(c, level, (w, h), changed_parent),
+                _ => None,
+            };
             if level < top {
                 let t = Instant::now();
                 let above = match cone.parent_crop(level) {
-                    Some(c) => b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?,
-                    None => state,
+                    Some(c) => {
+                        parent_size = (c.width(), c.height());
+                        b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?
+                    }
+                    None => {
+                        let r = cone.region(level + 1);
+                        parent_size = (r.width(), r.height());
+                        state
+                    }
                 };
                 let child = b.alloc(w, h)?;
                 let p = self.upsample_params(seed, level, region);
-                b.upsample_jitter(&above, &child, level, &p);
+                // Correcting a window with coherence reads the upsampled
+                // pixels within a subpass's reach of it; the rest take the
+                // previous frame's results before anything reads them.
+                let coherent = control
+                    .and_then(|c| c.guides.levels.get(level))
+                    .is_some_and(|g| g.weights.is_some());
+                match window.filter(|_| coherent) {
+                    Some(win) => {
+                        let read = widen(win, REACH_PER_SUBPASS, w, h);
+                        b.upsample_jitter_rect(&above, &child, level, &p, read);
+                    }
+                    None => b.upsample_jitter(&above, &child, level, &p),
+                }
                 if !device_clock {
                     b.finish()?;
                 }
@@ -314,14 +343,29 @@ impl<'db> Synthesizer<'db> {
                         }
                     }
                     Some(c) => {
-                        changed_parent = self.correct_level(
-                            b,
-                            (&state, parent.as_ref()),
-                            (level, region),
-                            c,
-                            changed_parent,
-                            frames.as_mut(),
-                        )?;
+                        changed_parent = match window.filter(|_| self.can_crop(b, c, level)) {
+                            Some(win) => {
+                                let buf = LevelBuffers {
+                                    state: &state,
+                                    parent: parent.as_ref().map(|p| (p, parent_size)),
+                                    level,
+                                    region,
+                                };
+                                let (changed, corrected) =
+                                    self.correct_cropped(b, buf, c, win, frames.as_mut())?;
+                                state = corrected;
+                                changed
+                            }
+                            None => self.correct_level(
+                                b,
+                                (&state, parent.as_ref()),
+                                (level, region),
+                                c,
+                                window,
+                                frames.as_mut(),
+                            )?,
+                        };
+                        window0 = window;
                     }
                 }
                 if !device_clock {
@@ -343,8 +387,24 @@ impl<'db> Synthesizer<'db> {
         }
         kept.reverse();
         let t = Instant::now();
-        let fixed = b.reconstruct(&state)?;
+        let prev_heights = control
+            .and_then(|c| c.prev)
+            .map(|f| &f.heights)
+            .filter(|h| h.len() == cone.region(0).width() * cone.region(0).height());
+        let fixed = match (window0, prev_heights) {
+            // Heights depend on their 3×3 neighbourhood's S and V, which
+            // differ from the previous frame's only inside the window.
+            (Some(win), Some(prev)) => {
+                let r = cone.region(0);
+                let read = widen(win, 1, r.width(), r.height());
+                b.reconstruct_rect(&state, prev, read)?
+            }
+            _ => b.reconstruct(&state)?,
+        };
         let heightfield = self.to_metres(&fixed, cone)?;
+        if let Some(f) = frames.as_mut() {
+            f.heights = fixed;
+        }
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
         if let Some(times) = b.device_times()? {
@@ -369,79 +429,6 @@ impl<'db> Synthesizer<'db> {
             },
             frames,
         ))
-    }
-
-    /// The correction passes of one `w × h` level under control: each
-    /// pass's guide uploaded to the backend, its result recorded into
-    /// `frames`. With [`Guides::restrict`] and a previous frame, only the
-    /// window that can differ is corrected (the stage gives the rest the
-    /// previous result). Returns the bounds of the pixels that differ from
-    /// the previous frame's, for the level below.
-    fn correct_level<B: Backend>(
-        &self,
-        b: &B,
-        (state, parent): (&B::State, Option<&B::State>),
-        (level, region): (usize, Rect),
-        c: &Control<'_>,
-        changed_parent: Option<[usize; 4]>,
-        mut frames: Option<&mut Frames>,
-    ) -> Result<Option<[usize; 4]>, SynthError> {
-        let (w, h) = (region.width(), region.height());
-        let lg = c.guides.levels.get(level);
-        let before = c.prev.and_then(|f| f.levels.get(level));
-        let window = match (c.guides.restrict, before) {
-            (true, Some(b)) if !b.is_empty() => {
-                let seeds = union(lg.and_then(|g| g.dirty), changed_parent.map(double));
-                let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
-                Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
-            }
-            _ => None,
-        };
-        let mut last_result = None;
-        for pass in 0..self.params.passes as usize {
-            let last = before.and_then(|b| b.get(pass));
-            let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
-                (Some(r), Some(weights)) => Some(Coherence {
-                    coords: &r.coords,
-                    offsets: &r.offsets,
-                    weights,
-                }),
-                _ => None,
-            };
-            let guide = Guide {
-                level: level as u32,
-                targets: lg.and_then(|g| g.targets.as_deref()),
-                allowed: lg.and_then(|g| g.allowed.as_deref()),
-                coherence,
-                window,
-                origin: [region.x0 as u32, region.y0 as u32],
-            };
-            let g = b.upload_guide(&guide, w, h)?;
-            for &(px, py) in &SUBPASSES {
-                let p = CorrectParams {
-                    px,
-                    py,
-                    prior: self.params.prior,
-                };
-                b.correct_guided(state, parent, level, &p, &g);
-            }
-            let is_last = pass + 1 == self.params.passes as usize;
-            if frames.is_some() || (is_last && window.is_some()) {
-                let (coords, offsets) = b.download(state)?;
-                let r = PassResult { coords, offsets };
-                match frames.as_deref_mut() {
-                    Some(f) => f.levels[level].push(r),
-                    None => last_result = Some(r),
-                }
-            }
-        }
-        let current = last_result
-            .as_ref()
-            .or_else(|| frames.and_then(|f| f.levels[level].last()));
-        Ok(match (window, before.and_then(|b| b.last()), current) {
-            (Some(_), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r),
-            _ => Some([0, 0, w, h]),
-        })
     }
 
     /// The database this synthesizer draws from.

@@ -9,6 +9,7 @@
 //! region that can change is re-synthesized (exactly, see
 //! [`crate::synth::Guides::restrict`]).
 
+use super::control::Target;
 use super::control::{
     Blend, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED, inside,
 };
@@ -17,9 +18,11 @@ use super::stages::correct::ALL_TYPES;
 use super::stages::reduce_types::reduce_types;
 use super::stages::reduce_weights::reduce_weights;
 use super::state::{level_size, top_level};
-use super::{Frames, Guides, LevelGuide, Params, SynthError, Synthesizer};
+use super::{Frames, Guides, LevelGuide, Params, SynthError, Synthesizer, union};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
+use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::Arc;
 use std::time::Duration;
 use thiserror::Error;
@@ -387,44 +390,16 @@ impl<'db> Session<'db> {
         // weights (a weight that changes switches how the previous result
         // competes; only freezing is safe, as it keeps the previous result).
         let prev = self.guides.as_ref();
+        let none = LevelGuide::default();
         for (i, g) in levels.iter_mut().enumerate() {
             let (w, h) = level_size(self.width, self.height, i);
-            let p = prev.and_then(|p| p.levels.get(i));
-            let none = LevelGuide::default();
-            let p = p.unwrap_or(&none);
-            let mut b: Option<[usize; 4]> = None;
-            for y in 0..h {
-                for x in 0..w {
-                    let k = y * w + x;
-                    let t = |g: &LevelGuide| g.targets.as_ref().map(|t| t[k]);
-                    let a = |g: &LevelGuide| g.allowed.as_ref().map_or(ALL_TYPES, |a| a[k]);
-                    let wt = |g: &LevelGuide| g.weights.as_ref().map_or(W_FREE, |w| w[k]);
-                    let same_t = t(g).unwrap_or(super::control::Target::NONE)
-                        == t(p).unwrap_or(super::control::Target::NONE);
-                    if !same_t
-                        || a(g) != a(p)
-                        || (wt(g) != wt(p) && wt(g) != W_FROZEN)
-                        || self.fresh_paste(i, k)
-                    {
-                        let px = [x, y, x + 1, y + 1];
-                        b = Some(b.map_or(px, |b| {
-                            [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)]
-                        }));
-                    }
-                }
-            }
-            g.dirty = b;
+            let p = prev.and_then(|p| p.levels.get(i)).unwrap_or(&none);
+            g.dirty = dirty_bounds(g, p, self.fresh.get(i).map(|f| &f[..]), w, h);
         }
         Guides {
             levels,
             restrict: self.restrict && self.coherence,
         }
-    }
-
-    /// Whether level pixel k received pasted values in this step (its
-    /// previous results were overwritten).
-    fn fresh_paste(&self, level: usize, k: usize) -> bool {
-        self.fresh.get(level).is_some_and(|f| f[k])
     }
 }
 
@@ -529,6 +504,54 @@ impl Session<'_> {
             }
         }
     }
+}
+
+/// Bounds of the pixels of a `w × h` level whose inputs in `g` differ from
+/// the previous frame's `p`, or that received pasted values in this step
+/// (`fresh`: their previous results were overwritten). Most rows of an
+/// edit are unchanged: a row whose rasters compare equal as slices is
+/// skipped without looking at its pixels.
+fn dirty_bounds(
+    g: &LevelGuide,
+    p: &LevelGuide,
+    fresh: Option<&[bool]>,
+    w: usize,
+    h: usize,
+) -> Option<[usize; 4]> {
+    fn same<T: PartialEq>(a: &Option<Vec<T>>, b: &Option<Vec<T>>, r: Range<usize>) -> bool {
+        match (a, b) {
+            (Some(a), Some(b)) => a[r.clone()] == b[r],
+            (None, None) => true,
+            _ => false,
+        }
+    }
+    let t = |g: &LevelGuide, k: usize| g.targets.as_ref().map_or(Target::NONE, |t| t[k]);
+    let a = |g: &LevelGuide, k: usize| g.allowed.as_ref().map_or(ALL_TYPES, |a| a[k]);
+    let wt = |g: &LevelGuide, k: usize| g.weights.as_ref().map_or(W_FREE, |w| w[k]);
+    let fresh_at = |k: usize| fresh.is_some_and(|f| f[k]);
+    let row = |y: usize| {
+        let r = y * w..(y + 1) * w;
+        if same(&g.targets, &p.targets, r.clone())
+            && same(&g.allowed, &p.allowed, r.clone())
+            && same(&g.weights, &p.weights, r.clone())
+            && !fresh.is_some_and(|f| f[r.clone()].contains(&true))
+        {
+            return None;
+        }
+        let mut b = None;
+        for k in r {
+            if t(g, k) != t(p, k)
+                || a(g, k) != a(p, k)
+                || (wt(g, k) != wt(p, k) && wt(g, k) != W_FROZEN)
+                || fresh_at(k)
+            {
+                let x = k - y * w;
+                b = union(b, Some([x, y, x + 1, y + 1]));
+            }
+        }
+        b
+    };
+    (0..h).into_par_iter().map(row).reduce(|| None, union)
 }
 
 /// Marks level-0 pixels within a constraint's reach unweighted.

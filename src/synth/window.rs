@@ -16,6 +16,10 @@ pub(super) const REACH_PER_SUBPASS: usize = 2;
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Frames {
     pub levels: Vec<Vec<PassResult>>,
+    /// Level 0's fixed-point heights (stage `reconstruct`'s output), which
+    /// an edit's re-synthesis recomputes only where S and V can change;
+    /// empty where not recorded.
+    pub heights: Vec<i32>,
 }
 
 /// One level's S and V after one pass.
@@ -54,19 +58,23 @@ pub(super) fn widen(b: [usize; 4], by: usize, w: usize, h: usize) -> [usize; 4] 
     ]
 }
 
-/// Bounds of the pixels whose S or V (row-major, `width` wide) differ from
-/// `r`; None if none do.
+/// Bounds of the pixels in `[x0, y0, x1, y1)` whose S or V (row-major,
+/// `width` wide) differ from `r`; None if none do. Outside the window a
+/// restricted re-synthesis keeps `r` as it is, so only the window is read.
 pub(super) fn changed_bounds(
     coords: &[Coord],
     offsets: &[i32],
     width: usize,
     r: &PassResult,
+    [x0, y0, x1, y1]: [usize; 4],
 ) -> Option<[usize; 4]> {
     let mut b: Option<[usize; 4]> = None;
-    for (i, (c, v)) in coords.iter().zip(offsets).enumerate() {
-        if *c != r.coords[i] || *v != r.offsets[i] {
-            let (x, y) = (i % width, i / width);
-            b = union(b, Some([x, y, x + 1, y + 1]));
+    for y in y0..y1 {
+        for i in y * width + x0..y * width + x1 {
+            if coords[i] != r.coords[i] || offsets[i] != r.offsets[i] {
+                let x = i % width;
+                b = union(b, Some([x, y, x + 1, y + 1]));
+            }
         }
     }
     b

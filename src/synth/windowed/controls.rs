@@ -23,10 +23,10 @@
 //! window's second frame is small anyway.
 
 use super::paste::{self, PasteGeometry};
-use super::pyramid::{crop, footprints, type_sets, weight_sets};
+use super::pyramid::{footprints, type_sets, weight_sets};
 use super::{WindowError, check_window};
 use crate::heightfield::Heightfield;
-use crate::synth::cone::{Cone, Rect};
+use crate::synth::cone::{Cone, Rect, crop};
 use crate::synth::control::{Blend, Constraint, FIRST_LEVEL, Paste, UNCONSTRAINED};
 use crate::synth::session::{PASTE_MARGIN, W_COHERENT, W_FREE, W_FROZEN};
 use crate::synth::state::{level_size, top_level};
@@ -101,6 +101,7 @@ impl Synthesizer<'_> {
                             .collect()
                     })
                     .collect(),
+                heights: Vec::new(),
             };
             let guides = self.window_guides(&cone, last, c, Some(&pastes))?;
             let two = self.run_cone(&cone, seed, &guides, Some(&prev), false)?.0;

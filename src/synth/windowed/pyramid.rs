@@ -34,18 +34,6 @@ pub(super) fn footprints(cone: &Cone, last: usize) -> Vec<Rect> {
     fp
 }
 
-/// `data` (over `from`) cropped to `to` (inside `from`).
-pub(super) fn crop<T: Copy>(data: &[T], from: Rect, to: Rect) -> Vec<T> {
-    let r = to.within(from);
-    (r.y0..r.y1)
-        .flat_map(|y| {
-            data[y * from.width() + r.x0..y * from.width() + r.x1]
-                .iter()
-                .copied()
-        })
-        .collect()
-}
-
 /// R^i over the footprints from painted level-0 type ids (over
 /// `fp[0] ∩ world`, [`UNCONSTRAINED`] = none): as `Session`'s guides, a
 /// painted pixel allows its type, any other (the padding of a world

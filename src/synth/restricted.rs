@@ -1,0 +1,252 @@
+//! A level's correction under control ([`Synthesizer::correct_level`]),
+//! and restricted re-synthesis
+//! ([`Guides::restrict`](super::Guides::restrict)): an edit corrects, at
+//! each level, only the window that can differ from the previous frame.
+//!
+//! On a backend that asks for it ([`Backend::crops_windows`]: the CPU),
+//! the window's passes run on a crop of the level — the window and the
+//! two-pixel ring its subpasses read — rather than on the whole level. The
+//! stage's rule for pixels outside a window (they take the previous frame's
+//! result of the pass, [`correct::keep_outside`]) then writes only the
+//! ring, instead of sweeping every pixel of the level in every subpass (at
+//! 1024² the sweeps cost several times the window's own correction). The
+//! level afterwards is the previous frame's result with the window's
+//! pixels replaced: what the whole-level subpasses leave, byte for byte.
+//!
+//! The crop's corner is even, so that its parents stay at p / 2 in the
+//! parent's crop ([`parent_view`]); the ring keeps every corrected pixel
+//! two pixels from a crop edge that is not the level's, so no read of the
+//! stage (reach two, [`REACH_PER_SUBPASS`]; the height prior's parent
+//! neighbour) meets an edge the whole level does not have; and
+//! [`Guide::origin`] makes the stage's hashes see absolute coordinates.
+//!
+//! [`correct::keep_outside`]: crate::stages::correct::keep_outside
+
+use super::cone::{Rect, crop, parent_view};
+use super::window::{REACH_PER_SUBPASS, changed_bounds, double, union, widen};
+use super::{Control, Frames, PassResult, SynthError, Synthesizer};
+use crate::backend::Backend;
+use crate::level::state::State;
+use crate::stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
+use rayon::prelude::*;
+
+/// One level's buffers for [`Synthesizer::correct_cropped`]: the state,
+/// the level above and its size, and where the level lies.
+pub(super) struct LevelBuffers<'s, S> {
+    pub state: &'s S,
+    pub parent: Option<(&'s S, (usize, usize))>,
+    pub level: usize,
+    pub region: Rect,
+}
+
+impl Synthesizer<'_> {
+    /// The window of a `w × h` level that restricted re-synthesis corrects
+    /// ([`super::Guides::restrict`], with a previous frame of the level): the
+    /// pixels whose own inputs changed and the children of the parent's
+    /// changed pixels, widened by how far the level's subpasses carry a
+    /// change. None: the whole level.
+    pub(super) fn window(
+        &self,
+        c: &Control<'_>,
+        level: usize,
+        (w, h): (usize, usize),
+        changed_parent: Option<[usize; 4]>,
+    ) -> Option<[usize; 4]> {
+        let before = c.prev.and_then(|f| f.levels.get(level))?;
+        if !c.guides.restrict || before.is_empty() {
+            return None;
+        }
+        let dirty = c.guides.levels.get(level).and_then(|g| g.dirty);
+        let seeds = union(dirty, changed_parent.map(double));
+        let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
+        Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
+    }
+
+    /// Whether the level's `window` can be corrected on a crop: the backend
+    /// asks for it and every pass has the previous frame's result and
+    /// weights (the coherence that decides the pixels outside the window).
+    pub(super) fn can_crop<B: Backend>(&self, b: &B, c: &Control<'_>, level: usize) -> bool {
+        let passes = self.params.passes as usize;
+        b.crops_windows()
+            && passes > 0
+            && c.prev
+                .and_then(|f| f.levels.get(level))
+                .is_some_and(|r| r.len() >= passes)
+            && c.guides
+                .levels
+                .get(level)
+                .is_some_and(|g| g.weights.is_some())
+    }
+
+    /// The correction passes of one `w × h` level under control: each
+    /// pass's guide uploaded to the backend, its result recorded into
+    /// `frames`. With [`Guides::restrict`] and a previous frame, only the
+    /// window that can differ is corrected (the stage gives the rest the
+    /// previous result). Returns the bounds of the pixels that differ from
+    /// the previous frame's, for the level below.
+    pub(super) fn correct_level<B: Backend>(
+        &self,
+        b: &B,
+        (state, parent): (&B::State, Option<&B::State>),
+        (level, region): (usize, Rect),
+        c: &Control<'_>,
+        window: Option<[usize; 4]>,
+        mut frames: Option<&mut Frames>,
+    ) -> Result<Option<[usize; 4]>, SynthError> {
+        let (w, h) = (region.width(), region.height());
+        let lg = c.guides.levels.get(level);
+        let before = c.prev.and_then(|f| f.levels.get(level));
+        let mut last_result = None;
+        for pass in 0..self.params.passes as usize {
+            let last = before.and_then(|b| b.get(pass));
+            let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
+                (Some(r), Some(weights)) => Some(Coherence {
+                    coords: &r.coords,
+                    offsets: &r.offsets,
+                    weights,
+                }),
+                _ => None,
+            };
+            let guide = Guide {
+                level: level as u32,
+                targets: lg.and_then(|g| g.targets.as_deref()),
+                allowed: lg.and_then(|g| g.allowed.as_deref()),
+                coherence,
+                window,
+                origin: [region.x0 as u32, region.y0 as u32],
+            };
+            let g = b.upload_guide(&guide, w, h)?;
+            for &(px, py) in &SUBPASSES {
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: self.params.prior,
+                };
+                b.correct_guided(state, parent, level, &p, &g);
+            }
+            let is_last = pass + 1 == self.params.passes as usize;
+            if frames.is_some() || (is_last && window.is_some()) {
+                let (coords, offsets) = b.download(state)?;
+                let r = PassResult { coords, offsets };
+                match frames.as_deref_mut() {
+                    Some(f) => f.levels[level].push(r),
+                    None => last_result = Some(r),
+                }
+            }
+        }
+        let current = last_result
+            .as_ref()
+            .or_else(|| frames.and_then(|f| f.levels[level].last()));
+        Ok(match (window, before.and_then(|b| b.last()), current) {
+            (Some(win), Some(r), Some(cur)) => changed_bounds(&cur.coords, &cur.offsets, w, r, win),
+            _ => Some([0, 0, w, h]),
+        })
+    }
+
+    /// The correction passes of one level's `window` on a crop of the level
+    /// (module docs), each pass's result recorded into `frames`. Returns
+    /// the bounds of the pixels that differ from the previous frame's and
+    /// the corrected level.
+    pub(super) fn correct_cropped<B: Backend>(
+        &self,
+        b: &B,
+        buf: LevelBuffers<'_, B::State>,
+        c: &Control<'_>,
+        window: [usize; 4],
+        mut frames: Option<&mut Frames>,
+    ) -> Result<(Option<[usize; 4]>, B::State), SynthError> {
+        let LevelBuffers {
+            state,
+            parent,
+            level,
+            region,
+        } = buf;
+        let (w, h) = (region.width(), region.height());
+        let level_rect = Rect::new(0, 0, w, h);
+        let before = &c.prev.expect("checked by can_crop").levels[level];
+        let lg = &c.guides.levels[level];
+        let [wx0, wy0, wx1, wy1] = widen(window, REACH_PER_SUBPASS, w, h);
+        let cr = Rect {
+            x0: wx0,
+            y0: wy0,
+            x1: wx1,
+            y1: wy1,
+        }
+        .even();
+        let sub = b.crop(state, [cr.x0, cr.y0, cr.x1, cr.y1])?;
+        let parent_sub = match parent {
+            Some((p, size)) => {
+                let v = parent_view(cr, (w, h), size);
+                Some(b.crop(p, [v.x0, v.y0, v.x1, v.y1])?)
+            }
+            None => None,
+        };
+        let targets = lg.targets.as_ref().map(|t| crop(t, level_rect, cr));
+        let allowed = lg.allowed.as_ref().map(|a| crop(a, level_rect, cr));
+        let weights = crop(lg.weights.as_ref().expect("checked"), level_rect, cr);
+        let (a, z) = (window[0] - cr.x0, window[2] - cr.x0);
+        let local = [a, window[1] - cr.y0, z, window[3] - cr.y0];
+        let mut last = None;
+        for (pass, prev) in before.iter().enumerate().take(self.params.passes as usize) {
+            let (coords, offsets) = (
+                crop(&prev.coords, level_rect, cr),
+                crop(&prev.offsets, level_rect, cr),
+            );
+            let guide = Guide {
+                level: level as u32,
+                targets: targets.as_deref(),
+                allowed: allowed.as_deref(),
+                coherence: Some(Coherence {
+                    coords: &coords,
+                    offsets: &offsets,
+                    weights: &weights,
+                }),
+                window: Some(local),
+                origin: [(region.x0 + cr.x0) as u32, (region.y0 + cr.y0) as u32],
+            };
+            let g = b.upload_guide(&guide, cr.width(), cr.height())?;
+            for &(px, py) in &SUBPASSES {
+                let p = CorrectParams {
+                    px,
+                    py,
+                    prior: self.params.prior,
+                };
+                b.correct_guided(&sub, parent_sub.as_ref(), level, &p, &g);
+            }
+            let is_last = pass + 1 == self.params.passes as usize;
+            if frames.is_some() || is_last {
+                // The pass's result: the previous frame's with the
+                // window's pixels replaced.
+                let (sc, so) = b.download(&sub)?;
+                let mut r = prev.clone();
+                for y in window[1]..window[3] {
+                    let (to, from) = (y * w + window[0], (y - cr.y0) * cr.width() + a);
+                    r.coords[to..to + z - a].copy_from_slice(&sc[from..from + z - a]);
+                    r.offsets[to..to + z - a].copy_from_slice(&so[from..from + z - a]);
+                }
+                match frames.as_deref_mut() {
+                    Some(f) => f.levels[level].push(r),
+                    None => last = Some(r),
+                }
+            }
+        }
+        let last = last
+            .as_ref()
+            .or_else(|| frames.and_then(|f| f.levels[level].last()))
+            .expect("passes > 0 (checked by can_crop)");
+        let prev_last = before.last().expect("checked by can_crop");
+        let changed = changed_bounds(&last.coords, &last.offsets, w, prev_last, window);
+        Ok((changed, b.upload(to_state(last, w, h))?))
+    }
+}
+
+/// A host state holding one pass's results.
+fn to_state(r: &PassResult, w: usize, h: usize) -> State {
+    let st = State::new(w, h);
+    (0..h).into_par_iter().for_each(|y| {
+        for i in y * w..(y + 1) * w {
+            st.set(i, r.coords[i], r.offsets[i]);
+        }
+    });
+    st
+}
