@@ -159,7 +159,47 @@ struct Pending {
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of row `y`, all at least two
 /// texels inside the level, writing each result as it is found.
+///
+/// On x86-64 CPUs with AVX2 the same code runs compiled for AVX2 (picked at
+/// run time; the baseline build targets SSE2): the `wide` vectors and the
+/// integer arithmetic give the same results on either, only faster.
 pub fn correct_span<const P: u32>(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    parent: Option<&State>,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    g: &Guide<'_>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2, the one feature the function
+        // enables (checked just above).
+        unsafe { span_avx2::<P>(atlas, st, parent, y, x0, x1, g) };
+        return;
+    }
+    span::<P>(atlas, st, parent, y, x0, x1, g);
+}
+
+/// [`span`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn span_avx2<const P: u32>(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    parent: Option<&State>,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    g: &Guide<'_>,
+) {
+    span::<P>(atlas, st, parent, y, x0, x1, g);
+}
+
+/// [`correct_span`] for any instruction set.
+#[inline(always)]
+fn span<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
     parent: Option<&State>,
@@ -180,6 +220,7 @@ pub fn correct_span<const P: u32>(
 /// One chunk `[x0, x1)` of a span. Reading the neighbours up front is safe:
 /// a subpass reads only pixels of other parity classes (which it never
 /// writes), and each pixel's own coordinate before the pixel is written.
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn correct_chunk<const P: u32>(
     atlas: &AtlasLevel<'_>,
@@ -207,6 +248,9 @@ fn correct_chunk<const P: u32>(
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
     for i in 0..n + LOOKAHEAD {
+        if i + LOOKAHEAD < n {
+            prefetch_similar(atlas, grid, 2 * (i + LOOKAHEAD) + 2);
+        }
         if i < n {
             gather(atlas, grid, 2 * i + 2, &mut ring[i % RING]);
         }
@@ -232,6 +276,21 @@ fn correct_chunk<const P: u32>(
 #[inline(always)]
 fn at(grid: &[[Tap; GRID_COLS]; 5], c: usize, dx: i32, dy: i32) -> &Tap {
     &grid[(2 + dy) as usize][(c as i32 + dx) as usize]
+}
+
+/// Prefetches the similarity entries the gathering of the pixel in grid
+/// column `c` will read, those of `u = S(p + Δ) − Δ` for the three Δ of
+/// its column (in a coherent patch all nine u coincide with these). The
+/// first read of an atlas row near u is this one: gathering's own
+/// prefetches cover only the texels that scoring reads later, and the
+/// profile showed the `similar` load as the costliest instruction.
+#[inline(always)]
+fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize) {
+    let similar = atlas.level.similar;
+    for dy in -1..=1 {
+        let n = at(grid, c, 0, dy);
+        prefetch_line((&similar[(n.idx - dy * n.stride) as usize] as *const u32).cast());
+    }
 }
 
 /// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
