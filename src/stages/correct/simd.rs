@@ -234,6 +234,9 @@ fn correct_chunk<const P: u32>(
 ) {
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
+    // True by construction; stated so that the compiler knows every grid
+    // column a pixel reads (≤ 2n + 2) is inside the grid.
+    assert!(n <= CHUNK);
     // Grid column j is level column x0 − 2 + j; grid row r is level row
     // y − 2 + r. Rows y ± 2 are read only at odd offsets from the class.
     let cols = 2 * n + 3;
@@ -272,10 +275,25 @@ fn correct_chunk<const P: u32>(
     }
 }
 
-/// The neighbour at offset (dx, dy) of the pixel in grid column `c`.
+/// The 5×5 neighbours of one pixel: rows y − 2 … y + 2, columns x − 2 …
+/// x + 2 (not all are read). Taken once per use, so that the reads at
+/// constant offsets need no bounds checks of their own.
+type Window<'g> = [&'g [Tap; 5]; 5];
+
+/// The [`Window`] of the pixel in grid column `c`.
 #[inline(always)]
-fn at(grid: &[[Tap; GRID_COLS]; 5], c: usize, dx: i32, dy: i32) -> &Tap {
-    &grid[(2 + dy) as usize][(c as i32 + dx) as usize]
+fn window(grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Window<'_> {
+    grid.each_ref().map(|row| {
+        row[c - 2..c + 3]
+            .try_into()
+            .expect("a pixel's window is 5 columns wide")
+    })
+}
+
+/// The neighbour at offset (dx, dy) of the window's pixel.
+#[inline(always)]
+fn at<'g>(win: &Window<'g>, dx: i32, dy: i32) -> &'g Tap {
+    &win[(2 + dy) as usize][(2 + dx) as usize]
 }
 
 /// Prefetches the similarity entries the gathering of the pixel in grid
@@ -287,8 +305,9 @@ fn at(grid: &[[Tap; GRID_COLS]; 5], c: usize, dx: i32, dy: i32) -> &Tap {
 #[inline(always)]
 fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize) {
     let similar = atlas.level.similar;
+    let win = window(grid, c);
     for dy in -1..=1 {
-        let n = at(grid, c, 0, dy);
+        let n = at(&win, 0, dy);
         prefetch_line((&similar[(n.idx - dy * n.stride) as usize] as *const u32).cast());
     }
 }
@@ -299,50 +318,79 @@ fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usi
 /// the atlas is larger than the L2 cache.
 #[inline(always)]
 fn gather(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize, out: &mut Pending) {
+    let win = window(grid, c);
+    let mut seen = Seen {
+        idx: [0; 9],
+        distinct: 0,
+    };
+    out.count = 0;
+    // One call per Δ, so that each is compiled with its Δ as a constant.
+    gather_delta::<0>(atlas, &win, &mut seen, out);
+    gather_delta::<1>(atlas, &win, &mut seen, out);
+    gather_delta::<2>(atlas, &win, &mut seen, out);
+    gather_delta::<3>(atlas, &win, &mut seen, out);
+    gather_delta::<4>(atlas, &win, &mut seen, out);
+    gather_delta::<5>(atlas, &win, &mut seen, out);
+    gather_delta::<6>(atlas, &win, &mut seen, out);
+    gather_delta::<7>(atlas, &win, &mut seen, out);
+    gather_delta::<8>(atlas, &win, &mut seen, out);
+}
+
+/// Texel indices of the distinct u of a pixel so far: u lies in the
+/// exemplar of S(n), one texel from its interior, so its index identifies
+/// it.
+struct Seen {
+    idx: [i32; 9],
+    distinct: usize,
+}
+
+/// [`gather`]'s step for Δ = `DELTAS[K]`: C₁ and C₂ of its u unless an
+/// earlier Δ had the same u.
+#[inline(always)]
+fn gather_delta<const K: usize>(
+    atlas: &AtlasLevel<'_>,
+    win: &Window<'_>,
+    seen: &mut Seen,
+    out: &mut Pending,
+) {
     let app = atlas.level.appearance;
-    let mut count = 0;
-    // Distinct u so far, packed `x | y << 16` (atlas sides are < 2^16).
-    let mut seen = [0u32; 9];
-    let mut distinct = 0;
-    for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
-        let n = at(grid, c, dx, dy);
-        let u = (n.sx - dx, n.sy - dy);
-        let key = u.0 as u32 | (u.1 as u32) << 16;
-        if seen[..distinct].contains(&key) {
-            continue;
-        }
-        seen[distinct] = key;
-        distinct += 1;
-        // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
-        let u_idx = n.idx - dx - dy * n.stride;
-        let (cx, cy) = atlas.clamp_interior(u.0, u.1);
-        out.cands[count] = Candidate {
-            idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
-            stride: n.stride,
-            x: cx,
-            y: cy,
-            from: k as u8,
-            kappa: 1,
-        };
-        // C₂: the stored best other match, anywhere in the atlas.
-        let c2 = atlas.level.similar[u_idx as usize];
-        let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
-        let col = &atlas.columns[qx as usize];
-        out.cands[count + 1] = Candidate {
-            idx: col.base + qy * col.stride as i32 + qx,
-            stride: col.stride as i32,
-            x: qx,
-            y: qy,
-            from: k as u8,
-            kappa: 2,
-        };
-        for q in &out.cands[count..count + 2] {
-            prefetch(&app[(q.idx - q.stride - 1) as usize]);
-            prefetch(&app[(q.idx + q.stride - 1) as usize]);
-        }
-        count += 2;
+    let (dx, dy) = DELTAS[K];
+    let n = at(win, dx, dy);
+    let u_idx = n.idx - dx - dy * n.stride;
+    if seen.idx[..seen.distinct].contains(&u_idx) {
+        return;
     }
-    out.count = count;
+    seen.idx[seen.distinct] = u_idx;
+    seen.distinct += 1;
+    let count = out.count;
+    // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
+    let u = (n.sx - dx, n.sy - dy);
+    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
+    out.cands[count] = Candidate {
+        idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
+        stride: n.stride,
+        x: cx,
+        y: cy,
+        from: K as u8,
+        kappa: 1,
+    };
+    // C₂: the stored best other match, anywhere in the atlas.
+    let c2 = atlas.level.similar[u_idx as usize];
+    let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+    let col = &atlas.columns[qx as usize];
+    out.cands[count + 1] = Candidate {
+        idx: col.base + qy * col.stride as i32 + qx,
+        stride: col.stride as i32,
+        x: qx,
+        y: qy,
+        from: K as u8,
+        kappa: 2,
+    };
+    for q in &out.cands[count..count + 2] {
+        prefetch(&app[(q.idx - q.stride - 1) as usize]);
+        prefetch(&app[(q.idx + q.stride - 1) as usize]);
+    }
+    out.count = count + 2;
 }
 
 /// Scores a gathered pixel's candidates against its synthesis
@@ -361,33 +409,7 @@ fn decide<const P: u32>(
     vp: i32,
 ) -> (Coord, i32) {
     let app = atlas.level.appearance;
-    // N_S (eq. 5–6): per diagonal δ, g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a
-    // for v ∈ {0, (δx, 0), (0, δy)}.
-    // Two diagonals per vector, three texels each; V joins mode 1.
-    let half = |k: usize| {
-        let (dx, dy) = DIAGONALS[k];
-        let a = at(grid, c, dx, dy);
-        let b = at(grid, c, 2 * dx, dy);
-        let cc = at(grid, c, dx, 2 * dy);
-        let texels = [
-            app[a.idx as usize],
-            app[(b.idx - dx) as usize],
-            app[(cc.idx - dy * cc.stride) as usize],
-        ];
-        (texels, a.v + b.v + cc.v)
-    };
-    let pairs = |k: usize| {
-        let ((t0, v0), (t1, v1)) = (half(k), half(k + 1));
-        let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
-        for j in 0..3 {
-            sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
-        }
-        sum
-    };
-    let ns = &Neighbourhood {
-        ns01: pairs(0),
-        ns23: pairs(2),
-    };
+    let ns = &neighbourhood(app, grid, c);
     // The coherence candidate first (a tie keeps the previous result), then
     // the rest in DELTAS order, C₁ before C₂ (ties keep the earlier).
     if let Some(c) = &g.coherence {
@@ -415,6 +437,41 @@ fn decide<const P: u32>(
     }
     let winner = best_of::<P>(app, ns, p, u32::MAX, vp);
     finish(atlas, st, pixel, p, winner, g)
+}
+
+/// N_S (eq. 5–6) of the pixel in grid column `c`: per diagonal δ,
+/// g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a for v ∈ {0, (δx, 0), (0, δy)}.
+/// Two diagonals per vector, three texels each; V joins mode 1.
+#[inline(always)]
+fn neighbourhood(app: &[u64], grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Neighbourhood {
+    let win = window(grid, c);
+    let pairs = |k: usize| {
+        let ((t0, v0), (t1, v1)) = (diagonal(app, &win, k), diagonal(app, &win, k + 1));
+        let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
+        for j in 0..3 {
+            sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
+        }
+        sum
+    };
+    Neighbourhood {
+        ns01: pairs(0),
+        ns23: pairs(2),
+    }
+}
+
+/// Diagonal k of N_S: its three appearance texels and their ΣV.
+#[inline(always)]
+fn diagonal(app: &[u64], win: &Window<'_>, k: usize) -> ([u64; 3], i32) {
+    let (dx, dy) = DIAGONALS[k];
+    let a = at(win, dx, dy);
+    let b = at(win, 2 * dx, dy);
+    let cc = at(win, dx, 2 * dy);
+    let texels = [
+        app[a.idx as usize],
+        app[(b.idx - dx) as usize],
+        app[(cc.idx - dy * cc.stride) as usize],
+    ];
+    (texels, a.v + b.v + cc.v)
 }
 
 /// The winner's offset `v`, nudged towards the pixel's geometric target
