@@ -76,7 +76,19 @@ mod tests {
         assert_eq!(div_floor(-7, 12), -1);
         assert_eq!(div_floor(7, 12), 0);
         assert_eq!(div_floor(-12, 12), -1);
-        for a in [i32::MIN, i32::MIN + 1, -37, -36, -35, -1, 0, 1, 35, 36, i32::MAX] {
+        for a in [
+            i32::MIN,
+            i32::MIN + 1,
+            -37,
+            -36,
+            -35,
+            -1,
+            0,
+            1,
+            35,
+            36,
+            i32::MAX,
+        ] {
             for b in [1, 2, 12, 24, 36, 1 << 20, i32::MAX] {
                 assert_eq!(div_floor(a, b), a.div_euclid(b), "{a} / {b}");
             }

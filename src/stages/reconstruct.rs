@@ -56,31 +56,55 @@ pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i
                     (atlas.index(tx, ty) as i32, stride, st.v(n))
                 })
                 .collect();
-            for (r, row) in block.chunks_mut(w).enumerate() {
-                let y = y0 + r;
-                for (x, o) in row.iter_mut().enumerate() {
-                    let (mut sum, mut count) = (0i32, 0i32);
-                    for dy in -1..=1i32 {
-                        let ny = y as i32 + dy;
-                        if ny < 0 || ny >= h as i32 {
+            // The prediction of neighbour (nx, ny) for the pixel at offset
+            // (−dx, −dy) from it. S(n) is interior (two texels from every
+            // exemplar edge), so the texel one step away is in its
+            // exemplar, at index − dx − dy·stride.
+            let predict = |(k, stride, v): (i32, i32, i32), dx: i32, dy: i32| {
+                (heights[(k - dx - dy * stride) as usize] as i32 + v) << HEIGHT_FRAC_BITS
+            };
+            // Any pixel, the level's edges included.
+            let pixel = |x: usize, y: usize| {
+                let (mut sum, mut count) = (0i32, 0i32);
+                for dy in -1..=1i32 {
+                    let ny = y as i32 + dy;
+                    if ny < 0 || ny >= h as i32 {
+                        continue;
+                    }
+                    let line = &base[(ny as usize - ya) * w..(ny as usize - ya + 1) * w];
+                    for dx in -1..=1i32 {
+                        let nx = x as i32 + dx;
+                        if nx < 0 || nx >= w as i32 {
                             continue;
                         }
-                        let line = &base[(ny as usize - ya) * w..(ny as usize - ya + 1) * w];
-                        for dx in -1..=1i32 {
-                            let nx = x as i32 + dx;
-                            if nx < 0 || nx >= w as i32 {
-                                continue;
-                            }
-                            // S(n) is interior (two texels from every
-                            // exemplar edge), so the texel one step away is
-                            // in its exemplar, at index − dx − dy·stride.
-                            let (k, stride, v) = line[nx as usize];
-                            let e = heights[(k - dx - dy * stride) as usize] as i32;
-                            sum += (e + v) << HEIGHT_FRAC_BITS;
-                            count += 1;
-                        }
+                        sum += predict(line[nx as usize], dx, dy);
+                        count += 1;
                     }
-                    *o = div_floor(sum, count);
+                }
+                div_floor(sum, count)
+            };
+            for (r, row) in block.chunks_mut(w).enumerate() {
+                let y = y0 + r;
+                if y == 0 || y + 1 == h || w < 3 {
+                    for (x, o) in row.iter_mut().enumerate() {
+                        *o = pixel(x, y);
+                    }
+                    continue;
+                }
+                // Inside the level every pixel has nine neighbours: no edge
+                // tests, and the mean divides by the constant 9 (the same
+                // sum and floor division as at the edges).
+                let line = |dy: usize| &base[(y + dy - 1 - ya) * w..(y + dy - ya) * w];
+                let lines = [line(0), line(1), line(2)];
+                row[0] = pixel(0, y);
+                row[w - 1] = pixel(w - 1, y);
+                for (x, o) in row[1..w - 1].iter_mut().enumerate() {
+                    let mut sum = 0i32;
+                    for (l, dy) in lines.iter().zip(-1..=1i32) {
+                        let n: &[_; 3] = l[x..x + 3].try_into().expect("three neighbours");
+                        sum += predict(n[0], -1, dy) + predict(n[1], 0, dy) + predict(n[2], 1, dy);
+                    }
+                    *o = div_floor(sum, 9);
                 }
             }
         });

@@ -242,10 +242,14 @@ fn correct_chunk<const P: u32>(
     let cols = 2 * n + 3;
     for (r, row) in grid.iter_mut().enumerate() {
         let base = (y + r - 2) * w + x0 - 2;
-        let step = if r == 0 || r == 4 { 2 } else { 1 };
-        let first = if step == 2 { 1 } else { 0 };
-        for j in (first..cols).step_by(step) {
-            row[j] = tap(atlas, st, base + j);
+        if r == 0 || r == 4 {
+            for j in 0..cols / 2 {
+                row[2 * j + 1] = tap(atlas, st, base + 2 * j + 1);
+            }
+        } else {
+            for (j, t) in row[..cols].iter_mut().enumerate() {
+                *t = tap(atlas, st, base + j);
+            }
         }
     }
     let grid = &*grid;
@@ -308,7 +312,7 @@ fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usi
     let win = window(grid, c);
     for dy in -1..=1 {
         let n = at(&win, 0, dy);
-        prefetch_line((&similar[(n.idx - dy * n.stride) as usize] as *const u32).cast());
+        prefetch(similar, n.idx - dy * n.stride);
     }
 }
 
@@ -387,8 +391,8 @@ fn gather_delta<const K: usize>(
         kappa: 2,
     };
     for q in &out.cands[count..count + 2] {
-        prefetch(&app[(q.idx - q.stride - 1) as usize]);
-        prefetch(&app[(q.idx + q.stride - 1) as usize]);
+        prefetch(app, q.idx - q.stride - 1);
+        prefetch(app, q.idx + q.stride - 1);
     }
     out.count = count + 2;
 }
@@ -445,18 +449,21 @@ fn decide<const P: u32>(
 #[inline(always)]
 fn neighbourhood(app: &[u64], grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Neighbourhood {
     let win = window(grid, c);
-    let pairs = |k: usize| {
-        let ((t0, v0), (t1, v1)) = (diagonal(app, &win, k), diagonal(app, &win, k + 1));
-        let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
-        for j in 0..3 {
-            sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
-        }
-        sum
-    };
     Neighbourhood {
-        ns01: pairs(0),
-        ns23: pairs(2),
+        ns01: diagonals(app, &win, 0),
+        ns23: diagonals(app, &win, 2),
     }
+}
+
+/// Diagonals k and k + 1 of N_S, summed, as one vector.
+#[inline(always)]
+fn diagonals(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
+    let ((t0, v0), (t1, v1)) = (diagonal(app, win, k), diagonal(app, win, k + 1));
+    let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
+    for j in 0..3 {
+        sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
+    }
+    sum
 }
 
 /// Diagonal k of N_S: its three appearance texels and their ΣV.
@@ -544,10 +551,12 @@ struct Candidate {
     kappa: u32,
 }
 
-/// [`prefetch_line`] for an appearance texel.
+/// [`prefetch_line`] for element `i` of `table`. The address is only
+/// formed, never read, so it needs no bounds check (prefetching is a hint
+/// that cannot fault).
 #[inline(always)]
-fn prefetch(t: &u64) {
-    prefetch_line((t as *const u64).cast());
+fn prefetch<T>(table: &[T], i: i32) {
+    prefetch_line(table.as_ptr().wrapping_offset(i as isize).cast());
 }
 
 /// Asks the cache for the line holding `t` (a hint: no effect on results).
