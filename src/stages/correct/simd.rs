@@ -147,7 +147,7 @@ const GRID_COLS: usize = 2 * CHUNK + 4;
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
-const LOOKAHEAD: usize = 4;
+const LOOKAHEAD: usize = 6;
 const RING: usize = LOOKAHEAD + 1;
 
 /// A pixel whose candidates are gathered, awaiting scoring.
@@ -390,10 +390,17 @@ fn gather_delta<const K: usize>(
         from: K as u8,
         kappa: 2,
     };
+    // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
+    // lines of one row when they straddle a cache line (a quarter of the
+    // time). C₂ lands anywhere, so both of its lines are asked for; C₁ is
+    // near S(p), whose lines N_S reads anyway.
     for q in &out.cands[count..count + 2] {
         prefetch(app, q.idx - q.stride - 1);
         prefetch(app, q.idx + q.stride - 1);
     }
+    let q = &out.cands[count + 1];
+    prefetch(app, q.idx - q.stride + 1);
+    prefetch(app, q.idx + q.stride + 1);
     out.count = count + 2;
 }
 
