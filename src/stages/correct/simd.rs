@@ -172,42 +172,56 @@ pub fn correct_span<const P: u32>(
     x1: usize,
     g: &Guide<'_>,
 ) {
+    let span = Span {
+        atlas,
+        st,
+        parent,
+        y,
+        x0,
+        x1,
+        g,
+    };
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU supports AVX2, the one feature the function
         // enables (checked just above).
-        unsafe { span_avx2::<P>(atlas, st, parent, y, x0, x1, g) };
+        unsafe { span_avx2::<P>(&span) };
         return;
     }
-    span::<P>(atlas, st, parent, y, x0, x1, g);
+    run_span::<P>(&span);
 }
 
-/// [`span`] compiled for AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn span_avx2<const P: u32>(
-    atlas: &AtlasLevel<'_>,
-    st: &State,
-    parent: Option<&State>,
+/// The arguments of [`correct_span`].
+#[derive(Clone, Copy)]
+struct Span<'s> {
+    atlas: &'s AtlasLevel<'s>,
+    st: &'s State,
+    parent: Option<&'s State>,
     y: usize,
     x0: usize,
     x1: usize,
-    g: &Guide<'_>,
-) {
-    span::<P>(atlas, st, parent, y, x0, x1, g);
+    g: &'s Guide<'s>,
+}
+
+/// [`run_span`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn span_avx2<const P: u32>(span: &Span<'_>) {
+    run_span::<P>(span);
 }
 
 /// [`correct_span`] for any instruction set.
 #[inline(always)]
-fn span<const P: u32>(
-    atlas: &AtlasLevel<'_>,
-    st: &State,
-    parent: Option<&State>,
-    y: usize,
-    x0: usize,
-    x1: usize,
-    g: &Guide<'_>,
-) {
+fn run_span<const P: u32>(span: &Span<'_>) {
+    let Span {
+        atlas,
+        st,
+        parent,
+        y,
+        x0,
+        x1,
+        g,
+    } = *span;
     let mut grid = [[Tap::default(); GRID_COLS]; 5];
     let mut a = x0;
     while a < x1 {
