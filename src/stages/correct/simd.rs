@@ -15,11 +15,15 @@
 //! - **Prefetched candidates.** C₂ entries point anywhere in the atlas; at
 //!   level 0 the atlas outgrows the L2 cache and scoring them one by one
 //!   would serialise cache misses. Candidates are listed a few pixels ahead
-//!   of scoring and their texels prefetched (a software pipeline).
+//!   of scoring and their texels prefetched (a software pipeline), and the
+//!   similarity entries a few pixels ahead of listing.
 //! - **Vector scoring.** The four diagonal texels of a candidate are two
 //!   `i16x8` loads; residuals are formed in `i32x8`, clamped to ±[`CLAMP`]
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
+//! - **AVX2 where the CPU has it.** The span is compiled twice, for the
+//!   SSE2 baseline and for AVX2, and picked at run time (integer
+//!   arithmetic: the same bytes either way).
 
 use super::nudge::nudge;
 use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, FLAT, Guide, Prior, W_FREE, scalar, weigh};
