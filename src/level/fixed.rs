@@ -52,9 +52,17 @@ pub fn round(c: i32) -> i32 {
 }
 
 /// ⌊a / b⌋ for b > 0, with the same result in WGSL (whose `/` truncates).
+///
+/// Computed as an unsigned division of `a` or of `−a − 1` (the bitwise
+/// complement, never negative), complemented back for negative `a`:
+/// ⌊a/b⌋ = −⌈−a/b⌉ = −(⌊(−a − 1)/b⌋ + 1) there. The same value as
+/// `a.div_euclid(b)`, but by a constant `b` it compiles to a multiply and
+/// a shift without sign fix-ups (the correction divides per candidate).
 #[inline(always)]
 pub fn div_floor(a: i32, b: i32) -> i32 {
-    a.div_euclid(b)
+    debug_assert!(b > 0);
+    let sign = a >> 31;
+    (((a ^ sign) as u32 / b as u32) as i32) ^ sign
 }
 
 #[cfg(test)]
@@ -68,6 +76,23 @@ mod tests {
         assert_eq!(div_floor(-7, 12), -1);
         assert_eq!(div_floor(7, 12), 0);
         assert_eq!(div_floor(-12, 12), -1);
+        for a in [
+            i32::MIN,
+            i32::MIN + 1,
+            -37,
+            -36,
+            -35,
+            -1,
+            0,
+            1,
+            35,
+            36,
+            i32::MAX,
+        ] {
+            for b in [1, 2, 12, 24, 36, 1 << 20, i32::MAX] {
+                assert_eq!(div_floor(a, b), a.div_euclid(b), "{a} / {b}");
+            }
+        }
         let c = Coord {
             x: 123_456,
             y: 65_535 << FRAC_BITS,

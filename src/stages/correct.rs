@@ -129,7 +129,13 @@ impl Prior {
     /// the coarsest corrected level, whose start has V = 0).
     #[inline(always)]
     pub fn at(weight: u32, parent: Option<&State>, x: usize, y: usize) -> Prior {
-        let v = parent.map_or(0, |pa| parent_v(pa, x, y));
+        // A `match`, not `Option::map_or`: the profile found `map_or` left
+        // out of line in the SIMD span (a call per pixel, 3.7 % of the
+        // time at 1024²).
+        let v = match parent {
+            Some(pa) => parent_v(pa, x, y),
+            None => 0,
+        };
         Prior { weight, v }
     }
 

@@ -85,31 +85,59 @@ pub fn reconstruct_rect(
                     (atlas.index(tx, ty) as i32, stride, st.v(n))
                 }));
             }
-            for (r, row) in block.chunks_mut(w).enumerate() {
-                let y = y_start + r;
-                for (x, o) in row.iter_mut().enumerate().take(x1).skip(x0) {
-                    let (mut sum, mut count) = (0i32, 0i32);
-                    for dy in -1..=1i32 {
-                        let ny = y as i32 + dy;
-                        if ny < 0 || ny >= h as i32 {
+            // The prediction of neighbour (nx, ny) for the pixel at offset
+            // (−dx, −dy) from it. S(n) is interior (two texels from every
+            // exemplar edge), so the texel one step away is in its
+            // exemplar, at index − dx − dy·stride.
+            let predict = |(k, stride, v): (i32, i32, i32), dx: i32, dy: i32| {
+                (heights[(k - dx - dy * stride) as usize] as i32 + v) << HEIGHT_FRAC_BITS
+            };
+            let line = |ny: usize| &base[(ny - ya) * cols..(ny - ya + 1) * cols];
+            // Any pixel, the level's edges included.
+            let pixel = |x: usize, y: usize| {
+                let (mut sum, mut count) = (0i32, 0i32);
+                for dy in -1..=1i32 {
+                    let ny = y as i32 + dy;
+                    if ny < 0 || ny >= h as i32 {
+                        continue;
+                    }
+                    let l = line(ny as usize);
+                    for dx in -1..=1i32 {
+                        let nx = x as i32 + dx;
+                        if nx < 0 || nx >= w as i32 {
                             continue;
                         }
-                        let line = &base[(ny as usize - ya) * cols..(ny as usize - ya + 1) * cols];
-                        for dx in -1..=1i32 {
-                            let nx = x as i32 + dx;
-                            if nx < 0 || nx >= w as i32 {
-                                continue;
-                            }
-                            // S(n) is interior (two texels from every
-                            // exemplar edge), so the texel one step away is
-                            // in its exemplar, at index − dx − dy·stride.
-                            let (k, stride, v) = line[nx as usize - xa];
-                            let e = heights[(k - dx - dy * stride) as usize] as i32;
-                            sum += (e + v) << HEIGHT_FRAC_BITS;
-                            count += 1;
-                        }
+                        sum += predict(l[nx as usize - xa], dx, dy);
+                        count += 1;
                     }
-                    *o = div_floor(sum, count);
+                }
+                div_floor(sum, count)
+            };
+            for (r, row) in block.chunks_mut(w).enumerate() {
+                let y = y_start + r;
+                if y == 0 || y + 1 == h || w < 3 {
+                    for (x, o) in row.iter_mut().enumerate().take(x1).skip(x0) {
+                        *o = pixel(x, y);
+                    }
+                    continue;
+                }
+                // Inside the level every pixel has nine neighbours: no edge
+                // tests, and the mean divides by the constant 9 (the same
+                // sum and floor division as at the edges).
+                let lines = [line(y - 1), line(y), line(y + 1)];
+                let (lo, hi) = (x0.max(1), x1.min(w - 1));
+                for x in (x0..lo).chain(hi.max(lo)..x1) {
+                    row[x] = pixel(x, y);
+                }
+                for (x, o) in row.iter_mut().enumerate().take(hi).skip(lo) {
+                    let mut sum = 0i32;
+                    for (l, dy) in lines.iter().zip(-1..=1i32) {
+                        let n: &[_; 3] = l[x - 1 - xa..x + 2 - xa]
+                            .try_into()
+                            .expect("three neighbours");
+                        sum += predict(n[0], -1, dy) + predict(n[1], 0, dy) + predict(n[2], 1, dy);
+                    }
+                    *o = div_floor(sum, 9);
                 }
             }
         });

@@ -15,11 +15,15 @@
 //! - **Prefetched candidates.** C₂ entries point anywhere in the atlas; at
 //!   level 0 the atlas outgrows the L2 cache and scoring them one by one
 //!   would serialise cache misses. Candidates are listed a few pixels ahead
-//!   of scoring and their texels prefetched (a software pipeline).
+//!   of scoring and their texels prefetched (a software pipeline), and the
+//!   similarity entries a few pixels ahead of listing.
 //! - **Vector scoring.** The four diagonal texels of a candidate are two
 //!   `i16x8` loads; residuals are formed in `i32x8`, clamped to ±[`CLAMP`]
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
+//! - **AVX2 where the CPU has it.** The span is compiled twice, for the
+//!   SSE2 baseline and for AVX2, and picked at run time (integer
+//!   arithmetic: the same bytes either way).
 
 use super::nudge::nudge;
 use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, FLAT, Guide, Prior, W_FREE, scalar, weigh};
@@ -147,7 +151,7 @@ const GRID_COLS: usize = 2 * CHUNK + 4;
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
-const LOOKAHEAD: usize = 4;
+const LOOKAHEAD: usize = 6;
 const RING: usize = LOOKAHEAD + 1;
 
 /// A pixel whose candidates are gathered, awaiting scoring.
@@ -159,6 +163,10 @@ struct Pending {
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of row `y`, all at least two
 /// texels inside the level, writing each result as it is found.
+///
+/// On x86-64 CPUs with AVX2 the same code runs compiled for AVX2 (picked at
+/// run time; the baseline build targets SSE2): the `wide` vectors and the
+/// integer arithmetic give the same results on either, only faster.
 pub fn correct_span<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
@@ -168,6 +176,56 @@ pub fn correct_span<const P: u32>(
     x1: usize,
     g: &Guide<'_>,
 ) {
+    let span = Span {
+        atlas,
+        st,
+        parent,
+        y,
+        x0,
+        x1,
+        g,
+    };
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2, the one feature the function
+        // enables (checked just above).
+        unsafe { span_avx2::<P>(&span) };
+        return;
+    }
+    run_span::<P>(&span);
+}
+
+/// The arguments of [`correct_span`].
+#[derive(Clone, Copy)]
+struct Span<'s> {
+    atlas: &'s AtlasLevel<'s>,
+    st: &'s State,
+    parent: Option<&'s State>,
+    y: usize,
+    x0: usize,
+    x1: usize,
+    g: &'s Guide<'s>,
+}
+
+/// [`run_span`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn span_avx2<const P: u32>(span: &Span<'_>) {
+    run_span::<P>(span);
+}
+
+/// [`correct_span`] for any instruction set.
+#[inline(always)]
+fn run_span<const P: u32>(span: &Span<'_>) {
+    let Span {
+        atlas,
+        st,
+        parent,
+        y,
+        x0,
+        x1,
+        g,
+    } = *span;
     let mut grid = [[Tap::default(); GRID_COLS]; 5];
     let mut a = x0;
     while a < x1 {
@@ -180,6 +238,7 @@ pub fn correct_span<const P: u32>(
 /// One chunk `[x0, x1)` of a span. Reading the neighbours up front is safe:
 /// a subpass reads only pixels of other parity classes (which it never
 /// writes), and each pixel's own coordinate before the pixel is written.
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn correct_chunk<const P: u32>(
     atlas: &AtlasLevel<'_>,
@@ -193,20 +252,30 @@ fn correct_chunk<const P: u32>(
 ) {
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
+    // True by construction; stated so that the compiler knows every grid
+    // column a pixel reads (≤ 2n + 2) is inside the grid.
+    assert!(n <= CHUNK);
     // Grid column j is level column x0 − 2 + j; grid row r is level row
     // y − 2 + r. Rows y ± 2 are read only at odd offsets from the class.
     let cols = 2 * n + 3;
     for (r, row) in grid.iter_mut().enumerate() {
         let base = (y + r - 2) * w + x0 - 2;
-        let step = if r == 0 || r == 4 { 2 } else { 1 };
-        let first = if step == 2 { 1 } else { 0 };
-        for j in (first..cols).step_by(step) {
-            row[j] = tap(atlas, st, base + j);
+        if r == 0 || r == 4 {
+            for j in 0..cols / 2 {
+                row[2 * j + 1] = tap(atlas, st, base + 2 * j + 1);
+            }
+        } else {
+            for (j, t) in row[..cols].iter_mut().enumerate() {
+                *t = tap(atlas, st, base + j);
+            }
         }
     }
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
     for i in 0..n + LOOKAHEAD {
+        if i + LOOKAHEAD < n {
+            prefetch_similar(atlas, grid, 2 * (i + LOOKAHEAD) + 2);
+        }
         if i < n {
             gather(atlas, grid, 2 * i + 2, &mut ring[i % RING]);
         }
@@ -228,10 +297,41 @@ fn correct_chunk<const P: u32>(
     }
 }
 
-/// The neighbour at offset (dx, dy) of the pixel in grid column `c`.
+/// The 5×5 neighbours of one pixel: rows y − 2 … y + 2, columns x − 2 …
+/// x + 2 (not all are read). Taken once per use, so that the reads at
+/// constant offsets need no bounds checks of their own.
+type Window<'g> = [&'g [Tap; 5]; 5];
+
+/// The [`Window`] of the pixel in grid column `c`.
 #[inline(always)]
-fn at(grid: &[[Tap; GRID_COLS]; 5], c: usize, dx: i32, dy: i32) -> &Tap {
-    &grid[(2 + dy) as usize][(c as i32 + dx) as usize]
+fn window(grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Window<'_> {
+    grid.each_ref().map(|row| {
+        row[c - 2..c + 3]
+            .try_into()
+            .expect("a pixel's window is 5 columns wide")
+    })
+}
+
+/// The neighbour at offset (dx, dy) of the window's pixel.
+#[inline(always)]
+fn at<'g>(win: &Window<'g>, dx: i32, dy: i32) -> &'g Tap {
+    &win[(2 + dy) as usize][(2 + dx) as usize]
+}
+
+/// Prefetches the similarity entries the gathering of the pixel in grid
+/// column `c` will read, those of `u = S(p + Δ) − Δ` for the three Δ of
+/// its column (in a coherent patch all nine u coincide with these). The
+/// first read of an atlas row near u is this one: gathering's own
+/// prefetches cover only the texels that scoring reads later, and the
+/// profile showed the `similar` load as the costliest instruction.
+#[inline(always)]
+fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize) {
+    let similar = atlas.level.similar;
+    let win = window(grid, c);
+    for dy in -1..=1 {
+        let n = at(&win, 0, dy);
+        prefetch(similar, n.idx - dy * n.stride);
+    }
 }
 
 /// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
@@ -240,50 +340,86 @@ fn at(grid: &[[Tap; GRID_COLS]; 5], c: usize, dx: i32, dy: i32) -> &Tap {
 /// the atlas is larger than the L2 cache.
 #[inline(always)]
 fn gather(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize, out: &mut Pending) {
+    let win = window(grid, c);
+    let mut seen = Seen {
+        idx: [0; 9],
+        distinct: 0,
+    };
+    out.count = 0;
+    // One call per Δ, so that each is compiled with its Δ as a constant.
+    gather_delta::<0>(atlas, &win, &mut seen, out);
+    gather_delta::<1>(atlas, &win, &mut seen, out);
+    gather_delta::<2>(atlas, &win, &mut seen, out);
+    gather_delta::<3>(atlas, &win, &mut seen, out);
+    gather_delta::<4>(atlas, &win, &mut seen, out);
+    gather_delta::<5>(atlas, &win, &mut seen, out);
+    gather_delta::<6>(atlas, &win, &mut seen, out);
+    gather_delta::<7>(atlas, &win, &mut seen, out);
+    gather_delta::<8>(atlas, &win, &mut seen, out);
+}
+
+/// Texel indices of the distinct u of a pixel so far: u lies in the
+/// exemplar of S(n), one texel from its interior, so its index identifies
+/// it.
+struct Seen {
+    idx: [i32; 9],
+    distinct: usize,
+}
+
+/// [`gather`]'s step for Δ = `DELTAS[K]`: C₁ and C₂ of its u unless an
+/// earlier Δ had the same u.
+#[inline(always)]
+fn gather_delta<const K: usize>(
+    atlas: &AtlasLevel<'_>,
+    win: &Window<'_>,
+    seen: &mut Seen,
+    out: &mut Pending,
+) {
     let app = atlas.level.appearance;
-    let mut count = 0;
-    // Distinct u so far, packed `x | y << 16` (atlas sides are < 2^16).
-    let mut seen = [0u32; 9];
-    let mut distinct = 0;
-    for (k, &(dx, dy)) in DELTAS.iter().enumerate() {
-        let n = at(grid, c, dx, dy);
-        let u = (n.sx - dx, n.sy - dy);
-        let key = u.0 as u32 | (u.1 as u32) << 16;
-        if seen[..distinct].contains(&key) {
-            continue;
-        }
-        seen[distinct] = key;
-        distinct += 1;
-        // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
-        let u_idx = n.idx - dx - dy * n.stride;
-        let (cx, cy) = atlas.clamp_interior(u.0, u.1);
-        out.cands[count] = Candidate {
-            idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
-            stride: n.stride,
-            x: cx,
-            y: cy,
-            from: k as u8,
-            kappa: 1,
-        };
-        // C₂: the stored best other match, anywhere in the atlas.
-        let c2 = atlas.level.similar[u_idx as usize];
-        let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
-        let col = &atlas.columns[qx as usize];
-        out.cands[count + 1] = Candidate {
-            idx: col.base + qy * col.stride as i32 + qx,
-            stride: col.stride as i32,
-            x: qx,
-            y: qy,
-            from: k as u8,
-            kappa: 2,
-        };
-        for q in &out.cands[count..count + 2] {
-            prefetch(&app[(q.idx - q.stride - 1) as usize]);
-            prefetch(&app[(q.idx + q.stride - 1) as usize]);
-        }
-        count += 2;
+    let (dx, dy) = DELTAS[K];
+    let n = at(win, dx, dy);
+    let u_idx = n.idx - dx - dy * n.stride;
+    if seen.idx[..seen.distinct].contains(&u_idx) {
+        return;
     }
-    out.count = count;
+    seen.idx[seen.distinct] = u_idx;
+    seen.distinct += 1;
+    let count = out.count;
+    // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
+    let u = (n.sx - dx, n.sy - dy);
+    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
+    out.cands[count] = Candidate {
+        idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
+        stride: n.stride,
+        x: cx,
+        y: cy,
+        from: K as u8,
+        kappa: 1,
+    };
+    // C₂: the stored best other match, anywhere in the atlas.
+    let c2 = atlas.level.similar[u_idx as usize];
+    let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+    let col = &atlas.columns[qx as usize];
+    out.cands[count + 1] = Candidate {
+        idx: col.base + qy * col.stride as i32 + qx,
+        stride: col.stride as i32,
+        x: qx,
+        y: qy,
+        from: K as u8,
+        kappa: 2,
+    };
+    // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
+    // lines of one row when they straddle a cache line (a quarter of the
+    // time). C₂ lands anywhere, so both of its lines are asked for; C₁ is
+    // near S(p), whose lines N_S reads anyway.
+    for q in &out.cands[count..count + 2] {
+        prefetch(app, q.idx - q.stride - 1);
+        prefetch(app, q.idx + q.stride - 1);
+    }
+    let q = &out.cands[count + 1];
+    prefetch(app, q.idx - q.stride + 1);
+    prefetch(app, q.idx + q.stride + 1);
+    out.count = count + 2;
 }
 
 /// Scores a gathered pixel's candidates against its synthesis
@@ -302,33 +438,7 @@ fn decide<const P: u32>(
     vp: i32,
 ) -> (Coord, i32) {
     let app = atlas.level.appearance;
-    // N_S (eq. 5–6): per diagonal δ, g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a
-    // for v ∈ {0, (δx, 0), (0, δy)}.
-    // Two diagonals per vector, three texels each; V joins mode 1.
-    let half = |k: usize| {
-        let (dx, dy) = DIAGONALS[k];
-        let a = at(grid, c, dx, dy);
-        let b = at(grid, c, 2 * dx, dy);
-        let cc = at(grid, c, dx, 2 * dy);
-        let texels = [
-            app[a.idx as usize],
-            app[(b.idx - dx) as usize],
-            app[(cc.idx - dy * cc.stride) as usize],
-        ];
-        (texels, a.v + b.v + cc.v)
-    };
-    let pairs = |k: usize| {
-        let ((t0, v0), (t1, v1)) = (half(k), half(k + 1));
-        let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
-        for j in 0..3 {
-            sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
-        }
-        sum
-    };
-    let ns = &Neighbourhood {
-        ns01: pairs(0),
-        ns23: pairs(2),
-    };
+    let ns = &neighbourhood(app, grid, c);
     // The coherence candidate first (a tie keeps the previous result), then
     // the rest in DELTAS order, C₁ before C₂ (ties keep the earlier).
     if let Some(c) = &g.coherence {
@@ -356,6 +466,44 @@ fn decide<const P: u32>(
     }
     let winner = best_of::<P>(app, ns, p, u32::MAX, vp);
     finish(atlas, st, pixel, p, winner, g)
+}
+
+/// N_S (eq. 5–6) of the pixel in grid column `c`: per diagonal δ,
+/// g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a for v ∈ {0, (δx, 0), (0, δy)}.
+/// Two diagonals per vector, three texels each; V joins mode 1.
+#[inline(always)]
+fn neighbourhood(app: &[u64], grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Neighbourhood {
+    let win = window(grid, c);
+    Neighbourhood {
+        ns01: diagonals(app, &win, 0),
+        ns23: diagonals(app, &win, 2),
+    }
+}
+
+/// Diagonals k and k + 1 of N_S, summed, as one vector.
+#[inline(always)]
+fn diagonals(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
+    let ((t0, v0), (t1, v1)) = (diagonal(app, win, k), diagonal(app, win, k + 1));
+    let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
+    for j in 0..3 {
+        sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
+    }
+    sum
+}
+
+/// Diagonal k of N_S: its three appearance texels and their ΣV.
+#[inline(always)]
+fn diagonal(app: &[u64], win: &Window<'_>, k: usize) -> ([u64; 3], i32) {
+    let (dx, dy) = DIAGONALS[k];
+    let a = at(win, dx, dy);
+    let b = at(win, 2 * dx, dy);
+    let cc = at(win, dx, 2 * dy);
+    let texels = [
+        app[a.idx as usize],
+        app[(b.idx - dx) as usize],
+        app[(cc.idx - dy * cc.stride) as usize],
+    ];
+    (texels, a.v + b.v + cc.v)
 }
 
 /// The winner's offset `v`, nudged towards the pixel's geometric target
@@ -428,10 +576,12 @@ struct Candidate {
     kappa: u32,
 }
 
-/// [`prefetch_line`] for an appearance texel.
+/// [`prefetch_line`] for element `i` of `table`. The address is only
+/// formed, never read, so it needs no bounds check (prefetching is a hint
+/// that cannot fault).
 #[inline(always)]
-fn prefetch(t: &u64) {
-    prefetch_line((t as *const u64).cast());
+fn prefetch<T>(table: &[T], i: i32) {
+    prefetch_line(table.as_ptr().wrapping_offset(i as isize).cast());
 }
 
 /// Asks the cache for the line holding `t` (a hint: no effect on results).
