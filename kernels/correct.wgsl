@@ -339,13 +339,15 @@ fn saturating_sub(a: i32, b: i32) -> i32 {
     return d;
 }
 
-// blend::phi: φ_d of eq. 9 with λ = ½, integer.
+// nudge::phi: φ_d of eq. 9 with λ = ½ (the whole error where tol = 0), integer.
 fn phi(x_in: i32, tol: i32) -> i32 {
     let x = clamp(x_in, -MAX_ERROR, MAX_ERROR);
     let a = u32(abs(x));
     let t = u32(tol);
     var mag = 0u;
-    if (a > t) {
+    if (t == 0u) {
+        mag = a;
+    } else if (a > t) {
         mag = (3u * a - 2u * t + 3u) / 6u;
     } else if (a != 0u) {
         let r = (a << 15u) / t;

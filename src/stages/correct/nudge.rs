@@ -28,7 +28,16 @@ impl Target {
 
 /// φ_d(x) of eq. 9 with λ = ½, in integer height units (the kernel side;
 /// identical in the scalar and SIMD corrections and in WGSL: 32-bit
-/// arithmetic only).
+/// arithmetic only) — except where the tolerance is 0, the pixels a curve
+/// or a point's site passes through: there φ = x, the whole error.
+///
+/// Why: eq. 9 halves the error per pass so that a constraint shapes its
+/// surroundings gradually, but a pixel held hard has no surroundings to
+/// shape — it is the constraint. Halved, the last level's two passes left
+/// a quarter of its error: ridges came out ~1.5 % of relief low and
+/// valleys high (issue 14), the cliff's top edge 1.38 % low. In full, the
+/// curve profile's mean error on the Pyrenees goes 1.32 → 0.80 % of
+/// relief and the cliff's top edge 1.38 → 0.87 %.
 ///
 /// With t the tolerance: `x/2 − sign(x)·t/3` outside ±t (slope λ, offset
 /// c = 2λt/3), `x·(x/t)²/6` inside (= −b·x³ with b = −λ/(3t²)). Inside, the
@@ -40,7 +49,9 @@ pub fn phi(x: i32, tol: i32) -> i32 {
     let x = x.clamp(-MAX_ERROR, MAX_ERROR);
     let a = x.unsigned_abs();
     let t = tol as u32;
-    let mag = if a > t {
+    let mag = if t == 0 {
+        a
+    } else if a > t {
         (3 * a - 2 * t + 3) / 6
     } else if a == 0 {
         0
@@ -66,11 +77,12 @@ pub fn nudge(v: i32, h_c: i32, target: Target) -> i32 {
 mod tests {
     use super::*;
 
-    /// Eq. 8–9 in floating point, as printed.
+    /// Eq. 8–9 in floating point, as printed (but the whole error where
+    /// t = 0).
     fn phi_f(x: f64, t: f64) -> f64 {
         let lambda = 0.5;
         if t == 0.0 {
-            return lambda * x;
+            return x;
         }
         let b = -lambda / (3.0 * t * t);
         let c = b * t * t * t + lambda * t;
@@ -109,7 +121,8 @@ mod tests {
                     tol: 0
                 }
             ),
-            500
+            1000,
+            "held hard: the whole error"
         );
     }
 }

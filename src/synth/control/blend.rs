@@ -36,7 +36,8 @@
 //! pixels would get a tolerance of up to 0.35·2^i cells of height and stay
 //! that far off. So d in t is measured from the footprint, approximated by
 //! its inscribed disc: `d_t = max(0, d − 2^(i−1))`. Every pixel a site or a
-//! curve passes through is held hard (t ≈ 0, φ = λx) at every level. The
+//! curve passes through is held hard (t = 0: φ = x, the whole error; see
+//! `stages::correct::nudge::phi`) at every level. The
 //! blend weight b keeps the centre distance.
 //!
 //! **Exactness.** Each sample's b, b·h_t and b·d_t are quantized to
