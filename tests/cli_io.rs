@@ -207,3 +207,23 @@ fn info_spacings_and_engine_settings() {
         assert!(masks.join(f).exists(), "{f}");
     }
 }
+
+#[test]
+fn a_closed_stdout_ends_a_command_without_a_panic() {
+    // `terrasynth … | head -1`: the reader is gone before anything is
+    // written (Rust ignores SIGPIPE by default, and println! panicked).
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
+        .args(["info", repo("data/hills.png").to_str().unwrap()])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        !out.status.success(),
+        "a command that could not write succeeded"
+    );
+}

@@ -74,6 +74,13 @@ pub type CliResult = Result<(), Box<dyn std::error::Error + Send + Sync>>;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    #[cfg(feature = "serve")]
+    let serving = matches!(cli.command, Command::Serve(_));
+    #[cfg(not(feature = "serve"))]
+    let serving = false;
+    if !serving {
+        default_sigpipe();
+    }
     let result = match cli.command {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
@@ -107,5 +114,18 @@ fn main() -> ExitCode {
             }
             ExitCode::FAILURE
         }
+    }
+}
+
+/// A closed stdout ends a command quietly, as it does any Unix tool
+/// (`terrasynth bench | head -1`): Rust starts programs with SIGPIPE
+/// ignored, so `println!` into a closed pipe panicked instead. The server
+/// keeps it ignored: a client hanging up must not end it.
+fn default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: the first thing `main` does, before any thread exists; SIG_DFL
+    // is a valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
