@@ -67,6 +67,20 @@ impl State {
     pub fn offsets(&self) -> Vec<i32> {
         self.v.iter().map(|a| a.load(Relaxed)).collect()
     }
+    /// A state holding `coords` and `offsets` (row-major, `width × height`):
+    /// the inverse of [`State::coords`] and [`State::offsets`].
+    pub fn from_parts(width: usize, height: usize, coords: &[Coord], offsets: &[i32]) -> State {
+        assert_eq!(
+            (coords.len(), offsets.len()),
+            (width * height, width * height)
+        );
+        State {
+            width,
+            height,
+            s: coords.iter().map(|c| AtomicU64::new(c.pack())).collect(),
+            v: offsets.iter().map(|&v| AtomicI32::new(v)).collect(),
+        }
+    }
     /// A copy of the pixels `[x0, x1) × [y0, y1)`.
     pub fn crop(&self, [x0, y0, x1, y1]: [usize; 4]) -> State {
         let out = State::new(x1 - x0, y1 - y0);

@@ -28,7 +28,6 @@ use super::{Control, Frames, PassResult, SynthError, Synthesizer};
 use crate::backend::Backend;
 use crate::level::state::State;
 use crate::stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
-use rayon::prelude::*;
 
 /// One level's buffers for [`Synthesizer::correct_cropped`]: the state,
 /// the level above and its size, and where the level lies.
@@ -116,14 +115,7 @@ impl Synthesizer<'_> {
                 origin: [region.x0 as u32, region.y0 as u32],
             };
             let g = b.upload_guide(&guide, w, h)?;
-            for &(px, py) in &SUBPASSES {
-                let p = CorrectParams {
-                    px,
-                    py,
-                    prior: self.params.prior,
-                };
-                b.correct_guided(state, parent, level, &p, &g);
-            }
+            self.subpasses(b, (state, parent), level, &g);
             let is_last = pass + 1 == self.params.passes as usize;
             if frames.is_some() || (is_last && window.is_some()) {
                 let (coords, offsets) = b.download(state)?;
@@ -205,14 +197,7 @@ impl Synthesizer<'_> {
                 origin: [(region.x0 + cr.x0) as u32, (region.y0 + cr.y0) as u32],
             };
             let g = b.upload_guide(&guide, cr.width(), cr.height())?;
-            for &(px, py) in &SUBPASSES {
-                let p = CorrectParams {
-                    px,
-                    py,
-                    prior: self.params.prior,
-                };
-                b.correct_guided(&sub, parent_sub.as_ref(), level, &p, &g);
-            }
+            self.subpasses(b, (&sub, parent_sub.as_ref()), level, &g);
             let is_last = pass + 1 == self.params.passes as usize;
             if frames.is_some() || is_last {
                 // The pass's result: the previous frame's with the
@@ -236,17 +221,25 @@ impl Synthesizer<'_> {
             .expect("passes > 0 (checked by can_crop)");
         let prev_last = before.last().expect("checked by can_crop");
         let changed = changed_bounds(&last.coords, &last.offsets, w, prev_last, window);
-        Ok((changed, b.upload(to_state(last, w, h))?))
+        let st = State::from_parts(w, h, &last.coords, &last.offsets);
+        Ok((changed, b.upload(st)?))
     }
-}
 
-/// A host state holding one pass's results.
-fn to_state(r: &PassResult, w: usize, h: usize) -> State {
-    let st = State::new(w, h);
-    (0..h).into_par_iter().for_each(|y| {
-        for i in y * w..(y + 1) * w {
-            st.set(i, r.coords[i], r.offsets[i]);
+    /// The subpasses of one correction pass, guided by `g`.
+    fn subpasses<B: Backend>(
+        &self,
+        b: &B,
+        (state, parent): (&B::State, Option<&B::State>),
+        level: usize,
+        g: &B::Guide<'_>,
+    ) {
+        for &(px, py) in &SUBPASSES {
+            let p = CorrectParams {
+                px,
+                py,
+                prior: self.params.prior,
+            };
+            b.correct_guided(state, parent, level, &p, g);
         }
-    });
-    st
+    }
 }
