@@ -148,7 +148,7 @@ fn the_start_exemplar_dominates_the_result() {
 fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     // The coarse start draws block origins uniformly over every exemplar's
     // interior texels, so each exemplar's share of the blocks follows its
-    // share of the interior area, within sampling noise.
+    // share of the interior area.
     let l = db().level_count() - 1;
     let atlas = AtlasLevel::new(db(), l);
     let bits = coarse::block_bits(&atlas, None);
@@ -169,9 +169,13 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     let n = 120;
     let side = n << bits;
     let jitter = 100; // 0.39 texel in fixed point
+    let src = coarse::Source {
+        db: db(),
+        atlas: &atlas,
+        from: None,
+    };
     let start = coarse::blocks(
-        &atlas,
-        None,
+        src,
         (Rect::new(0, 0, side, side), (side, side)),
         (l, bits),
         5,
@@ -192,9 +196,14 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     }
     for (e, (&u, &p)) in used.iter().zip(&areas).enumerate() {
         let (got, want) = (u as f64 / (n * n) as f64, p / total);
-        // Binomial standard deviation at n² = 14400 draws is < 0.005.
+        // The draws alone hold the area shares within sampling noise
+        // (binomial standard deviation < 0.005 at n² = 14400 draws; measured
+        // within 0.02); each group then keeps the layout most like its
+        // exemplars (`coarse::fit`), which moves them: measured 0.355 /
+        // 0.264 / 0.381 of 1/3 each. No exemplar may be starved or take
+        // over.
         assert!(
-            (got - want).abs() < 0.02,
+            got > 0.75 * want && got < 4.0 / 3.0 * want,
             "exemplar {e}: share {got:.3}, area share {want:.3} ({used:?})"
         );
     }
@@ -215,9 +224,13 @@ fn blocks_cover_every_interior_texel_alike_and_stay_inside() {
         (c.max_y - MARGIN as i32 + 1) as usize,
     );
     let side = 64 << bits;
+    let src = coarse::Source {
+        db: db(),
+        atlas: &atlas,
+        from: Some(0),
+    };
     let start = coarse::blocks(
-        &atlas,
-        Some(0),
+        src,
         (Rect::new(0, 0, side, side), (side, side)),
         (l, bits),
         9,
@@ -337,7 +350,7 @@ fn the_outer_strips_of_the_exemplars_are_drawn() {
         area += r.texels();
         area_strip += r.texels() - inner(r.width) * inner(r.height);
     }
-    for seed in [3, 4, 5] {
+    for seed in 1..=12 {
         let params = Params {
             keep_levels: true,
             ..Params::default()
@@ -357,10 +370,77 @@ fn the_outer_strips_of_the_exemplars_are_drawn() {
         }
     }
     let (got, want) = (in_strip as f64 / n as f64, area_strip as f64 / area as f64);
+    // Measured over these 12 seeds: 11.3 % of 23.4 %, with the start's
+    // fitted layouts (`coarse::fit`) as with single draws (seeds 3–5 alone:
+    // 10.3 / 13.5 % — a mean over a few outputs is a lottery).
     assert!(
-        got > 0.5 * want,
+        got > 0.35 * want,
         "outer {strip} px: {:.1} % of the output, {:.1} % of the exemplars",
         got * 100.0,
         want * 100.0
+    );
+}
+
+#[test]
+fn the_coarse_start_keeps_its_exemplar_relief_on_every_seed() {
+    // Each group of four blocks keeps, of eight drawn layouts, the one
+    // whose level-L heights and slopes are distributed most like its
+    // exemplars' (`coarse::fit`): an exemplar-sized output is one group,
+    // and a single draw left some seeds without the exemplar's heights or
+    // depths. Level-L heights are sampled at each texel's level-0 centre.
+    let l = db().level_count() - 1;
+    let atlas = AtlasLevel::new(db(), l);
+    let (heights, rects0) = (db().heights(), &db().level(0).layout.rects);
+    let height = |e: usize, x: i32, y: i32| {
+        let (r, rl) = (rects0[e], atlas.level.layout.rects[e]);
+        let (x0, y0) = (
+            ((x - rl.x0 as i32) << l) + (1 << (l - 1)),
+            (y << l) + (1 << (l - 1)),
+        );
+        f64::from(heights[r.offset as usize + y0 as usize * r.width as usize + x0 as usize])
+    };
+    let relief = |mut h: Vec<f64>| {
+        h.sort_by(f64::total_cmp);
+        h[h.len() * 99 / 100] - h[h.len() / 100]
+    };
+    let mut worst = f64::INFINITY;
+    for e in 0..atlas.level.layout.rects.len() {
+        let c = atlas.columns[atlas.level.layout.rects[e].x0 as usize];
+        let own = relief(
+            (MARGIN as i32..=c.max_y)
+                .flat_map(|y| (c.min_x..=c.max_x).map(move |x| (x, y)))
+                .map(|(x, y)| height(e, x, y))
+                .collect(),
+        );
+        let bits = coarse::block_bits(&atlas, Some(e));
+        let side = (c.max_x - c.min_x + 1) as usize;
+        for seed in 0..12 {
+            let src = coarse::Source {
+                db: db(),
+                atlas: &atlas,
+                from: Some(e),
+            };
+            let start = coarse::blocks(
+                src,
+                (Rect::new(0, 0, side, side), (side, side)),
+                (l, bits),
+                seed,
+                0,
+            );
+            let got = relief(
+                (0..side * side)
+                    .map(|i| start.s(i))
+                    .map(|s| height(e, round(s.x), round(s.y)))
+                    .collect(),
+            );
+            worst = worst.min(got / own);
+        }
+    }
+    // Measured over these 36 starts: worst 0.82 (one draw per group:
+    // 0.51, and 7 starts under 0.78).
+    assert!(
+        worst >= 0.78,
+        "a start kept {:.0} % of its exemplar's relief",
+        100.0 * worst
     );
 }

@@ -520,7 +520,12 @@ impl<'db> Synthesizer<'db> {
                 let from = self.params.start_exemplar;
                 let world = level_size(width, height, l);
                 let at = (region, world);
-                coarse::blocks(&self.atlas[l], from, at, (l, bits), seed, self.jitter)
+                let src = coarse::Source {
+                    db: self.db,
+                    atlas: &self.atlas[l],
+                    from,
+                };
+                coarse::blocks(src, at, (l, bits), seed, self.jitter)
             }
             Start::Centre => {
                 let top = start.top(m, l);

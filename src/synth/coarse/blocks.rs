@@ -1,133 +1,18 @@
-//! The coarse start: the state synthesis begins from, above or at the
-//! coarsest corrected level L — the database's coarsest level, at most
-//! [`MAX_START_LEVEL`].
-//!
-//! **Without jitter** (the reproduction property): level M holds the start
-//! exemplar's centre, spread so that each level halves the spacing — at
-//! level ≤ L an exact copy of the centre, tiled toroidally when the output
-//! is larger than the exemplar.
-//!
-//! **With jitter**, level L starts as a mosaic of *blocks* of 2^b × 2^b
-//! texels, each copied verbatim around a hash-chosen texel of any exemplar
-//! ([`blocks`]), drawn uniformly over every interior texel (so every
-//! exemplar, every terrain type and every part of an exemplar is drawn by
-//! its area), plus the paper's jitter; from L down, jitter and correction rearrange them.
-//!
-//! Why blocks, and why as large as the exemplars allow (b = ⌊log₂⌋ of the
-//! smallest exemplar interior side at L): pixel-based correction can join
-//! patches but cannot create large-scale structure. A mosaic of many small
-//! blocks (the fully jittered coarse level of Lefebvre & Hoppe 2005, which
-//! this crate used with b = 2) has no structure above the block size, and
-//! its joins — blocks from different altitudes side by side — are what the
-//! correction then levels: measured on the shared DEMs, level L kept 55–65 %
-//! of the exemplar's height spread and the output 55–70 % of its relief.
-//! Large blocks keep the exemplars' massifs and valley networks; the output
-//! still differs from any exemplar below the block scale (coherent patches
-//! at level 0 average ~100 pixels), and outputs larger than the exemplars
-//! get more blocks rather than a tiled copy. Halving the blocks (b − 1)
-//! was measured too: relief ≥ 85 % on 2 of the 8 DEMs instead of 4, and
-//! "hills" took 69 % of a typed output where they are 48 % of the
-//! exemplars — every join is levelled towards the middle.
-//!
-//! Computed on the host for every backend and uploaded: it is small
-//! (level L, ⌈W/2^L⌉ × ⌈H/2^L⌉ pixels), so it has no kernel mirror. Every
-//! choice is a hash of the seed and the block's absolute position
-//! (DESIGN §6), so any window of a terrain starts from the same blocks.
+//! The blocks of the coarse start: where they lie, what they draw, how
+//! their edges wander.
 
-use crate::database::layout::MARGIN;
+use super::fit;
+use super::{Source, interiors};
 use crate::hash::{below, hash4};
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::cone::Rect;
 use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::stages::upsample_jitter;
-use crate::synth::state::{State, level_size};
-
-/// The coarsest level synthesis starts from (and corrects), whatever
-/// coarser levels the database holds.
-///
-/// Why not the database's coarsest level L: synthesis coordinates stay
-/// [`MARGIN`] texels inside every exemplar at every level, and a level-L
-/// texel is 2^L pixels across — at L = 5 (the shared DEMs) the outer 64
-/// pixels of every exemplar side, 20–29 % of its area, were never drawn
-/// (measured from `--coords`: 0.0–0.5 % of the output from the outer 64
-/// columns of franconian_jura, 8 % of its area), and that is where those
-/// DEMs keep their lowest valleys and highest ridges: the output kept
-/// 76–85 % of their relief. Starting at level 3 loses 16 pixels a side;
-/// the blocks keep their size in pixels (b grows as the level falls).
-/// Level 2 left too few levels to join the blocks: straight seams showed
-/// along block edges (looked at on thuringia).
-pub const MAX_START_LEVEL: usize = 3;
+use crate::synth::state::State;
 
 /// Hash salt of the block positions (kept apart from the jitter's
 /// `hash4(seed, level, x, y)`, whose level is always < 2^16).
 const COARSE_SALT: u32 = 0xC0A5_0000;
-
-/// How a synthesis starts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Start {
-    /// The start exemplar's centre at level M (no jitter, or no room for a
-    /// block above L).
-    Centre,
-    /// Verbatim blocks of 2^bits × 2^bits level-L texels, made at level L.
-    Blocks { bits: usize },
-}
-
-impl Start {
-    /// The start of an output whose coarsest level is `m`, for a database
-    /// whose coarsest level `l` is `atlas_l`: blocks (from exemplar `from`,
-    /// or every exemplar) when there is jitter and room above L, else the
-    /// centre.
-    pub fn choose(
-        jittered: bool,
-        m: usize,
-        l: usize,
-        atlas_l: &AtlasLevel<'_>,
-        from: Option<usize>,
-    ) -> Start {
-        let bits = block_bits(atlas_l, from).min(m.saturating_sub(l));
-        if jittered && bits > 0 {
-            Start::Blocks { bits }
-        } else {
-            Start::Centre
-        }
-    }
-
-    /// The coarsest synthesized level.
-    pub fn top(self, m: usize, l: usize) -> usize {
-        match self {
-            Start::Centre => m,
-            Start::Blocks { .. } => l,
-        }
-    }
-}
-
-/// Inclusive interior bounds `[x0, x1] × [y0, y1]` of exemplar `from`, or
-/// of every exemplar, of a level, in atlas texels.
-fn interiors<'a>(
-    a: &'a AtlasLevel<'_>,
-    from: Option<usize>,
-) -> impl Iterator<Item = (i32, i32, i32, i32)> + 'a {
-    let rects = &a.level.layout.rects;
-    let rects = match from {
-        Some(e) => &rects[e..=e],
-        None => &rects[..],
-    };
-    rects.iter().map(|r| {
-        let c = a.columns[r.x0 as usize];
-        (c.min_x, c.max_x, MARGIN as i32, c.max_y)
-    })
-}
-
-/// The largest b such that a 2^b block fits the interior of exemplar
-/// `from` (or of every exemplar) at level L.
-pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
-    let side = interiors(a, from)
-        .map(|(x0, x1, y0, y1)| (x1 - x0 + 1).min(y1 - y0 + 1))
-        .min()
-        .unwrap_or(1)
-        .max(1);
-    side.ilog2() as usize
-}
 
 /// Level L of an output over `region` (absolute level-L pixels: the whole
 /// level, or a window's cone): each pixel belongs to the 2^bits × 2^bits
@@ -156,54 +41,93 @@ pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
 /// The block grid is shifted so that the world's centre is the centre of
 /// a 2 × 2 group ([`grid_shift`]).
 pub fn blocks(
-    a: &AtlasLevel<'_>,
-    from: Option<usize>,
+    src: Source<'_>,
     (region, world): (Rect, (usize, usize)),
     (l, bits): (usize, usize),
     seed: u32,
     jitter: i32,
 ) -> State {
-    // Interior origin and size (x0, y0, nx, ny) per exemplar.
-    let ranges: Vec<(i32, i32, i32, i32)> = interiors(a, from)
-        .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
-        .collect();
-    let total: u32 = ranges.iter().map(|r| (r.2 * r.3) as u32).sum();
-    let order = z_order(&ranges);
+    let draws = Draws::new(src.atlas, src.from, bits);
     let (w, h) = (region.width(), region.height());
-    let st = State::new(w, h);
     let shift = (grid_shift(world.0, bits), grid_shift(world.1, bits));
-    for (i, ay) in (region.y0..region.y1).enumerate() {
-        for (j, ax) in (region.x0..region.x1).enumerate() {
-            let (ax, ay) = (ax as i32, ay as i32);
-            // The block this pixel belongs to: the one under its warped
-            // position on the shifted grid; it copies that block's
-            // exemplar from its own place relative to the block's corner.
+    // The block of every pixel: the one under its warped position on the
+    // shifted grid; it copies that block's exemplar from its own place
+    // relative to the block's corner.
+    let at: Vec<((i32, i32), (i32, i32))> = (region.y0..region.y1)
+        .flat_map(|ay| (region.x0..region.x1).map(move |ax| (ax as i32, ay as i32)))
+        .map(|(ax, ay)| {
             let (x, y) = (ax + shift.0, ay + shift.1);
-            let (bx, by) = block_of(seed, x, y, bits);
-            let mut k = order[block_draw(seed, bx as u32, by as u32, total) as usize];
-            for &(x0, y0, nx, ny) in &ranges {
-                let n = (nx * ny) as u32;
-                if k < n {
-                    // The block is centred on its origin texel and
-                    // mirrored at the interior's edges (see below).
-                    let (ox, oy) = ((k % nx as u32) as i32, (k / nx as u32) as i32);
-                    let half = 1 << (bits - 1);
-                    let lx = mirror(ox - half + x - (bx << bits), nx);
-                    let ly = mirror(oy - half + y - (by << bits), ny);
-                    let (jx, jy) =
-                        upsample_jitter::jitter(seed, l as u32, ax as u32, ay as u32, jitter);
-                    let s = Coord {
-                        x: inside(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
-                        y: inside(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
-                    };
-                    st.set(i * w + j, s, 0);
-                    break;
-                }
-                k -= n;
-            }
-        }
+            ((x, y), block_of(seed, x, y, bits))
+        })
+        .collect();
+    let layouts = fit::layouts(src, &draws, (world, shift), seed, at.iter().map(|p| p.1));
+    let st = State::new(w, h);
+    for (i, &((x, y), (bx, by))) in at.iter().enumerate() {
+        let c = layouts[&(bx >> 1, by >> 1)];
+        let (r, lx, ly) = draws.texel(seed, c, (bx, by), (x, y));
+        let (x0, y0, nx, ny) = draws.ranges[r];
+        let (ax, ay) = (x - shift.0, y - shift.1);
+        let (jx, jy) = upsample_jitter::jitter(seed, l as u32, ax as u32, ay as u32, jitter);
+        let s = Coord {
+            x: inside(((x0 + lx) << FRAC_BITS) + jx, x0, nx),
+            y: inside(((y0 + ly) << FRAC_BITS) + jy, y0, ny),
+        };
+        st.set(i, s, 0);
     }
     st
+}
+
+/// The interiors blocks draw from, and where a drawn block's pixels copy
+/// their texels.
+pub(super) struct Draws {
+    /// Interior origin and size (x0, y0, nx, ny) per exemplar.
+    pub ranges: Vec<(i32, i32, i32, i32)>,
+    /// [`z_order`] of the interior texels.
+    order: Vec<u32>,
+    total: u32,
+    pub bits: usize,
+}
+
+impl Draws {
+    pub fn new(a: &AtlasLevel<'_>, from: Option<usize>, bits: usize) -> Draws {
+        let ranges: Vec<(i32, i32, i32, i32)> = interiors(a, from)
+            .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
+            .collect();
+        let total = ranges.iter().map(|r| (r.2 * r.3) as u32).sum();
+        let order = z_order(&ranges);
+        Draws {
+            ranges,
+            order,
+            total,
+            bits,
+        }
+    }
+
+    /// The interior texel `(range, lx, ly)` that pixel (x, y) of the
+    /// shifted grid copies when it belongs to block (bx, by) and the
+    /// block's group takes its `layout`-th draw: the block is centred on
+    /// its drawn texel and mirrored at the interior's edges.
+    pub fn texel(
+        &self,
+        seed: u32,
+        layout: u32,
+        (bx, by): (i32, i32),
+        (x, y): (i32, i32),
+    ) -> (usize, i32, i32) {
+        let mut k = self.order[block_draw(seed, layout, bx as u32, by as u32, self.total) as usize];
+        let half = 1 << (self.bits - 1);
+        for (r, &(_, _, nx, ny)) in self.ranges.iter().enumerate() {
+            let n = (nx * ny) as u32;
+            if k < n {
+                let (ox, oy) = ((k % nx as u32) as i32, (k / nx as u32) as i32);
+                let lx = mirror(ox - half + x - (bx << self.bits), nx);
+                let ly = mirror(oy - half + y - (by << self.bits), ny);
+                return (r, lx, ly);
+            }
+            k -= n;
+        }
+        unreachable!("block_draw stays below the interior texel count")
+    }
 }
 
 /// The interior texels (as row-major indices over every exemplar's
@@ -288,14 +212,15 @@ fn block_of(seed: u32, x: i32, y: i32, bits: usize) -> (i32, i32) {
 /// exemplar), while groups stay independent, so like still meets like
 /// across group borders. A pure function of the seed and the block's
 /// position, as every choice of the start (windows need no neighbours).
-fn block_draw(seed: u32, bx: u32, by: u32, total: u32) -> u32 {
-    let group = hash4(seed, COARSE_SALT | 1, bx >> 1, by >> 1);
+fn block_draw(seed: u32, layout: u32, bx: u32, by: u32, total: u32) -> u32 {
+    let salt = COARSE_SALT | layout << 8;
+    let group = hash4(seed, salt | 1, bx >> 1, by >> 1);
     // The group's order of quarters: each slot's rank among four hashed
     // bytes (ties by slot), so every order of the quarters can occur.
     let key = |slot: u32| ((group >> (8 * slot)) & 0xFF, slot);
     let slot = (bx & 1) | (by & 1) << 1;
     let quarter = (0..4).filter(|&t| key(t) < key(slot)).count() as u64;
-    let within = below(hash4(seed, COARSE_SALT, bx, by), total);
+    let within = below(hash4(seed, salt, bx, by), total);
     ((quarter * u64::from(total) + u64::from(within)) / 4) as u32
 }
 
@@ -354,44 +279,6 @@ fn inside(v: i32, min: i32, n: i32) -> i32 {
     )
 }
 
-/// Level `top` of a `width × height` output without blocks, over `region`
-/// (absolute level-`top` pixels): the centre of exemplar `e` at the level
-/// `min(top, l)` of `a`, spread so that each level halves the spacing (in
-/// level-L units above L).
-pub fn centre(
-    a: &AtlasLevel<'_>,
-    e: usize,
-    (width, height): (usize, usize),
-    region: Rect,
-    top: usize,
-    l: usize,
-) -> State {
-    let r = a.level.layout.rects[e];
-    let (w, h) = level_size(width, height, top);
-    let st = State::new(region.width(), region.height());
-    let (cx, cy) = ((r.x0 + r.width / 2) as i32, (r.height / 2) as i32);
-    for (i, y) in (region.y0..region.y1).enumerate() {
-        for (j, x) in (region.x0..region.x1).enumerate() {
-            // Offset from the level's centre, in half texels of level top.
-            let (hx, hy) = (2 * x as i32 + 1 - w as i32, 2 * y as i32 + 1 - h as i32);
-            let to_fixed = |half: i32| -> i32 {
-                if top > l {
-                    // In level-L units: a level-top texel is 2^(top−L) of them.
-                    (half << FRAC_BITS) << (top - l - 1)
-                } else {
-                    half << (FRAC_BITS - 1)
-                }
-            };
-            let s = Coord {
-                x: (cx << FRAC_BITS) + to_fixed(hx),
-                y: (cy << FRAC_BITS) + to_fixed(hy),
-            };
-            st.set(i * region.width() + j, s, 0);
-        }
-    }
-    st
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -402,7 +289,7 @@ mod tests {
         for seed in 0..50 {
             for (gx, gy) in [(0u32, 0u32), (7, 3), (u32::MAX >> 1, 2)] {
                 let mut quarters: Vec<u32> = (0..4)
-                    .map(|s| block_draw(seed, 2 * gx + (s & 1), 2 * gy + (s >> 1), total))
+                    .map(|s| block_draw(seed, 0, 2 * gx + (s & 1), 2 * gy + (s >> 1), total))
                     .map(|k| {
                         assert!(k < total);
                         k * 4 / total
