@@ -194,6 +194,7 @@ pub fn synthesize_with(
         valleys,
         timings,
         stats,
+        sources: canvas.source,
     })
 }
 
