@@ -6,6 +6,9 @@
 //! of the pixels) and 3.51 averaged over its sources by share; with it,
 //! 2.32 and 2.40. Skipped with a message without ../shared/dem.
 
+mod common;
+
+use common::dem::{DEM, typed_stems};
 use std::path::Path;
 use terrasynth::Heightfield;
 use terrasynth::eval;
@@ -14,33 +17,23 @@ use terrasynth::patch::sketch::Sketch;
 use terrasynth::patch::{self, Library, Params};
 use terrasynth::progress::Silent;
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
-
-const NAMES: [&str; 8] = [
-    "catalan_coast_hills",
-    "franconian_jura",
-    "north_german_plain",
-    "olympic_peninsula_coast",
-    "pyrenees_andorra",
-    "riviera_coast",
-    "thuringia_hills",
-    "yosemite_half_dome",
-];
-
+/// The eight shared DEMs (each has a type mask beside it), or None with a
+/// message without ../shared/dem.
 fn sources() -> Option<Vec<(String, Heightfield)>> {
-    let mut out = Vec::new();
-    for name in NAMES {
-        let p = Path::new(DEM).join(format!("{name}.png"));
-        if !p.exists() {
-            eprintln!("skipping: {} not found", p.display());
-            return None;
-        }
-        out.push((
-            name.to_string(),
-            io::read(&p, &ReadOptions::default()).unwrap(),
-        ));
-    }
-    Some(out)
+    let stems = typed_stems("the eight-source sketch synthesis")?;
+    assert_eq!(stems.len(), 8, "{stems:?}");
+    let read = |s: &String| {
+        io::read(
+            &Path::new(DEM).join(format!("{s}.png")),
+            &ReadOptions::default(),
+        )
+    };
+    Some(
+        stems
+            .iter()
+            .map(|s| (s.clone(), read(s).unwrap()))
+            .collect(),
+    )
 }
 
 #[test]
