@@ -123,7 +123,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("cpu/64", |b| {
         b.iter(|| {
             let mut cv = canvas.clone();
-            black_box(merge::apply(&mut cv, win, &p, &seam.take_new, &opts))
+            black_box(merge::apply(&mut cv, win, (&p, 0), &seam.take_new, &opts))
         })
     });
     g.finish();

@@ -147,7 +147,13 @@ pub fn synthesize_with(
         if let Some((s, seam)) = chosen {
             let t3 = Instant::now();
             *uses.entry(s.key).or_insert(0) += 1;
-            if let Some(rep) = merge::apply(&mut canvas, win, &s.patch, &seam.take_new, &opts) {
+            if let Some(rep) = merge::apply(
+                &mut canvas,
+                win,
+                (&s.patch, s.key.0 as u32),
+                &seam.take_new,
+                &opts,
+            ) {
                 stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
             }
             stats.feature_patches += 1;
@@ -188,6 +194,7 @@ pub fn synthesize_with(
         valleys,
         timings,
         stats,
+        sources: canvas.source,
     })
 }
 

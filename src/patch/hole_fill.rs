@@ -364,7 +364,13 @@ pub(crate) fn fill(
         let t3 = Instant::now();
         *uses.entry(s.key).or_insert(0) += 1;
         let before = uw.overlap;
-        if let Some(rep) = merge::apply(canvas, win, &s.patch, &seam.take_new, &opts) {
+        if let Some(rep) = merge::apply(
+            canvas,
+            win,
+            (&s.patch, s.key.0 as u32),
+            &seam.take_new,
+            &opts,
+        ) {
             stats.worst_residual = stats.worst_residual.max(rep.relative_residual);
         }
         bl.update(canvas, win.x0, win.y0, win.x0 + n, win.y0 + n);

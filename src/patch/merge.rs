@@ -21,15 +21,23 @@ pub struct Canvas {
     pub height: usize,
     pub heights: Vec<f32>,
     pub filled: Vec<bool>,
+    /// Which source each filled pixel came from (index into the library's
+    /// sources; [`Canvas::NO_SOURCE`] where nothing is placed): the
+    /// coherence cost of round two reads it ([`super::Weights::coherence`]).
+    pub source: Vec<u32>,
 }
 
 impl Canvas {
+    /// [`Canvas::source`] of a pixel nothing has been placed on.
+    pub const NO_SOURCE: u32 = u32::MAX;
+
     pub fn new(width: usize, height: usize) -> Canvas {
         Canvas {
             width,
             height,
             heights: vec![0.0; width * height],
             filled: vec![false; width * height],
+            source: vec![Canvas::NO_SOURCE; width * height],
         }
     }
 }
@@ -238,13 +246,14 @@ pub fn seam_coarse(c: &Canvas, win: Window, patch: &[f32], core: Option<&[bool]>
     s
 }
 
-/// Merges `patch` (already offset) into the canvas at `win`, taking the
-/// pixels `take_new`. Returns the Poisson solve's report (None when nothing
-/// old bordered the patch and it was copied as is).
+/// Merges `patch` (already offset), cut from source `source`, into the
+/// canvas at `win`, taking the pixels `take_new`. Returns the Poisson
+/// solve's report (None when nothing old bordered the patch and it was
+/// copied as is).
 pub fn apply(
     c: &mut Canvas,
     win: Window,
-    patch: &[f32],
+    (patch, source): (&[f32], u32),
     take_new: &[bool],
     opts: &SolveOptions,
 ) -> Option<SolveReport> {
@@ -294,6 +303,7 @@ pub fn apply(
                 let i = (win.y0 + y) * w + win.x0 + x;
                 c.heights[i] = patch[y * n + x];
                 c.filled[i] = true;
+                c.source[i] = source;
             }
         }
         return None;
@@ -458,6 +468,7 @@ pub fn apply(
                 let i = ci(gx, gy);
                 c.heights[i] = u[gy * gw + gx];
                 c.filled[i] = true;
+                c.source[i] = source;
             }
         }
     }

@@ -69,6 +69,19 @@ pub struct Weights {
     /// Weight of the noise cost against the SSD in the integer first round
     /// of hole filling.
     pub fill_noise: u64,
+    /// Weight of the coherence cost: the share of a window's placed pixels
+    /// that came from another source than the candidate's. Not in the
+    /// seeds (seed 004 takes the best patch of any source at every step).
+    /// Without it, eight shared DEMs made a patchwork that switched source
+    /// at nearly every patch (a patch of Alpine ridge, then one of a
+    /// coastal plain, then one of a low plateau, all brought to one relief
+    /// but each with its own mix of fine and mid-scale relief): blobs of
+    /// mush between sharp patches, ridges broken into lumps, and the
+    /// plains' fine noise with none of their structure. Real terrain
+    /// changes character over tens of kilometres, not every patch; with
+    /// this cost a source is kept until another fits clearly better. With
+    /// one source it is always 0.
+    pub coherence: f64,
 }
 
 impl Default for Weights {
@@ -82,6 +95,7 @@ impl Default for Weights {
             repeat: 0.5,
             detail: 1.0,
             fill_noise: 4,
+            coherence: 1.0,
         }
     }
 }

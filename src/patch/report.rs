@@ -44,4 +44,10 @@ pub struct Synthesis {
     pub valleys: FeatureGraph,
     pub timings: Timings,
     pub stats: Stats,
+    /// Which of the library's sources each output pixel was cut from
+    /// (row-major, an index into [`Library::sources`]), for measuring a
+    /// result against the DEMs it is made of.
+    ///
+    /// [`Library::sources`]: super::Library::sources
+    pub sources: Vec<u32>,
 }

@@ -105,7 +105,8 @@ pub(crate) fn round2_cost(
     cost + weights.noise * num / den
 }
 
-/// Picks the winner among scored candidates: sort by cost (ties by key),
+/// Picks the winner among scored candidates: add the coherence cost
+/// ([`Weights::coherence`]), sort by cost (ties by key),
 /// add the graph-cut cost for the best `finalists` (estimated at half
 /// resolution, [`merge::seam_coarse`]), take the minimum (ties by rank),
 /// and cut the winner at full resolution in a band around its half-
@@ -118,6 +119,10 @@ pub(crate) fn select(
     core: Option<&[bool]>,
     params: &Params,
 ) -> Option<(Scored, graphcut::Seam)> {
+    let coherence = coherence_costs(c, win);
+    for s in &mut scored {
+        s.cost += params.weights.coherence * coherence(s.key.0);
+    }
     scored.sort_by(|a, b| a.cost.total_cmp(&b.cost).then(a.key.cmp(&b.key)));
     scored.truncate(params.finalists.max(1));
     let n = win.n as f64;
@@ -161,4 +166,35 @@ pub(crate) fn select(
     let mut win_s = scored.swap_remove(best);
     win_s.patch = p;
     Some((win_s, seam))
+}
+
+/// The coherence cost of a candidate from each source in `win`: the share
+/// of the already placed pixels of the window that came from another
+/// source (0 where nothing is placed). See [`Weights::coherence`].
+fn coherence_costs(c: &Canvas, win: Window) -> impl Fn(usize) -> f64 {
+    let mut counts: Vec<(u32, usize)> = Vec::new();
+    let mut placed = 0usize;
+    for y in 0..win.n {
+        let row = (win.y0 + y) * c.width + win.x0;
+        for &s in &c.source[row..row + win.n] {
+            if s == Canvas::NO_SOURCE {
+                continue;
+            }
+            placed += 1;
+            match counts.iter_mut().find(|(k, _)| *k == s) {
+                Some((_, n)) => *n += 1,
+                None => counts.push((s, 1)),
+            }
+        }
+    }
+    move |source: usize| {
+        if placed == 0 {
+            return 0.0;
+        }
+        let same = counts
+            .iter()
+            .find(|(k, _)| *k as usize == source)
+            .map_or(0, |(_, n)| *n);
+        1.0 - same as f64 / placed as f64
+    }
 }
