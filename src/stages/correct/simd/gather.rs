@@ -1,0 +1,154 @@
+//! Candidate gathering (paper eq. 3): C₁ and C₂ of every distinct
+//! `u = S(p+Δ) − Δ` of a pixel, listed ahead of scoring with their texels
+//! prefetched.
+
+use super::super::DELTAS;
+use super::grid::{Grid, Window, at, window};
+use crate::level::atlas::AtlasLevel;
+
+/// A pixel whose candidates are gathered, awaiting scoring.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Pending {
+    pub cands: [Candidate; 18],
+    pub count: usize,
+}
+
+/// One candidate of the pixel being corrected.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Candidate {
+    /// Texel index and row stride.
+    pub idx: i32,
+    pub stride: i32,
+    /// Atlas texel.
+    pub x: i32,
+    pub y: i32,
+    /// Index into DELTAS of the neighbour it came from.
+    pub from: u8,
+    pub kappa: u32,
+}
+
+/// Prefetches the similarity entries the gathering of the pixel in grid
+/// column `c` will read, those of `u = S(p + Δ) − Δ` for the three Δ of
+/// its column (in a coherent patch all nine u coincide with these). The
+/// first read of an atlas row near u is this one: gathering's own
+/// prefetches cover only the texels that scoring reads later, and the
+/// profile showed the `similar` load as the costliest instruction.
+#[inline(always)]
+pub(super) fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize) {
+    let similar = atlas.level.similar;
+    let win = window(grid, c);
+    for dy in -1..=1 {
+        let n = at(&win, 0, dy);
+        prefetch(similar, n.idx - dy * n.stride);
+    }
+}
+
+/// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
+/// distinct `u = S(p+Δ) − Δ`, in DELTAS order) and prefetches the texels
+/// scoring will read: C₂ entries point anywhere in the atlas, and at level 0
+/// the atlas is larger than the L2 cache.
+#[inline(always)]
+pub(super) fn gather(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, out: &mut Pending) {
+    let win = window(grid, c);
+    let mut seen = Seen {
+        idx: [0; 9],
+        distinct: 0,
+    };
+    out.count = 0;
+    // One call per Δ, so that each is compiled with its Δ as a constant.
+    gather_delta::<0>(atlas, &win, &mut seen, out);
+    gather_delta::<1>(atlas, &win, &mut seen, out);
+    gather_delta::<2>(atlas, &win, &mut seen, out);
+    gather_delta::<3>(atlas, &win, &mut seen, out);
+    gather_delta::<4>(atlas, &win, &mut seen, out);
+    gather_delta::<5>(atlas, &win, &mut seen, out);
+    gather_delta::<6>(atlas, &win, &mut seen, out);
+    gather_delta::<7>(atlas, &win, &mut seen, out);
+    gather_delta::<8>(atlas, &win, &mut seen, out);
+}
+
+/// Texel indices of the distinct u of a pixel so far: u lies in the
+/// exemplar of S(n), one texel from its interior, so its index identifies
+/// it.
+struct Seen {
+    idx: [i32; 9],
+    distinct: usize,
+}
+
+/// [`gather`]'s step for Δ = `DELTAS[K]`: C₁ and C₂ of its u unless an
+/// earlier Δ had the same u.
+#[inline(always)]
+fn gather_delta<const K: usize>(
+    atlas: &AtlasLevel<'_>,
+    win: &Window<'_>,
+    seen: &mut Seen,
+    out: &mut Pending,
+) {
+    let app = atlas.level.appearance;
+    let (dx, dy) = DELTAS[K];
+    let n = at(win, dx, dy);
+    let u_idx = n.idx - dx - dy * n.stride;
+    if seen.idx[..seen.distinct].contains(&u_idx) {
+        return;
+    }
+    seen.idx[seen.distinct] = u_idx;
+    seen.distinct += 1;
+    let count = out.count;
+    // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
+    let u = (n.sx - dx, n.sy - dy);
+    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
+    out.cands[count] = Candidate {
+        idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
+        stride: n.stride,
+        x: cx,
+        y: cy,
+        from: K as u8,
+        kappa: 1,
+    };
+    // C₂: the stored best other match, anywhere in the atlas.
+    let c2 = atlas.level.similar[u_idx as usize];
+    let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+    let col = &atlas.columns[qx as usize];
+    out.cands[count + 1] = Candidate {
+        idx: col.base + qy * col.stride as i32 + qx,
+        stride: col.stride as i32,
+        x: qx,
+        y: qy,
+        from: K as u8,
+        kappa: 2,
+    };
+    // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
+    // lines of one row when they straddle a cache line (a quarter of the
+    // time). C₂ lands anywhere, so both of its lines are asked for; C₁ is
+    // near S(p), whose lines N_S reads anyway.
+    for q in &out.cands[count..count + 2] {
+        prefetch(app, q.idx - q.stride - 1);
+        prefetch(app, q.idx + q.stride - 1);
+    }
+    let q = &out.cands[count + 1];
+    prefetch(app, q.idx - q.stride + 1);
+    prefetch(app, q.idx + q.stride + 1);
+    out.count = count + 2;
+}
+
+/// [`prefetch_line`] for element `i` of `table`. The address is only
+/// formed, never read, so it needs no bounds check (prefetching is a hint
+/// that cannot fault).
+#[inline(always)]
+fn prefetch<T>(table: &[T], i: i32) {
+    prefetch_line(table.as_ptr().wrapping_offset(i as isize).cast());
+}
+
+/// Asks the cache for the line holding `t` (a hint: no effect on results).
+#[inline(always)]
+fn prefetch_line(t: *const i8) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `prefetch` only hints the cache; it cannot fault or change
+    // memory, and SSE is part of the x86_64 baseline.
+    unsafe {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(t);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = t;
+}
