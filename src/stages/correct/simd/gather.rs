@@ -3,7 +3,7 @@
 //! prefetched.
 
 use super::super::DELTAS;
-use super::grid::{Grid, Window, at, window};
+use super::grid::{Grid, Tap, at, window};
 use crate::level::atlas::AtlasLevel;
 
 /// A pixel whose candidates are gathered, awaiting scoring.
@@ -47,64 +47,42 @@ pub(super) fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize) {
 /// distinct `u = S(p+Δ) − Δ`, in DELTAS order) and prefetches the texels
 /// scoring will read: C₂ entries point anywhere in the atlas, and at level 0
 /// the atlas is larger than the L2 cache.
+///
+/// The distinct u are found first, as a bit mask, with a fixed number of
+/// compares; then only they are listed, in one loop. Deciding per Δ
+/// whether its u is new was a branch that varied from pixel to pixel and
+/// mispredicted often (listing every Δ instead, repeats included, was
+/// slower still).
 #[inline(always)]
 pub(super) fn gather(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, out: &mut Pending) {
     let win = window(grid, c);
-    let mut seen = Seen {
-        idx: [Seen::NONE; 9],
-        distinct: 0,
-    };
-    out.count = 0;
-    // One call per Δ, so that each is compiled with its Δ as a constant.
-    gather_delta::<0>(atlas, &win, &mut seen, out);
-    gather_delta::<1>(atlas, &win, &mut seen, out);
-    gather_delta::<2>(atlas, &win, &mut seen, out);
-    gather_delta::<3>(atlas, &win, &mut seen, out);
-    gather_delta::<4>(atlas, &win, &mut seen, out);
-    gather_delta::<5>(atlas, &win, &mut seen, out);
-    gather_delta::<6>(atlas, &win, &mut seen, out);
-    gather_delta::<7>(atlas, &win, &mut seen, out);
-    gather_delta::<8>(atlas, &win, &mut seen, out);
-}
-
-/// Texel indices of the distinct u of a pixel so far: u lies in the
-/// exemplar of S(n), one texel from its interior, so its index identifies
-/// it. Entries past `distinct` hold [`Seen::NONE`].
-struct Seen {
-    idx: [i32; 9],
-    distinct: usize,
-}
-
-impl Seen {
-    /// No texel index (indices are never negative).
-    const NONE: i32 = i32::MIN;
-}
-
-/// [`gather`]'s step for Δ = `DELTAS[K]`: C₁ and C₂ of its u unless an
-/// earlier Δ had the same u.
-#[inline(always)]
-fn gather_delta<const K: usize>(
-    atlas: &AtlasLevel<'_>,
-    win: &Window<'_>,
-    seen: &mut Seen,
-    out: &mut Pending,
-) {
-    let app = atlas.level.appearance;
-    let (dx, dy) = DELTAS[K];
-    let n = at(win, dx, dy);
-    let u_idx = n.idx - dx - dy * n.stride;
-    // Compared with all K entries the earlier Δ can have filled, unused
-    // ones holding NONE: a fixed number of compares, not a search whose
-    // length varies from pixel to pixel (that search's exits were 4.6 %
-    // of the synthesis' time at 1024²).
-    if seen.idx[..K]
-        .iter()
-        .fold(false, |dup, &i| dup | (i == u_idx))
-    {
-        return;
+    let taps: [&Tap; 9] = std::array::from_fn(|k| at(&win, DELTAS[k].0, DELTAS[k].1));
+    // u lies in the exemplar of S(n), one texel from its interior, so its
+    // texel index identifies it.
+    let u: [i32; 9] = std::array::from_fn(|k| {
+        let (dx, dy) = DELTAS[k];
+        taps[k].idx - dx - dy * taps[k].stride
+    });
+    // Bit k: no earlier Δ has Δ k's u.
+    let mut first = 1u32;
+    for k in 1..9 {
+        let dup = u[..k].iter().fold(false, |dup, &v| dup | (v == u[k]));
+        first |= (!dup as u32) << k;
     }
-    seen.idx[seen.distinct] = u_idx;
-    seen.distinct += 1;
+    out.count = 0;
+    while first != 0 {
+        let k = first.trailing_zeros() as usize;
+        first &= first - 1;
+        list(atlas, taps[k], k, u[k], out);
+    }
+}
+
+/// [`gather`]'s listing of C₁ and C₂ of Δ = `DELTAS[k]`, whose neighbour
+/// is `n` and u's texel index `u_idx`.
+#[inline(always)]
+fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending) {
+    let app = atlas.level.appearance;
+    let (dx, dy) = DELTAS[k];
     let count = out.count;
     // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
     let u = (n.sx - dx, n.sy - dy);
@@ -114,7 +92,7 @@ fn gather_delta<const K: usize>(
         stride: n.stride,
         x: cx,
         y: cy,
-        from: K as u8,
+        from: k as u8,
         kappa: 1,
     };
     // C₂: the stored best other match, anywhere in the atlas.
@@ -126,7 +104,7 @@ fn gather_delta<const K: usize>(
         stride: col.stride as i32,
         x: qx,
         y: qy,
-        from: K as u8,
+        from: k as u8,
         kappa: 2,
     };
     // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
