@@ -25,141 +25,23 @@
 //!   SSE2 baseline and for AVX2, and picked at run time (integer
 //!   arithmetic: the same bytes either way).
 
+mod gather;
+mod grid;
+mod score;
+
 use super::nudge::nudge;
-use super::{ALL_TYPES, CLAMP, DELTAS, DIAGONALS, FLAT, Guide, Prior, W_FREE, scalar, weigh};
+use super::{ALL_TYPES, DELTAS, Guide, Prior, W_FREE, scalar, weigh};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use wide::{i16x8, i32x8};
-
-/// A neighbour as the kernel needs it.
-#[derive(Clone, Copy, Default)]
-struct Tap {
-    /// Texel index of the rounded coordinate.
-    idx: i32,
-    /// Row stride of its exemplar.
-    stride: i32,
-    /// Rounded coordinate.
-    sx: i32,
-    sy: i32,
-    /// Height offset V.
-    v: i32,
-}
-
-#[inline(always)]
-fn tap(atlas: &AtlasLevel<'_>, st: &State, i: usize) -> Tap {
-    let s = st.s(i);
-    let (sx, sy) = (round(s.x), round(s.y));
-    let col = &atlas.columns[sx as usize];
-    Tap {
-        idx: col.base + sy * col.stride as i32 + sx,
-        stride: col.stride as i32,
-        sx,
-        sy,
-        v: st.v(i),
-    }
-}
-
-/// Two packed appearance texels as eight i16 lanes.
-#[inline(always)]
-fn pair(app: &[u64], a: i32, b: i32) -> i16x8 {
-    wide::bytemuck::cast([app[a as usize], app[b as usize]])
-}
-
-/// The synthesis neighbourhood N_S (×3), two diagonals per vector, mode 1
-/// including the offsets V.
-#[derive(Clone, Copy)]
-struct Neighbourhood {
-    ns01: i32x8,
-    ns23: i32x8,
-}
-
-/// Score (×κ) and optimal offset of the candidate whose texel index is
-/// `q` in an exemplar of row stride `s` (same arithmetic as the scalar
-/// `score`; the prior's weight P is a constant, so its closed form divides
-/// by a constant).
-#[inline(always)]
-fn score<const P: u32>(
-    app: &[u64],
-    ns: &Neighbourhood,
-    q: i32,
-    s: i32,
-    kappa: u32,
-    vp: i32,
-) -> (u32, i32) {
-    score_with::<P>(app, ns, q, s, kappa, None, vp)
-}
-
-/// [`score`] with the offset fixed to `fixed` when given (a coherent
-/// previous result keeps its own offset).
-#[inline(always)]
-fn score_with<const P: u32>(
-    app: &[u64],
-    ns: &Neighbourhood,
-    q: i32,
-    s: i32,
-    kappa: u32,
-    fixed: Option<i32>,
-    vp: i32,
-) -> (u32, i32) {
-    // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
-    let m01 = i32x8::from_i16x8(pair(app, q - s - 1, q - s + 1));
-    let m23 = i32x8::from_i16x8(pair(app, q + s - 1, q + s + 1));
-    let d01 = ns.ns01 - (m01 + m01 + m01);
-    let d23 = ns.ns23 - (m23 + m23 + m23);
-    let (a, b) = (d01.to_array(), d23.to_array());
-    let (ma, mb) = (m01.to_array(), m23.to_array());
-    let sum1 = a[0] + a[4] + b[0] + b[4];
-    // Both priors have constant weights, so each closed form divides by a
-    // constant (the branch picks one, never a run-time divisor).
-    let flat = Prior { weight: P, v: vp }.for_candidate([ma[0], ma[4], mb[0], mb[4]]) == FLAT;
-    let prior = if flat {
-        FLAT
-    } else {
-        Prior { weight: P, v: vp }
-    };
-    let h = fixed.unwrap_or_else(|| {
-        if flat {
-            FLAT.optimal(sum1)
-        } else {
-            Prior { weight: P, v: vp }.optimal(sum1)
-        }
-    });
-    let h3 = 3 * h;
-    let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
-    // Clamping after the saturating narrowing equals clamping before it
-    // (saturation is monotone and ±CLAMP lies inside i16), and i16 min/max
-    // are single instructions where i32 ones are not (SSE2).
-    let lo = i16x8::splat(-CLAMP as i16);
-    let hi = i16x8::splat(CLAMP as i16);
-    let r01 = i16x8::from_i32x8_saturate(d01 - off).max(lo).min(hi);
-    let r23 = i16x8::from_i32x8_saturate(d23 - off).max(lo).min(hi);
-    let sums = (r01.dot(r01) + r23.dot(r23)).to_array();
-    let s = (sums[0] as u32)
-        .wrapping_add(sums[1] as u32)
-        .wrapping_add(sums[2] as u32)
-        .wrapping_add(sums[3] as u32)
-        .wrapping_add(prior.cost(h));
-    (s * kappa, h)
-}
-
-/// Class pixels per chunk: a chunk's neighbours are read once into a small
-/// grid (5 rows × 2·CHUNK + 4 columns, ~16 KiB, in L1) that consecutive
-/// pixels share — a 3×3 block and its ring overlap the next pixel's by half.
-const CHUNK: usize = 64;
-const GRID_COLS: usize = 2 * CHUNK + 4;
+use gather::{Pending, gather, prefetch_similar};
+use grid::{CHUNK, GRID_COLS, Grid, Tap};
+use score::{best_of, neighbourhood, score_with};
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
 const LOOKAHEAD: usize = 6;
 const RING: usize = LOOKAHEAD + 1;
-
-/// A pixel whose candidates are gathered, awaiting scoring.
-#[derive(Clone, Copy, Default)]
-struct Pending {
-    cands: [Candidate; 18],
-    count: usize,
-}
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of row `y`, all at least two
 /// texels inside the level, writing each result as it is found.
@@ -226,7 +108,7 @@ fn run_span<const P: u32>(span: &Span<'_>) {
         x1,
         g,
     } = *span;
-    let mut grid = [[Tap::default(); GRID_COLS]; 5];
+    let mut grid: Grid = [[Tap::default(); GRID_COLS]; 5];
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
@@ -247,7 +129,7 @@ fn correct_chunk<const P: u32>(
     y: usize,
     x0: usize,
     x1: usize,
-    grid: &mut [[Tap; GRID_COLS]; 5],
+    grid: &mut Grid,
     g: &Guide<'_>,
 ) {
     let w = st.width;
@@ -255,21 +137,7 @@ fn correct_chunk<const P: u32>(
     // True by construction; stated so that the compiler knows every grid
     // column a pixel reads (≤ 2n + 2) is inside the grid.
     assert!(n <= CHUNK);
-    // Grid column j is level column x0 − 2 + j; grid row r is level row
-    // y − 2 + r. Rows y ± 2 are read only at odd offsets from the class.
-    let cols = 2 * n + 3;
-    for (r, row) in grid.iter_mut().enumerate() {
-        let base = (y + r - 2) * w + x0 - 2;
-        if r == 0 || r == 4 {
-            for j in 0..cols / 2 {
-                row[2 * j + 1] = tap(atlas, st, base + 2 * j + 1);
-            }
-        } else {
-            for (j, t) in row[..cols].iter_mut().enumerate() {
-                *t = tap(atlas, st, base + j);
-            }
-        }
-    }
+    grid::fill(grid, atlas, st, y, x0, n);
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
     for i in 0..n + LOOKAHEAD {
@@ -297,131 +165,6 @@ fn correct_chunk<const P: u32>(
     }
 }
 
-/// The 5×5 neighbours of one pixel: rows y − 2 … y + 2, columns x − 2 …
-/// x + 2 (not all are read). Taken once per use, so that the reads at
-/// constant offsets need no bounds checks of their own.
-type Window<'g> = [&'g [Tap; 5]; 5];
-
-/// The [`Window`] of the pixel in grid column `c`.
-#[inline(always)]
-fn window(grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Window<'_> {
-    grid.each_ref().map(|row| {
-        row[c - 2..c + 3]
-            .try_into()
-            .expect("a pixel's window is 5 columns wide")
-    })
-}
-
-/// The neighbour at offset (dx, dy) of the window's pixel.
-#[inline(always)]
-fn at<'g>(win: &Window<'g>, dx: i32, dy: i32) -> &'g Tap {
-    &win[(2 + dy) as usize][(2 + dx) as usize]
-}
-
-/// Prefetches the similarity entries the gathering of the pixel in grid
-/// column `c` will read, those of `u = S(p + Δ) − Δ` for the three Δ of
-/// its column (in a coherent patch all nine u coincide with these). The
-/// first read of an atlas row near u is this one: gathering's own
-/// prefetches cover only the texels that scoring reads later, and the
-/// profile showed the `similar` load as the costliest instruction.
-#[inline(always)]
-fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize) {
-    let similar = atlas.level.similar;
-    let win = window(grid, c);
-    for dy in -1..=1 {
-        let n = at(&win, 0, dy);
-        prefetch(similar, n.idx - dy * n.stride);
-    }
-}
-
-/// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
-/// distinct `u = S(p+Δ) − Δ`, in DELTAS order) and prefetches the texels
-/// scoring will read: C₂ entries point anywhere in the atlas, and at level 0
-/// the atlas is larger than the L2 cache.
-#[inline(always)]
-fn gather(atlas: &AtlasLevel<'_>, grid: &[[Tap; GRID_COLS]; 5], c: usize, out: &mut Pending) {
-    let win = window(grid, c);
-    let mut seen = Seen {
-        idx: [0; 9],
-        distinct: 0,
-    };
-    out.count = 0;
-    // One call per Δ, so that each is compiled with its Δ as a constant.
-    gather_delta::<0>(atlas, &win, &mut seen, out);
-    gather_delta::<1>(atlas, &win, &mut seen, out);
-    gather_delta::<2>(atlas, &win, &mut seen, out);
-    gather_delta::<3>(atlas, &win, &mut seen, out);
-    gather_delta::<4>(atlas, &win, &mut seen, out);
-    gather_delta::<5>(atlas, &win, &mut seen, out);
-    gather_delta::<6>(atlas, &win, &mut seen, out);
-    gather_delta::<7>(atlas, &win, &mut seen, out);
-    gather_delta::<8>(atlas, &win, &mut seen, out);
-}
-
-/// Texel indices of the distinct u of a pixel so far: u lies in the
-/// exemplar of S(n), one texel from its interior, so its index identifies
-/// it.
-struct Seen {
-    idx: [i32; 9],
-    distinct: usize,
-}
-
-/// [`gather`]'s step for Δ = `DELTAS[K]`: C₁ and C₂ of its u unless an
-/// earlier Δ had the same u.
-#[inline(always)]
-fn gather_delta<const K: usize>(
-    atlas: &AtlasLevel<'_>,
-    win: &Window<'_>,
-    seen: &mut Seen,
-    out: &mut Pending,
-) {
-    let app = atlas.level.appearance;
-    let (dx, dy) = DELTAS[K];
-    let n = at(win, dx, dy);
-    let u_idx = n.idx - dx - dy * n.stride;
-    if seen.idx[..seen.distinct].contains(&u_idx) {
-        return;
-    }
-    seen.idx[seen.distinct] = u_idx;
-    seen.distinct += 1;
-    let count = out.count;
-    // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
-    let u = (n.sx - dx, n.sy - dy);
-    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
-    out.cands[count] = Candidate {
-        idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
-        stride: n.stride,
-        x: cx,
-        y: cy,
-        from: K as u8,
-        kappa: 1,
-    };
-    // C₂: the stored best other match, anywhere in the atlas.
-    let c2 = atlas.level.similar[u_idx as usize];
-    let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
-    let col = &atlas.columns[qx as usize];
-    out.cands[count + 1] = Candidate {
-        idx: col.base + qy * col.stride as i32 + qx,
-        stride: col.stride as i32,
-        x: qx,
-        y: qy,
-        from: K as u8,
-        kappa: 2,
-    };
-    // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
-    // lines of one row when they straddle a cache line (a quarter of the
-    // time). C₂ lands anywhere, so both of its lines are asked for; C₁ is
-    // near S(p), whose lines N_S reads anyway.
-    for q in &out.cands[count..count + 2] {
-        prefetch(app, q.idx - q.stride - 1);
-        prefetch(app, q.idx + q.stride - 1);
-    }
-    let q = &out.cands[count + 1];
-    prefetch(app, q.idx - q.stride + 1);
-    prefetch(app, q.idx + q.stride + 1);
-    out.count = count + 2;
-}
-
 /// Scores a gathered pixel's candidates against its synthesis
 /// neighbourhood; returns the winner's coordinate (with the fraction of
 /// the neighbour it came from) and optimal offset.
@@ -430,7 +173,7 @@ fn gather_delta<const K: usize>(
 fn decide<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
-    grid: &[[Tap; GRID_COLS]; 5],
+    grid: &Grid,
     c: usize,
     pixel: usize,
     p: &Pending,
@@ -468,44 +211,6 @@ fn decide<const P: u32>(
     finish(atlas, st, pixel, p, winner, g)
 }
 
-/// N_S (eq. 5–6) of the pixel in grid column `c`: per diagonal δ,
-/// g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a for v ∈ {0, (δx, 0), (0, δy)}.
-/// Two diagonals per vector, three texels each; V joins mode 1.
-#[inline(always)]
-fn neighbourhood(app: &[u64], grid: &[[Tap; GRID_COLS]; 5], c: usize) -> Neighbourhood {
-    let win = window(grid, c);
-    Neighbourhood {
-        ns01: diagonals(app, &win, 0),
-        ns23: diagonals(app, &win, 2),
-    }
-}
-
-/// Diagonals k and k + 1 of N_S, summed, as one vector.
-#[inline(always)]
-fn diagonals(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
-    let ((t0, v0), (t1, v1)) = (diagonal(app, win, k), diagonal(app, win, k + 1));
-    let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
-    for j in 0..3 {
-        sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
-    }
-    sum
-}
-
-/// Diagonal k of N_S: its three appearance texels and their ΣV.
-#[inline(always)]
-fn diagonal(app: &[u64], win: &Window<'_>, k: usize) -> ([u64; 3], i32) {
-    let (dx, dy) = DIAGONALS[k];
-    let a = at(win, dx, dy);
-    let b = at(win, 2 * dx, dy);
-    let cc = at(win, dx, 2 * dy);
-    let texels = [
-        app[a.idx as usize],
-        app[(b.idx - dx) as usize],
-        app[(cc.idx - dy * cc.stride) as usize],
-    ];
-    (texels, a.v + b.v + cc.v)
-}
-
 /// The winner's offset `v`, nudged towards the pixel's geometric target
 /// if any (`idx`: the winner's texel).
 #[inline(always)]
@@ -517,26 +222,6 @@ fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>)
         }
         None => v,
     }
-}
-
-/// The best gathered candidate whose cost is below `bar`:
-/// (cost, index, optimal offset), index `usize::MAX` if none is.
-#[inline(always)]
-fn best_of<const P: u32>(
-    app: &[u64],
-    ns: &Neighbourhood,
-    p: &Pending,
-    bar: u32,
-    vp: i32,
-) -> (u32, usize, i32) {
-    let mut best = (bar, usize::MAX, 0i32);
-    for (i, c) in p.cands[..p.count].iter().enumerate() {
-        let (sc, hh) = score::<P>(app, ns, c.idx, c.stride, c.kappa, vp);
-        if sc < best.0 {
-            best = (sc, i, hh);
-        }
-    }
-    best
 }
 
 /// The winner's coordinate (with the fraction of the neighbour it came
@@ -560,40 +245,4 @@ fn finish(
         y: (q.y << FRAC_BITS) + frac(n.y),
     };
     (s, nudged(atlas, q.idx, best.2, pixel, g))
-}
-
-/// One candidate of the pixel being corrected.
-#[derive(Clone, Copy, Default)]
-struct Candidate {
-    /// Texel index and row stride.
-    idx: i32,
-    stride: i32,
-    /// Atlas texel.
-    x: i32,
-    y: i32,
-    /// Index into DELTAS of the neighbour it came from.
-    from: u8,
-    kappa: u32,
-}
-
-/// [`prefetch_line`] for element `i` of `table`. The address is only
-/// formed, never read, so it needs no bounds check (prefetching is a hint
-/// that cannot fault).
-#[inline(always)]
-fn prefetch<T>(table: &[T], i: i32) {
-    prefetch_line(table.as_ptr().wrapping_offset(i as isize).cast());
-}
-
-/// Asks the cache for the line holding `t` (a hint: no effect on results).
-#[inline(always)]
-fn prefetch_line(t: *const i8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: `prefetch` only hints the cache; it cannot fault or change
-    // memory, and SSE is part of the x86_64 baseline.
-    unsafe {
-        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>(t);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = t;
 }

@@ -1,0 +1,144 @@
+//! Candidate gathering (paper eq. 3): C₁ and C₂ of every distinct
+//! `u = S(p+Δ) − Δ` of a pixel, listed ahead of scoring with their texels
+//! prefetched.
+
+use super::super::DELTAS;
+use super::grid::{Grid, Tap, at, window};
+use crate::level::atlas::AtlasLevel;
+
+/// A pixel whose candidates are gathered, awaiting scoring.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Pending {
+    pub cands: [Candidate; 18],
+    pub count: usize,
+}
+
+/// One candidate of the pixel being corrected.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Candidate {
+    /// Texel index and row stride.
+    pub idx: i32,
+    pub stride: i32,
+    /// Atlas texel.
+    pub x: i32,
+    pub y: i32,
+    /// Index into DELTAS of the neighbour it came from.
+    pub from: u8,
+    pub kappa: u32,
+}
+
+/// Prefetches the similarity entries the gathering of the pixel in grid
+/// column `c` will read, those of `u = S(p + Δ) − Δ` for the three Δ of
+/// its column (in a coherent patch all nine u coincide with these). The
+/// first read of an atlas row near u is this one: gathering's own
+/// prefetches cover only the texels that scoring reads later, and the
+/// profile showed the `similar` load as the costliest instruction.
+#[inline(always)]
+pub(super) fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize) {
+    let similar = atlas.level.similar;
+    let win = window(grid, c);
+    for dy in -1..=1 {
+        let n = at(&win, 0, dy);
+        prefetch(similar, n.idx - dy * n.stride);
+    }
+}
+
+/// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
+/// distinct `u = S(p+Δ) − Δ`, in DELTAS order) and prefetches the texels
+/// scoring will read: C₂ entries point anywhere in the atlas, and at level 0
+/// the atlas is larger than the L2 cache.
+///
+/// The distinct u are found first, as a bit mask, with a fixed number of
+/// compares; then only they are listed, in one loop. Deciding per Δ
+/// whether its u is new was a branch that varied from pixel to pixel and
+/// mispredicted often (listing every Δ instead, repeats included, was
+/// slower still).
+#[inline(always)]
+pub(super) fn gather(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, out: &mut Pending) {
+    let win = window(grid, c);
+    let taps: [&Tap; 9] = std::array::from_fn(|k| at(&win, DELTAS[k].0, DELTAS[k].1));
+    // u lies in the exemplar of S(n), one texel from its interior, so its
+    // texel index identifies it.
+    let u: [i32; 9] = std::array::from_fn(|k| {
+        let (dx, dy) = DELTAS[k];
+        taps[k].idx - dx - dy * taps[k].stride
+    });
+    // Bit k: no earlier Δ has Δ k's u.
+    let mut first = 1u32;
+    for k in 1..9 {
+        let dup = u[..k].iter().fold(false, |dup, &v| dup | (v == u[k]));
+        first |= (!dup as u32) << k;
+    }
+    out.count = 0;
+    while first != 0 {
+        let k = first.trailing_zeros() as usize;
+        first &= first - 1;
+        list(atlas, taps[k], k, u[k], out);
+    }
+}
+
+/// [`gather`]'s listing of C₁ and C₂ of Δ = `DELTAS[k]`, whose neighbour
+/// is `n` and u's texel index `u_idx`.
+#[inline(always)]
+fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending) {
+    let app = atlas.level.appearance;
+    let (dx, dy) = DELTAS[k];
+    let count = out.count;
+    // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
+    let u = (n.sx - dx, n.sy - dy);
+    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
+    out.cands[count] = Candidate {
+        idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
+        stride: n.stride,
+        x: cx,
+        y: cy,
+        from: k as u8,
+        kappa: 1,
+    };
+    // C₂: the stored best other match, anywhere in the atlas.
+    let c2 = atlas.level.similar[u_idx as usize];
+    let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
+    let col = &atlas.columns[qx as usize];
+    out.cands[count + 1] = Candidate {
+        idx: col.base + qy * col.stride as i32 + qx,
+        stride: col.stride as i32,
+        x: qx,
+        y: qy,
+        from: k as u8,
+        kappa: 2,
+    };
+    // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
+    // lines of one row when they straddle a cache line (a quarter of the
+    // time). C₂ lands anywhere, so both of its lines are asked for; C₁ is
+    // near S(p), whose lines N_S reads anyway.
+    for q in &out.cands[count..count + 2] {
+        prefetch(app, q.idx - q.stride - 1);
+        prefetch(app, q.idx + q.stride - 1);
+    }
+    let q = &out.cands[count + 1];
+    prefetch(app, q.idx - q.stride + 1);
+    prefetch(app, q.idx + q.stride + 1);
+    out.count = count + 2;
+}
+
+/// [`prefetch_line`] for element `i` of `table`. The address is only
+/// formed, never read, so it needs no bounds check (prefetching is a hint
+/// that cannot fault).
+#[inline(always)]
+fn prefetch<T>(table: &[T], i: i32) {
+    prefetch_line(table.as_ptr().wrapping_offset(i as isize).cast());
+}
+
+/// Asks the cache for the line holding `t` (a hint: no effect on results).
+#[inline(always)]
+fn prefetch_line(t: *const i8) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `prefetch` only hints the cache; it cannot fault or change
+    // memory, and SSE is part of the x86_64 baseline.
+    unsafe {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(t);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = t;
+}

@@ -1,0 +1,94 @@
+//! The neighbours of a chunk of a span, read once: the 5-row grid of
+//! [`Tap`]s that consecutive pixels of a subpass share, and each pixel's
+//! 5×5 [`Window`] into it.
+
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::round;
+use crate::level::state::State;
+
+/// A neighbour as the kernel needs it.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Tap {
+    /// Texel index of the rounded coordinate.
+    pub idx: i32,
+    /// Row stride of its exemplar.
+    pub stride: i32,
+    /// Rounded coordinate.
+    pub sx: i32,
+    pub sy: i32,
+    /// Height offset V.
+    pub v: i32,
+}
+
+#[inline(always)]
+fn tap(atlas: &AtlasLevel<'_>, st: &State, i: usize) -> Tap {
+    let s = st.s(i);
+    let (sx, sy) = (round(s.x), round(s.y));
+    let col = &atlas.columns[sx as usize];
+    Tap {
+        idx: col.base + sy * col.stride as i32 + sx,
+        stride: col.stride as i32,
+        sx,
+        sy,
+        v: st.v(i),
+    }
+}
+
+/// Class pixels per chunk: a chunk's neighbours are read once into a small
+/// grid (5 rows × 2·CHUNK + 4 columns, ~16 KiB, in L1) that consecutive
+/// pixels share — a 3×3 block and its ring overlap the next pixel's by half.
+pub(super) const CHUNK: usize = 64;
+pub(super) const GRID_COLS: usize = 2 * CHUNK + 4;
+
+/// A chunk's grid: row r is level row y − 2 + r, column j level column
+/// x0 − 2 + j.
+pub(super) type Grid = [[Tap; GRID_COLS]; 5];
+
+/// Reads the neighbours of the `n` class pixels from column `x0` of row
+/// `y` into `grid`. Rows y ± 2 are read only at odd offsets from the
+/// class.
+#[inline(always)]
+pub(super) fn fill(
+    grid: &mut Grid,
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    y: usize,
+    x0: usize,
+    n: usize,
+) {
+    let w = st.width;
+    let cols = 2 * n + 3;
+    for (r, row) in grid.iter_mut().enumerate() {
+        let base = (y + r - 2) * w + x0 - 2;
+        if r == 0 || r == 4 {
+            for j in 0..cols / 2 {
+                row[2 * j + 1] = tap(atlas, st, base + 2 * j + 1);
+            }
+        } else {
+            for (j, t) in row[..cols].iter_mut().enumerate() {
+                *t = tap(atlas, st, base + j);
+            }
+        }
+    }
+}
+
+/// The 5×5 neighbours of one pixel: rows y − 2 … y + 2, columns x − 2 …
+/// x + 2 (not all are read). Taken once per use, so that the reads at
+/// constant offsets need no bounds checks of their own.
+pub(super) type Window<'g> = [&'g [Tap; 5]; 5];
+
+/// The [`Window`] of the pixel in grid column `c`.
+#[inline(always)]
+pub(super) fn window(grid: &Grid, c: usize) -> Window<'_> {
+    grid.each_ref().map(|row| {
+        row[c - 2..c + 3]
+            .try_into()
+            .expect("a pixel's window is 5 columns wide")
+    })
+}
+
+/// The neighbour at offset (dx, dy) of the window's pixel.
+#[inline(always)]
+pub(super) fn at<'g>(win: &Window<'g>, dx: i32, dy: i32) -> &'g Tap {
+    &win[(2 + dy) as usize][(2 + dx) as usize]
+}
