@@ -122,9 +122,9 @@ const ROW_CHUNK: usize = 256;
 #[inline]
 fn jitter_row(p: &UpsampleParams, ax: u32, ay: u32, out: &mut [(i32, i32)]) {
     #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2, the one feature the function
-        // enables (checked just above).
+    if crate::stages::isa::avx2() {
+        // SAFETY: the CPU supports AVX2 (`isa::avx2` checks it), the one
+        // feature the function enables.
         unsafe { jitter_row_avx2(p, ax, ay, out) };
         return;
     }

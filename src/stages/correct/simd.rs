@@ -68,9 +68,9 @@ pub fn correct_span<const P: u32>(
         g,
     };
     #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU supports AVX2, the one feature the function
-        // enables (checked just above).
+    if crate::stages::isa::avx2() {
+        // SAFETY: the CPU supports AVX2 (`isa::avx2` checks it), the one
+        // feature the function enables.
         unsafe { span_avx2::<P>(&span) };
         return;
     }

@@ -1,0 +1,25 @@
+//! Which instruction set the run-time-dispatched CPU stages use.
+//!
+//! `correct` and `upsample_jitter` compile their hot loops twice — for the
+//! build's baseline (SSE2 on x86-64) and for AVX2 — and pick AVX2 where the
+//! CPU has it. Both must give the same bytes as the scalar oracle, but on
+//! an AVX2 machine the baseline copy would never run: setting
+//! `TERRASYNTH_PORTABLE_SIMD` (to anything) makes every dispatch take it,
+//! so the tests check both copies on one machine (`.ci/run` runs the stage
+//! tests with and without it).
+
+use std::sync::OnceLock;
+
+/// Whether the stages run their AVX2 copies: the CPU has AVX2 and
+/// `TERRASYNTH_PORTABLE_SIMD` is unset (read once per process).
+#[inline]
+pub fn avx2() -> bool {
+    static AVX2: OnceLock<bool> = OnceLock::new();
+    *AVX2.get_or_init(|| {
+        #[cfg(target_arch = "x86_64")]
+        let has = std::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let has = false;
+        has && std::env::var_os("TERRASYNTH_PORTABLE_SIMD").is_none()
+    })
+}
