@@ -62,9 +62,18 @@ pub fn blocks(
         .collect();
     let layouts = fit::layouts(src, &draws, (world, shift), seed, at.iter().map(|p| p.1));
     let st = State::new(w, h);
-    for (i, &((x, y), (bx, by))) in at.iter().enumerate() {
-        let c = layouts[&(bx >> 1, by >> 1)];
-        let (r, lx, ly) = draws.texel(seed, c, (bx, by), (x, y));
+    // Neighbouring pixels mostly share a block: its origin is drawn once.
+    let mut last: Option<((i32, i32), Texel)> = None;
+    for (i, &((x, y), block)) in at.iter().enumerate() {
+        let origin = match last {
+            Some((b, o)) if b == block => o,
+            _ => {
+                let o = draws.origin(seed, layouts[&(block.0 >> 1, block.1 >> 1)], block);
+                last = Some((block, o));
+                o
+            }
+        };
+        let (r, lx, ly) = draws.texel(origin, block, (x, y));
         let (x0, y0, nx, ny) = draws.ranges[r];
         let (ax, ay) = (x - shift.0, y - shift.1);
         let (jx, jy) = upsample_jitter::jitter(seed, l as u32, ax as u32, ay as u32, jitter);
@@ -76,6 +85,10 @@ pub fn blocks(
     }
     st
 }
+
+/// An interior texel: the exemplar's range in [`Draws`] and its position
+/// in that interior.
+pub(super) type Texel = (usize, i32, i32);
 
 /// The interiors blocks draw from, and where a drawn block's pixels copy
 /// their texels.
@@ -103,30 +116,31 @@ impl Draws {
         }
     }
 
-    /// The interior texel `(range, lx, ly)` that pixel (x, y) of the
-    /// shifted grid copies when it belongs to block (bx, by) and the
-    /// block's group takes its `layout`-th draw: the block is centred on
-    /// its drawn texel and mirrored at the interior's edges.
-    pub fn texel(
-        &self,
-        seed: u32,
-        layout: u32,
-        (bx, by): (i32, i32),
-        (x, y): (i32, i32),
-    ) -> (usize, i32, i32) {
+    /// The interior texel `(range, ox, oy)` block (bx, by) is centred on
+    /// when its group takes its `layout`-th draw.
+    pub fn origin(&self, seed: u32, layout: u32, (bx, by): (i32, i32)) -> Texel {
         let mut k = self.order[block_draw(seed, layout, bx as u32, by as u32, self.total) as usize];
-        let half = 1 << (self.bits - 1);
         for (r, &(_, _, nx, ny)) in self.ranges.iter().enumerate() {
             let n = (nx * ny) as u32;
             if k < n {
-                let (ox, oy) = ((k % nx as u32) as i32, (k / nx as u32) as i32);
-                let lx = mirror(ox - half + x - (bx << self.bits), nx);
-                let ly = mirror(oy - half + y - (by << self.bits), ny);
-                return (r, lx, ly);
+                return (r, (k % nx as u32) as i32, (k / nx as u32) as i32);
             }
             k -= n;
         }
         unreachable!("block_draw stays below the interior texel count")
+    }
+
+    /// The interior texel `(range, lx, ly)` that pixel (x, y) of the
+    /// shifted grid copies when it belongs to block (bx, by), centred on
+    /// `origin` ([`Draws::origin`]): the block is mirrored at the
+    /// interior's edges.
+    #[inline]
+    pub fn texel(&self, (r, ox, oy): Texel, (bx, by): (i32, i32), (x, y): (i32, i32)) -> Texel {
+        let (_, _, nx, ny) = self.ranges[r];
+        let half = 1 << (self.bits - 1);
+        let lx = mirror(ox - half + x - (bx << self.bits), nx);
+        let ly = mirror(oy - half + y - (by << self.bits), ny);
+        (r, lx, ly)
     }
 }
 

@@ -19,6 +19,7 @@
 
 use super::Source;
 use super::blocks::Draws;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Layouts drawn per group.
@@ -164,7 +165,7 @@ impl Profile {
         // Per range: (height, slope) of every interior texel, row-major.
         let texels: Vec<Vec<(i64, i64)>> = draws
             .ranges
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(r, &(x0, y0, nx, ny))| {
                 let (e, r0) = (first + r, &rects0[first + r]);
@@ -226,7 +227,7 @@ impl Profile {
             .collect();
         let types: Vec<Vec<u8>> = draws
             .ranges
-            .iter()
+            .par_iter()
             .map(|&(x0, y0, nx, ny)| {
                 (0..ny)
                     .flat_map(|ly| (0..nx).map(move |lx| (x0 + lx, y0 + ly)))
@@ -274,14 +275,21 @@ impl Profile {
         }
         let mut h = vec![Histogram::new(); self.bins.len()];
         let mut types = vec![0u32; self.type_shares.len()];
-        for y in y0c..y1c {
-            for x in x0c..x1c {
-                let block = (x >> draws.bits, y >> draws.bits);
-                let (r, lx, ly) = draws.texel(seed, layout, block, (x, y));
-                let nx = draws.ranges[r].2;
-                let k = (ly * nx + lx) as usize;
-                h[r].add(self.bins[r][k]);
-                types[self.types[r][k] as usize] += 1;
+        // Block by block (each block's origin is drawn once).
+        for (bx, by) in [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(i, j)| (2 * gx + i, 2 * gy + j)) {
+            let origin = draws.origin(seed, layout, (bx, by));
+            let b = 1 << draws.bits;
+            let (xs, ys) = (
+                x0c.max(bx * b)..x1c.min((bx + 1) * b),
+                y0c.max(by * b)..y1c.min((by + 1) * b),
+            );
+            for y in ys {
+                for x in xs.clone() {
+                    let (r, lx, ly) = draws.texel(origin, (bx, by), (x, y));
+                    let k = (ly * draws.ranges[r].2 + lx) as usize;
+                    h[r].add(self.bins[r][k]);
+                    types[self.types[r][k] as usize] += 1;
+                }
             }
         }
         (h, types)
@@ -349,7 +357,7 @@ pub(super) fn layouts(
         shift.1 + world.1 as i32,
     ];
     groups
-        .into_iter()
+        .into_par_iter()
         .map(|g| {
             let distance = |c: u32| profile.distance(draws, seed, c, g, world);
             // Ties keep the earlier layout.
