@@ -17,9 +17,10 @@ const COARSE_SALT: u32 = 0xC0A5_0000;
 /// Level L of an output over `region` (absolute level-L pixels: the whole
 /// level, or a window's cone): each pixel belongs to the 2^bits × 2^bits
 /// block under its `warp`ed position; each block picks one exemplar
-/// texel (`block_draw`: a hash of the seed and the block's position)
-/// uniformly over every interior texel of exemplar `from` (or of every
-/// exemplar), and its pixels copy the exemplar around that texel, mirrored
+/// texel (`block_draw`: a hash of the seed, the block's position and its
+/// group's layout, which `fit.rs` chooses) uniformly over every interior
+/// texel of exemplar `from` (or of every exemplar), and its pixels copy the
+/// exemplar around that texel, mirrored
 /// at the interior's edges; each pixel gets the level's jitter (`jitter`,
 /// fixed point, the same hash as `upsample_jitter`).
 ///

@@ -14,7 +14,7 @@
 //! its area), plus the paper's jitter; from L down, jitter and correction
 //! rearrange them. Each 2 × 2 group of blocks keeps, of eight such draws,
 //! the one whose heights, slopes and terrain types are distributed most
-//! like its exemplars' ([`fit`]).
+//! like its exemplars' (`fit.rs`).
 //!
 //! Why blocks, and why as large as the exemplars allow (b = ⌊log₂⌋ of the
 //! smallest exemplar interior side at L): pixel-based correction can join
@@ -52,7 +52,7 @@ use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::state::{State, level_size};
 
 /// What the blocks draw from: the database level L of `atlas`, its
-/// level-0 heights in `db` ([`fit`] profiles them), and exemplar `from`
+/// level-0 heights in `db` (`fit.rs` profiles them), and exemplar `from`
 /// (or every exemplar).
 #[derive(Clone, Copy)]
 pub struct Source<'a> {
