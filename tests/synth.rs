@@ -169,10 +169,11 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
     let n = 120;
     let side = n << bits;
     let jitter = 100; // 0.39 texel in fixed point
+    let profile = coarse::Profile::new(db(), &atlas, None);
     let src = coarse::Source {
-        db: db(),
         atlas: &atlas,
         from: None,
+        profile: &profile,
     };
     let start = coarse::blocks(
         src,
@@ -224,10 +225,11 @@ fn blocks_cover_every_interior_texel_alike_and_stay_inside() {
         (c.max_y - MARGIN as i32 + 1) as usize,
     );
     let side = 64 << bits;
+    let profile = coarse::Profile::new(db(), &atlas, Some(0));
     let src = coarse::Source {
-        db: db(),
         atlas: &atlas,
         from: Some(0),
+        profile: &profile,
     };
     let start = coarse::blocks(
         src,
@@ -414,11 +416,12 @@ fn the_coarse_start_keeps_its_exemplar_relief_on_every_seed() {
         );
         let bits = coarse::block_bits(&atlas, Some(e));
         let side = (c.max_x - c.min_x + 1) as usize;
+        let profile = coarse::Profile::new(db(), &atlas, Some(e));
         for seed in 0..12 {
             let src = coarse::Source {
-                db: db(),
                 atlas: &atlas,
                 from: Some(e),
+                profile: &profile,
             };
             let start = coarse::blocks(
                 src,

@@ -39,6 +39,7 @@ use stages::correct::{CorrectParams, SUBPASSES};
 use stages::reconstruct::HEIGHT_FRAC_BITS;
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 use window::{REACH_PER_SUBPASS, widen};
 
@@ -64,6 +65,9 @@ pub struct Synthesizer<'db> {
     params: Params,
     atlas: Vec<AtlasLevel<'db>>,
     jitter: i32,
+    /// The coarse start's profile of the exemplars, built by the first
+    /// synthesis that starts from blocks.
+    profile: OnceLock<coarse::Profile>,
     #[cfg(feature = "gpu")]
     gpu: Option<crate::backend::gpu::Gpu>,
 }
@@ -92,6 +96,7 @@ impl<'db> Synthesizer<'db> {
             params,
             atlas,
             jitter,
+            profile: OnceLock::new(),
             #[cfg(feature = "gpu")]
             gpu: None,
         })
@@ -520,10 +525,14 @@ impl<'db> Synthesizer<'db> {
                 let from = self.params.start_exemplar;
                 let world = level_size(width, height, l);
                 let at = (region, world);
+                let atlas = &self.atlas[l];
+                let profile = self
+                    .profile
+                    .get_or_init(|| coarse::Profile::new(self.db, atlas, from));
                 let src = coarse::Source {
-                    db: self.db,
-                    atlas: &self.atlas[l],
+                    atlas,
                     from,
+                    profile,
                 };
                 coarse::blocks(src, at, (l, bits), seed, self.jitter)
             }

@@ -61,7 +61,13 @@ pub fn blocks(
             ((x, y), block_of(seed, x, y, bits))
         })
         .collect();
-    let layouts = fit::layouts(src, &draws, (world, shift), seed, at.iter().map(|p| p.1));
+    let layouts = fit::layouts(
+        src.profile,
+        &draws,
+        (world, shift),
+        seed,
+        at.iter().map(|p| p.1),
+    );
     let st = State::new(w, h);
     // Neighbouring pixels mostly share a block: its origin is drawn once.
     let mut last: Option<((i32, i32), Texel)> = None;
@@ -104,9 +110,7 @@ pub(super) struct Draws {
 
 impl Draws {
     pub fn new(a: &AtlasLevel<'_>, from: Option<usize>, bits: usize) -> Draws {
-        let ranges: Vec<(i32, i32, i32, i32)> = interiors(a, from)
-            .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
-            .collect();
+        let ranges = ranges(a, from);
         let total = ranges.iter().map(|r| (r.2 * r.3) as u32).sum();
         let order = z_order(&ranges);
         Draws {
@@ -143,6 +147,14 @@ impl Draws {
         let ly = mirror(oy - half + y - (by << self.bits), ny);
         (r, lx, ly)
     }
+}
+
+/// Interior origin and size (x0, y0, nx, ny) of exemplar `from`, or of
+/// every exemplar, at level L.
+pub(super) fn ranges(a: &AtlasLevel<'_>, from: Option<usize>) -> Vec<(i32, i32, i32, i32)> {
+    interiors(a, from)
+        .map(|(x0, x1, y0, y1)| (x0, y0, x1 - x0 + 1, y1 - y0 + 1))
+        .collect()
 }
 
 /// The interior texels (as row-major indices over every exemplar's

@@ -43,22 +43,21 @@ mod blocks;
 mod fit;
 
 pub use blocks::blocks;
+pub use fit::Profile;
 
-use crate::database::Database;
 use crate::database::layout::MARGIN;
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::cone::Rect;
 use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::state::{State, level_size};
 
-/// What the blocks draw from: the database level L of `atlas`, its
-/// level-0 heights in `db` (`fit.rs` profiles them), and exemplar `from`
-/// (or every exemplar).
+/// What the blocks draw from: the database level L of `atlas`, exemplar
+/// `from` (or every exemplar), and the [`Profile`] of the same.
 #[derive(Clone, Copy)]
 pub struct Source<'a> {
-    pub db: &'a Database,
     pub atlas: &'a AtlasLevel<'a>,
     pub from: Option<usize>,
+    pub profile: &'a Profile,
 }
 
 /// The coarsest level synthesis starts from (and corrects), whatever
