@@ -15,6 +15,18 @@
 //! into each transform's frame once, and every candidate's cells are stored
 //! contiguously, so the kernel streams both. The best 5 per
 //! source go to round two and the graph-cut finalists ([`super::select`]).
+//!
+//! A fill patch enters as its source has it, tilt included (feature patches
+//! are detrended, [`super::detrend`]): round two's offset-free SSD then
+//! prefers patches whose slope continues the window's. Detrending them
+//! too turned every valley floor that falls less steeply than its patch's
+//! mean tilt into a chain of closed dimples: on the Pyrenees alone, the
+//! copied fill patches had 0.6 % pit cells against the DEM's 0.38 %, and
+//! the outputs of the three sketches in `data/sketches/` 0.52 % (mean of 4
+//! sizes each). Without it: 0.47 %, realism ratio against the DEM 1.40 →
+//! 1.17 on average, 8 sources 3.02 → 2.61 against their dominant one,
+//! feature adherence unchanged (0.515 → 0.519). The broad drift that the
+//! kept tilts add is what [`super::remove_drift`] takes out.
 
 use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
 use super::costs::noise_cost;
@@ -349,7 +361,8 @@ pub(crate) fn fill(
                             src.heights[(fc.y as usize + sy) * src.width + fc.x as usize + sx];
                     }
                 }
-                super::detrend(&mut patch, n);
+                // Not detrended (unlike feature patches): a fill patch
+                // keeps the tilt it has in its source, see the module docs.
                 let key = (si, 2u8, k);
                 let u = uses.get(&key).copied().unwrap_or(0);
                 let cost = round2_cost(&uw, &patch, &params.weights, &lib.noise_ref, u);
