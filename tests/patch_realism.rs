@@ -4,7 +4,16 @@
 //! cost (`Weights::coherence`) the output switched source at nearly every
 //! patch and scored 3.34 against its dominant source (the Pyrenees, 42 %
 //! of the pixels) and 3.51 averaged over its sources by share; with it,
-//! 2.32 and 2.40. Skipped with a message without ../shared/dem.
+//! 2.32 and 2.40; with fill patches that keep their source's tilt (not
+//! detrended: no closed pits along valley floors), 1.75 and 1.84.
+//!
+//! The rest of the gap to one source is the pits descriptor, and it is the
+//! sources' own: the output's pit fraction is what its sources' pit
+//! fractions weighted by their shares predict (the Franconian Jura has
+//! 2.4 %, the North German Plain 4.4 %, the Pyrenees 0.38 %), which the
+//! test checks, so a mixture scores far from its dominant source on pits
+//! however faithfully each patch is copied. Skipped with a message without
+//! ../shared/dem.
 
 mod common;
 
@@ -79,10 +88,33 @@ fn eight_sources_make_terrain_as_real_as_the_sources_it_is_cut_from() {
         "dominant source {:.0} %, ratio {dom_ratio:.2}; by share {weighted:.2}",
         100.0 * dom_share
     );
-    // A patchwork of sources is far from each of them (3.34 and 3.51 before).
+    // A patchwork of sources is far from each of them (3.34 and 3.51
+    // before the coherence cost, 2.32 and 2.40 with detrended fill patches).
     assert!(
-        dom_ratio <= 2.8,
+        dom_ratio <= 2.1,
         "against the dominant source: {dom_ratio:.2}"
     );
-    assert!(weighted <= 2.9, "averaged by share: {weighted:.2}");
+    assert!(weighted <= 2.2, "averaged by share: {weighted:.2}");
+    // Pits: the output has about as many as its sources bring by share
+    // (0.59 % against 0.60 %); the merge's seams add none of their own.
+    let expected: f64 = lib
+        .sources
+        .iter()
+        .zip(&count)
+        .map(|(s, &k)| {
+            let hf =
+                Heightfield::from_vec(s.width, s.height, s.cell_size, s.heights.clone()).unwrap();
+            k as f64 / total * eval::drainage::pit_fraction(&hf)
+        })
+        .sum();
+    let pits = eval::drainage::pit_fraction(hf);
+    eprintln!(
+        "pits {:.3} % against {:.3} % from the sources by share",
+        100.0 * pits,
+        100.0 * expected
+    );
+    assert!(
+        pits <= 1.2 * expected,
+        "pits {pits} against {expected} from the sources"
+    );
 }

@@ -43,8 +43,9 @@ pub fn deform_by_sketch(
 /// component (three box passes of radius 2·patch, about a Gaussian of
 /// σ = 2·patch) minus its mean. Each gradient-domain merge keeps its
 /// patch's slopes and only pins it to its neighbours along the seam, so
-/// small slope residues (after [`detrend`]) add up along the placement
-/// order into a random walk of height across the output: with many
+/// the tilts that fill patches keep from their sources (and the slope
+/// residues of feature patches after [`detrend`]) add up along the
+/// placement order into a random walk of height across the output: with many
 /// sources, half of a sketched circle came out a kilometre above the other
 /// half as one smooth snowy mass, and the λ inside it was lost in that
 /// tilt. Ridges and valleys are narrower than this scale and stay; the

@@ -104,11 +104,14 @@ pub fn sample_warped(
 }
 
 /// Removes the least-squares tilt (the `x` and `y` slopes of the best-fit
-/// plane) from an `n × n` patch, keeping its mean. Gradient-domain merging
-/// keeps every patch's slopes, so the regional tilt each patch brings from
-/// its source (a ridge that runs downhill, a valley side) would add up from
-/// patch to patch into a random walk of height across the output; the
-/// broad shape is the sketch's to give ([`deform_by_sketch`]).
+/// plane) from an `n × n` feature patch, keeping its mean. Gradient-domain
+/// merging keeps every patch's slopes, so the regional tilt a ridge or
+/// valley patch brings from its source (a ridge that runs downhill) would
+/// add up along the sketched feature into a random walk of height; the
+/// feature's broad shape is the sketch's to give ([`deform_by_sketch`]).
+/// Fill patches are not detrended: removing a patch's tilt reverses every
+/// channel that falls less steeply than it, which makes closed pits
+/// ([`super::hole_fill`] says how many).
 ///
 /// [`deform_by_sketch`]: super::deform_by_sketch
 pub fn detrend(patch: &mut [f32], n: usize) {
