@@ -75,6 +75,7 @@ use crate::level::fixed::{Coord, div_floor};
 use crate::level::state::State;
 use nudge::Target;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicI32, Ordering::Relaxed};
 
 pub use uniform::{CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, CorrectUniform, GuideCell};
 
@@ -100,20 +101,50 @@ pub const DEFAULT_PRIOR: u32 = 4;
 /// level 0 as faint squares (seen in the sea of the shared DEMs).
 #[inline(always)]
 pub fn parent_v(pa: &State, x: usize, y: usize) -> i32 {
-    let (px, py) = (x / 2, y / 2);
-    let near = |c: usize, odd: bool, n: usize| {
-        if odd {
-            (c + 1).min(n - 1)
-        } else {
-            c.saturating_sub(1)
+    ParentRow::new(pa, y).v(x)
+}
+
+/// The two rows of the level above that [`parent_v`] reads for one child
+/// row, looked up once: kernels that walk a row take each pixel's anchor
+/// from here (per pixel, the row lookups and clamps cost as much as the
+/// interpolation).
+pub struct ParentRow<'a> {
+    /// The parent row under the child row, and the nearest other one.
+    under: &'a [AtomicI32],
+    other: &'a [AtomicI32],
+}
+
+/// `c`'s neighbour on the side of the child (`odd`), clamped to `0..n`.
+#[inline(always)]
+fn nearest(c: usize, odd: bool, n: usize) -> usize {
+    if odd {
+        (c + 1).min(n - 1)
+    } else {
+        c.saturating_sub(1)
+    }
+}
+
+impl<'a> ParentRow<'a> {
+    /// The rows for child row `y`.
+    #[inline(always)]
+    pub fn new(pa: &'a State, y: usize) -> ParentRow<'a> {
+        let (py, w) = (y / 2, pa.width);
+        let qy = nearest(py, y % 2 == 1, pa.height);
+        ParentRow {
+            under: pa.run(py * w, w).1,
+            other: pa.run(qy * w, w).1,
         }
-    };
-    let (qx, qy) = (
-        near(px, x % 2 == 1, pa.width),
-        near(py, y % 2 == 1, pa.height),
-    );
-    let v = |x: usize, y: usize| pa.v(y * pa.width + x);
-    (9 * v(px, py) + 3 * v(qx, py) + 3 * v(px, qy) + v(qx, qy) + 8) >> 4
+    }
+
+    /// [`parent_v`] of child column `x`.
+    #[inline(always)]
+    pub fn v(&self, x: usize) -> i32 {
+        let px = x / 2;
+        let qx = nearest(px, x % 2 == 1, self.under.len());
+        let (a, b) = (self.under, self.other);
+        let v = |r: &[AtomicI32], i: usize| r[i].load(Relaxed);
+        (9 * v(a, px) + 3 * v(a, qx) + 3 * v(b, px) + v(b, qx) + 8) >> 4
+    }
 }
 
 /// One pixel's height prior: its weight P and the parent's offset V it

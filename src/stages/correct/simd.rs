@@ -30,7 +30,7 @@ mod grid;
 mod score;
 
 use super::nudge::nudge;
-use super::{ALL_TYPES, DELTAS, Guide, Prior, W_FREE, scalar, weigh};
+use super::{ALL_TYPES, DELTAS, Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
@@ -41,7 +41,10 @@ use score::{best_of, neighbourhood, score_with};
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
 const LOOKAHEAD: usize = 6;
-const RING: usize = LOOKAHEAD + 1;
+/// Gathered pixels awaiting scoring: more than [`LOOKAHEAD`], and a power
+/// of two so that the ring index is a mask.
+const RING: usize = 8;
+const _: () = assert!(RING > LOOKAHEAD && RING.is_power_of_two());
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of row `y`, all at least two
 /// texels inside the level, writing each result as it is found.
@@ -140,6 +143,7 @@ fn correct_chunk<const P: u32>(
     grid::fill(grid, atlas, st, y, x0, n);
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
+    let parent = parent.map(|pa| ParentRow::new(pa, y));
     for i in 0..n + LOOKAHEAD {
         if i + LOOKAHEAD < n {
             prefetch_similar(atlas, grid, 2 * (i + LOOKAHEAD) + 2);
@@ -150,7 +154,13 @@ fn correct_chunk<const P: u32>(
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
             let i = y * w + x0 + 2 * k;
-            let prior = Prior::at(P, parent, x0 + 2 * k, y);
+            let prior = Prior {
+                weight: P,
+                v: match &parent {
+                    Some(r) => r.v(x0 + 2 * k),
+                    None => 0,
+                },
+            };
             // Type-constrained pixels take the scalar path (rejection and
             // seeding live there; they are few and at coarse levels).
             let (s, v) = match g.allowed {
