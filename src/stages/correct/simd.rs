@@ -27,7 +27,6 @@
 
 mod gather;
 mod grid;
-mod lanes;
 mod score;
 
 use super::nudge::nudge;
@@ -37,7 +36,6 @@ use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
 use gather::{Pending, gather, prefetch_similar};
 use grid::{CHUNK, GRID_COLS, Grid, Tap};
-use lanes::{Lanes, Portable};
 use score::{best_of, neighbourhood, score_with};
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
@@ -79,7 +77,7 @@ pub fn correct_span<const P: u32>(
         unsafe { span_avx2::<P>(&span) };
         return;
     }
-    run_span::<P, Portable>(&span);
+    run_span::<P>(&span);
 }
 
 /// The arguments of [`correct_span`].
@@ -98,12 +96,12 @@ struct Span<'s> {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 fn span_avx2<const P: u32>(span: &Span<'_>) {
-    run_span::<P, lanes::Avx2>(span);
+    run_span::<P>(span);
 }
 
 /// [`correct_span`] for any instruction set.
 #[inline(always)]
-fn run_span<const P: u32, L: Lanes>(span: &Span<'_>) {
+fn run_span<const P: u32>(span: &Span<'_>) {
     let Span {
         atlas,
         st,
@@ -117,7 +115,7 @@ fn run_span<const P: u32, L: Lanes>(span: &Span<'_>) {
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
-        correct_chunk::<P, L>(atlas, st, parent, y, a, b, &mut grid, g);
+        correct_chunk::<P>(atlas, st, parent, y, a, b, &mut grid, g);
         a = b;
     }
 }
@@ -127,7 +125,7 @@ fn run_span<const P: u32, L: Lanes>(span: &Span<'_>) {
 /// writes), and each pixel's own coordinate before the pixel is written.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn correct_chunk<const P: u32, L: Lanes>(
+fn correct_chunk<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
     parent: Option<&State>,
@@ -170,7 +168,7 @@ fn correct_chunk<const P: u32, L: Lanes>(
                     let (x, y) = ((x0 + 2 * k) as i32, y as i32);
                     scalar::correct_pixel_guided(atlas, st, x, y, g, prior)
                 }
-                _ => decide::<P, L>(atlas, st, grid, 2 * k + 2, i, &ring[k % RING], g, prior.v),
+                _ => decide::<P>(atlas, st, grid, 2 * k + 2, i, &ring[k % RING], g, prior.v),
             };
             st.set(i, s, v);
         }
@@ -182,7 +180,7 @@ fn correct_chunk<const P: u32, L: Lanes>(
 /// the neighbour it came from) and optimal offset.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn decide<const P: u32, L: Lanes>(
+fn decide<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
     grid: &Grid,
@@ -209,8 +207,8 @@ fn decide<const P: u32, L: Lanes>(
         // coherent: the previous result as is.
         let free = w >= W_FREE;
         let fixed = (!free).then_some(v);
-        let (sc, h_prev) = score_with::<P, L>(app, ns, idx, col.stride as i32, 1, fixed, vp);
-        let (cost, i, hh) = best_of::<P, L>(app, ns, p, weigh(sc, w), vp);
+        let (sc, h_prev) = score_with::<P>(app, ns, idx, col.stride as i32, 1, fixed, vp);
+        let (cost, i, hh) = best_of::<P>(app, ns, p, weigh(sc, w), vp);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -219,7 +217,7 @@ fn decide<const P: u32, L: Lanes>(
         }
         return finish(atlas, st, pixel, p, (cost, i, hh), g);
     }
-    let winner = best_of::<P, L>(app, ns, p, u32::MAX, vp);
+    let winner = best_of::<P>(app, ns, p, u32::MAX, vp);
     finish(atlas, st, pixel, p, winner, g)
 }
 

@@ -2,21 +2,23 @@
 //! the cost of each gathered candidate against it, two diagonals per
 //! vector.
 
-use super::super::{DIAGONALS, FLAT, Prior};
+use super::super::{CLAMP, DIAGONALS, FLAT, Prior};
 use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
-use super::lanes::Lanes;
-use wide::i32x8;
+use wide::{i16x8, i32x8};
 
 /// The four diagonal texels of the candidate at texel index `q` (row
-/// stride `s`), in DIAGONALS order. They are read from one slice that
-/// spans them, so two bounds checks cover the four loads.
+/// stride `s`), two per vector as eight i16 lanes, in DIAGONALS order.
+/// They are read from one slice that spans them, so two bounds checks
+/// cover the four loads.
 #[inline(always)]
-fn diagonal_texels(app: &[u64], q: i32, s: i32) -> [u64; 4] {
-    // Through u32, so that the compiler knows 2s + 3 cannot overflow.
-    let s = s as u32 as usize;
+fn diagonal_texels(app: &[u64], q: i32, s: i32) -> (i16x8, i16x8) {
+    let s = s as usize;
     let t = &app[(q as usize).wrapping_sub(s + 1)..][..2 * s + 3];
-    [t[0], t[2], t[2 * s], t[2 * s + 2]]
+    (
+        wide::bytemuck::cast([t[0], t[2]]),
+        wide::bytemuck::cast([t[2 * s], t[2 * s + 2]]),
+    )
 }
 
 /// The synthesis neighbourhood N_S (×3), two diagonals per vector, mode 1
@@ -32,7 +34,7 @@ pub(super) struct Neighbourhood {
 /// `score`; the prior's weight P is a constant, so its closed form divides
 /// by a constant).
 #[inline(always)]
-fn score<const P: u32, L: Lanes>(
+fn score<const P: u32>(
     app: &[u64],
     ns: &Neighbourhood,
     q: i32,
@@ -40,13 +42,13 @@ fn score<const P: u32, L: Lanes>(
     kappa: u32,
     vp: i32,
 ) -> (u32, i32) {
-    score_with::<P, L>(app, ns, q, s, kappa, None, vp)
+    score_with::<P>(app, ns, q, s, kappa, None, vp)
 }
 
 /// [`score`] with the offset fixed to `fixed` when given (a coherent
 /// previous result keeps its own offset).
 #[inline(always)]
-pub(super) fn score_with<const P: u32, L: Lanes>(
+pub(super) fn score_with<const P: u32>(
     app: &[u64],
     ns: &Neighbourhood,
     q: i32,
@@ -56,14 +58,16 @@ pub(super) fn score_with<const P: u32, L: Lanes>(
     vp: i32,
 ) -> (u32, i32) {
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
-    let t = diagonal_texels(app, q, s);
-    let d = L::residuals(ns.ns01, ns.ns23, t);
-    // Mode 1 is each texel's low 16 bits.
-    let heights = t.map(|t| t as i16 as i32);
-    let sum1 = d.sum1();
+    let (t01, t23) = diagonal_texels(app, q, s);
+    let (m01, m23) = (i32x8::from_i16x8(t01), i32x8::from_i16x8(t23));
+    let d01 = ns.ns01 - (m01 + m01 + m01);
+    let d23 = ns.ns23 - (m23 + m23 + m23);
+    let (a, b) = (d01.to_array(), d23.to_array());
+    let (ma, mb) = (m01.to_array(), m23.to_array());
+    let sum1 = a[0] + a[4] + b[0] + b[4];
     // Both priors have constant weights, so each closed form divides by a
     // constant (the branch picks one, never a run-time divisor).
-    let flat = Prior { weight: P, v: vp }.for_candidate(heights) == FLAT;
+    let flat = Prior { weight: P, v: vp }.for_candidate([ma[0], ma[4], mb[0], mb[4]]) == FLAT;
     let prior = if flat {
         FLAT
     } else {
@@ -76,7 +80,21 @@ pub(super) fn score_with<const P: u32, L: Lanes>(
             Prior { weight: P, v: vp }.optimal(sum1)
         }
     });
-    let s = d.squares(3 * h).wrapping_add(prior.cost(h));
+    let h3 = 3 * h;
+    let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
+    // Clamping after the saturating narrowing equals clamping before it
+    // (saturation is monotone and ±CLAMP lies inside i16), and i16 min/max
+    // are single instructions where i32 ones are not (SSE2).
+    let lo = i16x8::splat(-CLAMP as i16);
+    let hi = i16x8::splat(CLAMP as i16);
+    let r01 = i16x8::from_i32x8_saturate(d01 - off).max(lo).min(hi);
+    let r23 = i16x8::from_i32x8_saturate(d23 - off).max(lo).min(hi);
+    let sums = (r01.dot(r01) + r23.dot(r23)).to_array();
+    let s = (sums[0] as u32)
+        .wrapping_add(sums[1] as u32)
+        .wrapping_add(sums[2] as u32)
+        .wrapping_add(sums[3] as u32)
+        .wrapping_add(prior.cost(h));
     (s * kappa, h)
 }
 
@@ -121,7 +139,7 @@ fn diagonal(app: &[u64], win: &Window<'_>, k: usize) -> ([u64; 3], i32) {
 /// The best gathered candidate whose cost is below `bar`:
 /// (cost, index, optimal offset), index `usize::MAX` if none is.
 #[inline(always)]
-pub(super) fn best_of<const P: u32, L: Lanes>(
+pub(super) fn best_of<const P: u32>(
     app: &[u64],
     ns: &Neighbourhood,
     p: &Pending,
@@ -130,7 +148,7 @@ pub(super) fn best_of<const P: u32, L: Lanes>(
 ) -> (u32, usize, i32) {
     let mut best = (bar, usize::MAX, 0i32);
     for (i, c) in p.cands[..p.count].iter().enumerate() {
-        let (sc, hh) = score::<P, L>(app, ns, c.idx, c.stride, c.kappa, vp);
+        let (sc, hh) = score::<P>(app, ns, c.idx, c.stride, c.kappa, vp);
         if sc < best.0 {
             best = (sc, i, hh);
         }
