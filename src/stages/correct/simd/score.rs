@@ -7,18 +7,10 @@ use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
 use wide::{i16x8, i32x8};
 
-/// The four diagonal texels of the candidate at texel index `q` (row
-/// stride `s`), two per vector as eight i16 lanes, in DIAGONALS order.
-/// They are read from one slice that spans them, so two bounds checks
-/// cover the four loads.
+/// Two packed appearance texels as eight i16 lanes.
 #[inline(always)]
-fn diagonal_texels(app: &[u64], q: i32, s: i32) -> (i16x8, i16x8) {
-    let s = s as usize;
-    let t = &app[(q as usize).wrapping_sub(s + 1)..][..2 * s + 3];
-    (
-        wide::bytemuck::cast([t[0], t[2]]),
-        wide::bytemuck::cast([t[2 * s], t[2 * s + 2]]),
-    )
+fn pair(app: &[u64], a: i32, b: i32) -> i16x8 {
+    wide::bytemuck::cast([app[a as usize], app[b as usize]])
 }
 
 /// The synthesis neighbourhood N_S (×3), two diagonals per vector, mode 1
@@ -58,8 +50,8 @@ pub(super) fn score_with<const P: u32>(
     vp: i32,
 ) -> (u32, i32) {
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
-    let (t01, t23) = diagonal_texels(app, q, s);
-    let (m01, m23) = (i32x8::from_i16x8(t01), i32x8::from_i16x8(t23));
+    let m01 = i32x8::from_i16x8(pair(app, q - s - 1, q - s + 1));
+    let m23 = i32x8::from_i16x8(pair(app, q + s - 1, q + s + 1));
     let d01 = ns.ns01 - (m01 + m01 + m01);
     let d23 = ns.ns23 - (m23 + m23 + m23);
     let (a, b) = (d01.to_array(), d23.to_array());
