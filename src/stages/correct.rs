@@ -344,32 +344,47 @@ fn guided<const P: u32>(
     // First row/column of the class at or after a bound.
     let class_from = |start: usize, parity: usize| start + ((parity + 2 - start % 2) % 2);
     let (y_first, x_first) = (class_from(wy0, p.py as usize), class_from(wx0, px));
-    (y_first..wy1.min(h))
+    let x_end = wx1.min(w);
+    // Interior span: first class pixel ≥ 2, last one < w − 2.
+    let x0 = class_from(x_first.max(2), px);
+    let x1 = x_end.min(w.saturating_sub(2));
+    let interior = |y: usize| y >= 2 && y + 2 < h && w >= 5;
+    let rows = (wy1.min(h).saturating_sub(y_first)).div_ceil(2);
+    // Blocks of consecutive class rows per task: the SIMD span walks a
+    // block's rows chunk by chunk and reuses grid rows between them.
+    (0..rows.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
-        .step_by(2)
-        .for_each(|y| {
-            let scalar_at = |x: usize| {
-                let prior = Prior::at(P, parent, x, y);
-                let (s, v) = scalar::correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
-                st.set(y * w + x, s, v);
-            };
-            let x_end = wx1.min(w);
-            if y < 2 || y + 2 >= h || w < 5 {
-                (x_first..x_end).step_by(2).for_each(scalar_at);
-                return;
+        .for_each(|b| {
+            let first = b * ROWS_PER_TASK;
+            let ys: [usize; ROWS_PER_TASK] = std::array::from_fn(|j| y_first + 2 * (first + j));
+            let ys = &ys[..ROWS_PER_TASK.min(rows - first)];
+            for &y in ys {
+                let scalar_at = |x: usize| {
+                    let prior = Prior::at(P, parent, x, y);
+                    let (s, v) =
+                        scalar::correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
+                    st.set(y * w + x, s, v);
+                };
+                if !interior(y) {
+                    (x_first..x_end).step_by(2).for_each(scalar_at);
+                    continue;
+                }
+                (x_first..x0.min(x_end)).step_by(2).for_each(scalar_at);
+                (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
+                    .step_by(2)
+                    .for_each(scalar_at);
             }
-            // Interior span: first class pixel ≥ 2, last one < w − 2.
-            let x0 = class_from(x_first.max(2), px);
-            let x1 = x_end.min(w - 2);
-            (x_first..x0.min(x_end)).step_by(2).for_each(scalar_at);
-            if x0 < x1 {
-                simd::correct_span::<P>(atlas, st, parent, y, x0, x1, g);
+            // The interior rows of the block are consecutive.
+            let a = ys.iter().position(|&y| interior(y)).unwrap_or(ys.len());
+            let n = ys[a..].iter().take_while(|&&y| interior(y)).count();
+            if x0 < x1 && n > 0 {
+                simd::correct_span::<P>(atlas, st, parent, &ys[a..a + n], x0, x1, g);
             }
-            (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
-                .step_by(2)
-                .for_each(scalar_at);
         });
 }
+
+/// Class rows per parallel task of a subpass (see [`simd::correct_span`]).
+const ROWS_PER_TASK: usize = 8;
 
 /// The subpass's pixels outside [`Guide::window`] take the previous frame's
 /// result of this pass (what a full subpass would compute there), so a

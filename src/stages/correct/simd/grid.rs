@@ -48,7 +48,9 @@ pub(super) type Grid = [[Tap; GRID_COLS]; 5];
 
 /// Reads the neighbours of the `n` class pixels from column `x0` of row
 /// `y` into `grid`. Rows y ± 2 are read only at odd offsets from the
-/// class.
+/// class. `next`: the grid holds the same columns of class row y − 2,
+/// whose rows 2–3 are this row's rows 0–1 (unchanged: the subpass writes
+/// neither row y − 1 nor row y − 2 at odd offsets).
 #[inline(always)]
 pub(super) fn fill(
     grid: &mut Grid,
@@ -57,11 +59,18 @@ pub(super) fn fill(
     y: usize,
     x0: usize,
     n: usize,
+    next: bool,
 ) {
     let w = st.width;
     let cols = 2 * n + 3;
     let columns = &atlas.columns[..];
-    for (r, row) in grid.iter_mut().enumerate() {
+    let first = if next {
+        grid.copy_within(2..4, 0);
+        2
+    } else {
+        0
+    };
+    for (r, row) in grid.iter_mut().enumerate().skip(first) {
         let (s, v) = st.run((y + r - 2) * w + x0 - 2, cols);
         if r == 0 || r == 4 {
             for j in 0..cols / 2 {
