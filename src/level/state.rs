@@ -78,6 +78,13 @@ impl State {
         self.s[i].store(s.pack(), Relaxed);
         self.v[i].store(v, Relaxed);
     }
+    /// The S and V of the `n` pixels from `i` on, for kernels that read a
+    /// run of pixels (one bounds check per run, not two per pixel). Read
+    /// them with [`Coord::unpack`] and relaxed loads.
+    #[inline(always)]
+    pub fn run(&self, i: usize, n: usize) -> (&[AtomicU64], &[AtomicI32]) {
+        (&self.s[i..i + n], &self.v[i..i + n])
+    }
     /// A copy of the coordinates, row-major.
     pub fn coords(&self) -> Vec<Coord> {
         self.s

@@ -75,6 +75,7 @@ use crate::level::fixed::{Coord, div_floor};
 use crate::level::state::State;
 use nudge::Target;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicI32, Ordering::Relaxed};
 
 pub use uniform::{CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, CorrectUniform, GuideCell};
 
@@ -100,20 +101,50 @@ pub const DEFAULT_PRIOR: u32 = 4;
 /// level 0 as faint squares (seen in the sea of the shared DEMs).
 #[inline(always)]
 pub fn parent_v(pa: &State, x: usize, y: usize) -> i32 {
-    let (px, py) = (x / 2, y / 2);
-    let near = |c: usize, odd: bool, n: usize| {
-        if odd {
-            (c + 1).min(n - 1)
-        } else {
-            c.saturating_sub(1)
+    ParentRow::new(pa, y).v(x)
+}
+
+/// The two rows of the level above that [`parent_v`] reads for one child
+/// row, looked up once: kernels that walk a row take each pixel's anchor
+/// from here (per pixel, the row lookups and clamps cost as much as the
+/// interpolation).
+pub struct ParentRow<'a> {
+    /// The parent row under the child row, and the nearest other one.
+    under: &'a [AtomicI32],
+    other: &'a [AtomicI32],
+}
+
+/// `c`'s neighbour on the side of the child (`odd`), clamped to `0..n`.
+#[inline(always)]
+fn nearest(c: usize, odd: bool, n: usize) -> usize {
+    if odd {
+        (c + 1).min(n - 1)
+    } else {
+        c.saturating_sub(1)
+    }
+}
+
+impl<'a> ParentRow<'a> {
+    /// The rows for child row `y`.
+    #[inline(always)]
+    pub fn new(pa: &'a State, y: usize) -> ParentRow<'a> {
+        let (py, w) = (y / 2, pa.width);
+        let qy = nearest(py, y % 2 == 1, pa.height);
+        ParentRow {
+            under: pa.run(py * w, w).1,
+            other: pa.run(qy * w, w).1,
         }
-    };
-    let (qx, qy) = (
-        near(px, x % 2 == 1, pa.width),
-        near(py, y % 2 == 1, pa.height),
-    );
-    let v = |x: usize, y: usize| pa.v(y * pa.width + x);
-    (9 * v(px, py) + 3 * v(qx, py) + 3 * v(px, qy) + v(qx, qy) + 8) >> 4
+    }
+
+    /// [`parent_v`] of child column `x`.
+    #[inline(always)]
+    pub fn v(&self, x: usize) -> i32 {
+        let px = x / 2;
+        let qx = nearest(px, x % 2 == 1, self.under.len());
+        let (a, b) = (self.under, self.other);
+        let v = |r: &[AtomicI32], i: usize| r[i].load(Relaxed);
+        (9 * v(a, px) + 3 * v(a, qx) + 3 * v(b, px) + v(b, qx) + 8) >> 4
+    }
 }
 
 /// One pixel's height prior: its weight P and the parent's offset V it
@@ -313,32 +344,47 @@ fn guided<const P: u32>(
     // First row/column of the class at or after a bound.
     let class_from = |start: usize, parity: usize| start + ((parity + 2 - start % 2) % 2);
     let (y_first, x_first) = (class_from(wy0, p.py as usize), class_from(wx0, px));
-    (y_first..wy1.min(h))
+    let x_end = wx1.min(w);
+    // Interior span: first class pixel ≥ 2, last one < w − 2.
+    let x0 = class_from(x_first.max(2), px);
+    let x1 = x_end.min(w.saturating_sub(2));
+    let interior = |y: usize| y >= 2 && y + 2 < h && w >= 5;
+    let rows = (wy1.min(h).saturating_sub(y_first)).div_ceil(2);
+    // Blocks of consecutive class rows per task: the SIMD span walks a
+    // block's rows chunk by chunk and reuses grid rows between them.
+    (0..rows.div_ceil(ROWS_PER_TASK))
         .into_par_iter()
-        .step_by(2)
-        .for_each(|y| {
-            let scalar_at = |x: usize| {
-                let prior = Prior::at(P, parent, x, y);
-                let (s, v) = scalar::correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
-                st.set(y * w + x, s, v);
-            };
-            let x_end = wx1.min(w);
-            if y < 2 || y + 2 >= h || w < 5 {
-                (x_first..x_end).step_by(2).for_each(scalar_at);
-                return;
+        .for_each(|b| {
+            let first = b * ROWS_PER_TASK;
+            let ys: [usize; ROWS_PER_TASK] = std::array::from_fn(|j| y_first + 2 * (first + j));
+            let ys = &ys[..ROWS_PER_TASK.min(rows - first)];
+            for &y in ys {
+                let scalar_at = |x: usize| {
+                    let prior = Prior::at(P, parent, x, y);
+                    let (s, v) =
+                        scalar::correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
+                    st.set(y * w + x, s, v);
+                };
+                if !interior(y) {
+                    (x_first..x_end).step_by(2).for_each(scalar_at);
+                    continue;
+                }
+                (x_first..x0.min(x_end)).step_by(2).for_each(scalar_at);
+                (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
+                    .step_by(2)
+                    .for_each(scalar_at);
             }
-            // Interior span: first class pixel ≥ 2, last one < w − 2.
-            let x0 = class_from(x_first.max(2), px);
-            let x1 = x_end.min(w - 2);
-            (x_first..x0.min(x_end)).step_by(2).for_each(scalar_at);
-            if x0 < x1 {
-                simd::correct_span::<P>(atlas, st, parent, y, x0, x1, g);
+            // The interior rows of the block are consecutive.
+            let a = ys.iter().position(|&y| interior(y)).unwrap_or(ys.len());
+            let n = ys[a..].iter().take_while(|&&y| interior(y)).count();
+            if x0 < x1 && n > 0 {
+                simd::correct_span::<P>(atlas, st, parent, &ys[a..a + n], x0, x1, g);
             }
-            (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
-                .step_by(2)
-                .for_each(scalar_at);
         });
 }
+
+/// Class rows per parallel task of a subpass (see [`simd::correct_span`]).
+const ROWS_PER_TASK: usize = 8;
 
 /// The subpass's pixels outside [`Guide::window`] take the previous frame's
 /// result of this pass (what a full subpass would compute there), so a

@@ -2,9 +2,10 @@
 //! [`Tap`]s that consecutive pixels of a subpass share, and each pixel's
 //! 5×5 [`Window`] into it.
 
-use crate::level::atlas::AtlasLevel;
-use crate::level::fixed::round;
+use crate::level::atlas::{AtlasLevel, Column};
+use crate::level::fixed::{Coord, round};
 use crate::level::state::State;
+use std::sync::atomic::{AtomicI32, AtomicU64, Ordering::Relaxed};
 
 /// A neighbour as the kernel needs it.
 #[derive(Clone, Copy, Default)]
@@ -20,17 +21,18 @@ pub(super) struct Tap {
     pub v: i32,
 }
 
+/// The tap of a pixel whose S and V are `s` and `v`.
 #[inline(always)]
-fn tap(atlas: &AtlasLevel<'_>, st: &State, i: usize) -> Tap {
-    let s = st.s(i);
+fn tap(columns: &[Column], s: &AtomicU64, v: &AtomicI32) -> Tap {
+    let s = Coord::unpack(s.load(Relaxed));
     let (sx, sy) = (round(s.x), round(s.y));
-    let col = &atlas.columns[sx as usize];
+    let col = &columns[sx as usize];
     Tap {
         idx: col.base + sy * col.stride as i32 + sx,
         stride: col.stride as i32,
         sx,
         sy,
-        v: st.v(i),
+        v: v.load(Relaxed),
     }
 }
 
@@ -46,7 +48,9 @@ pub(super) type Grid = [[Tap; GRID_COLS]; 5];
 
 /// Reads the neighbours of the `n` class pixels from column `x0` of row
 /// `y` into `grid`. Rows y ± 2 are read only at odd offsets from the
-/// class.
+/// class. `next`: the grid holds the same columns of class row y − 2,
+/// whose rows 2–3 are this row's rows 0–1 (unchanged: the subpass writes
+/// neither row y − 1 nor row y − 2 at odd offsets).
 #[inline(always)]
 pub(super) fn fill(
     grid: &mut Grid,
@@ -55,18 +59,26 @@ pub(super) fn fill(
     y: usize,
     x0: usize,
     n: usize,
+    next: bool,
 ) {
     let w = st.width;
     let cols = 2 * n + 3;
-    for (r, row) in grid.iter_mut().enumerate() {
-        let base = (y + r - 2) * w + x0 - 2;
+    let columns = &atlas.columns[..];
+    let first = if next {
+        grid.copy_within(2..4, 0);
+        2
+    } else {
+        0
+    };
+    for (r, row) in grid.iter_mut().enumerate().skip(first) {
+        let (s, v) = st.run((y + r - 2) * w + x0 - 2, cols);
         if r == 0 || r == 4 {
             for j in 0..cols / 2 {
-                row[2 * j + 1] = tap(atlas, st, base + 2 * j + 1);
+                row[2 * j + 1] = tap(columns, &s[2 * j + 1], &v[2 * j + 1]);
             }
         } else {
-            for (j, t) in row[..cols].iter_mut().enumerate() {
-                *t = tap(atlas, st, base + j);
+            for ((t, s), v) in row[..cols].iter_mut().zip(s).zip(v) {
+                *t = tap(columns, s, v);
             }
         }
     }
