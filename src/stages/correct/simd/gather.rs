@@ -116,39 +116,6 @@ fn firsts_scalar(u: &[i32; 9]) -> u32 {
     first
 }
 
-#[cfg(test)]
-mod tests {
-    use super::{firsts, firsts_scalar};
-
-    #[test]
-    fn firsts_marks_each_first_occurrence_like_the_pairwise_compares() {
-        // Every u over an alphabet of 3 values whose first entry is fixed
-        // (3^8 patterns: every arrangement of repeats among the nine), and
-        // hashed ones with wide values (sign bits, lanes packed to i16).
-        let mut us: Vec<[i32; 9]> = (0..3u32.pow(8))
-            .map(|code| {
-                std::array::from_fn(|k| {
-                    if k == 0 {
-                        0
-                    } else {
-                        (code / 3u32.pow(k as u32 - 1) % 3) as i32
-                    }
-                })
-            })
-            .collect();
-        let mut h = 0x9E37_79B9u32;
-        for _ in 0..4096 {
-            us.push(std::array::from_fn(|_| {
-                h = h.wrapping_mul(0x0101_0101).wrapping_add(0x7F4A_7C15) ^ (h >> 13);
-                [i32::MIN, -1, 0x0001_0000, 0x7FFF_0000][(h >> 30) as usize] | (h & 1) as i32
-            }));
-        }
-        for u in &us {
-            assert_eq!(firsts(u), firsts_scalar(u), "u = {u:?}");
-        }
-    }
-}
-
 /// [`gather`]'s listing of C₁ and C₂ of Δ = `DELTAS[k]`, whose neighbour
 /// is `n` and u's texel index `u_idx`.
 #[inline(always)]
@@ -213,4 +180,37 @@ fn prefetch_line(t: *const i8) {
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = t;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{firsts, firsts_scalar};
+
+    #[test]
+    fn firsts_marks_each_first_occurrence_like_the_pairwise_compares() {
+        // Every u over an alphabet of 3 values whose first entry is fixed
+        // (3^8 patterns: every arrangement of repeats among the nine), and
+        // hashed ones with wide values (sign bits, lanes packed to i16).
+        let mut us: Vec<[i32; 9]> = (0..3u32.pow(8))
+            .map(|code| {
+                std::array::from_fn(|k| {
+                    if k == 0 {
+                        0
+                    } else {
+                        (code / 3u32.pow(k as u32 - 1) % 3) as i32
+                    }
+                })
+            })
+            .collect();
+        let mut h = 0x9E37_79B9u32;
+        for _ in 0..4096 {
+            us.push(std::array::from_fn(|_| {
+                h = h.wrapping_mul(0x0101_0101).wrapping_add(0x7F4A_7C15) ^ (h >> 13);
+                [i32::MIN, -1, 0x0001_0000, 0x7FFF_0000][(h >> 30) as usize] | (h & 1) as i32
+            }));
+        }
+        for u in &us {
+            assert_eq!(firsts(u), firsts_scalar(u), "u = {u:?}");
+        }
+    }
 }
