@@ -11,6 +11,7 @@ use terrasynth::progress::Silent;
 use terrasynth::synth::atlas::AtlasLevel;
 use terrasynth::synth::cone::Rect;
 use terrasynth::synth::fixed::{FRAC_BITS, round};
+use terrasynth::synth::state::State;
 use terrasynth::synth::{Params, Synthesizer, coarse};
 
 fn db() -> &'static Database {
@@ -20,6 +21,24 @@ fn db() -> &'static Database {
 
 fn bits(hf: &terrasynth::Heightfield) -> Vec<u32> {
     hf.data().iter().map(|v| v.to_bits()).collect()
+}
+
+/// The coarse start of a `side × side` world at level `l` in blocks of
+/// 2^`bits` texels.
+fn square_start(
+    src: coarse::Source<'_>,
+    side: usize,
+    (l, bits): (usize, usize),
+    seed: u32,
+    jitter: i32,
+) -> State {
+    coarse::blocks(
+        src,
+        (Rect::new(0, 0, side, side), (side, side)),
+        (l, bits),
+        seed,
+        jitter,
+    )
 }
 
 #[test]
@@ -175,13 +194,7 @@ fn without_a_start_exemplar_blocks_come_from_every_exemplar_by_area() {
         from: None,
         profile: &profile,
     };
-    let start = coarse::blocks(
-        src,
-        (Rect::new(0, 0, side, side), (side, side)),
-        (l, bits),
-        5,
-        jitter,
-    );
+    let start = square_start(src, side, (l, bits), 5, jitter);
     assert_eq!((start.width, start.height), (side, side));
     let mut used = vec![0usize; areas.len()];
     for by in 0..n {
@@ -231,13 +244,7 @@ fn blocks_cover_every_interior_texel_alike_and_stay_inside() {
         from: Some(0),
         profile: &profile,
     };
-    let start = coarse::blocks(
-        src,
-        (Rect::new(0, 0, side, side), (side, side)),
-        (l, bits),
-        9,
-        100,
-    );
+    let start = square_start(src, side, (l, bits), 9, 100);
     let mut hits = vec![0u32; nx];
     for i in 0..side * side {
         let s = start.s(i);
@@ -423,13 +430,7 @@ fn the_coarse_start_keeps_its_exemplar_relief_on_every_seed() {
                 from: Some(e),
                 profile: &profile,
             };
-            let start = coarse::blocks(
-                src,
-                (Rect::new(0, 0, side, side), (side, side)),
-                (l, bits),
-                seed,
-                0,
-            );
+            let start = square_start(src, side, (l, bits), seed, 0);
             let got = relief(
                 (0..side * side)
                     .map(|i| start.s(i))
