@@ -99,15 +99,13 @@ pub fn upsample_jitter_rect(
     let x1 = x1.min(child.width);
     (y0..y1.min(child.height)).into_par_iter().for_each(|y| {
         let mut jit = [(0, 0); ROW_CHUNK];
-        let mut a = x0;
-        while a < x1 {
+        for a in (x0..x1).step_by(ROW_CHUNK) {
             let b = x1.min(a + ROW_CHUNK);
             let jit = &mut jit[..b - a];
             jitter_row(p, ox + a as u32, oy + y as u32, jit);
             for (x, &j) in (a..b).zip(jit.iter()) {
                 upsample_pixel(parent, child, atlas, p, x, y, j);
             }
-            a = b;
         }
     });
 }
