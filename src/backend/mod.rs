@@ -137,6 +137,17 @@ pub trait Backend {
     /// Stage `reconstruct` of a level-0 state: fixed-point heights (see
     /// `stages::reconstruct`), row-major.
     fn reconstruct(&self, st: &Self::State) -> Result<Vec<i32>, BackendError>;
+    /// [`Backend::reconstruct`], the heights handed to `f` where they lie
+    /// rather than returned: the GPU's mapped read-back, which a copy into
+    /// a `Vec` read at a few GB/s (0.6 ms of a 5 ms 1024² synthesis on an
+    /// H100). Default: `f` of the returned heights.
+    fn reconstruct_with<R>(
+        &self,
+        st: &Self::State,
+        f: impl FnOnce(&[i32]) -> R,
+    ) -> Result<R, BackendError> {
+        Ok(f(&self.reconstruct(st)?))
+    }
     /// [`Backend::reconstruct`] where the heights can differ from `prev`
     /// (the previous frame's, level-sized) only in `rect`: an edit's
     /// re-synthesis. Default: the whole level.

@@ -396,18 +396,23 @@ impl<'db> Synthesizer<'db> {
             .and_then(|c| c.prev)
             .map(|f| &f.heights)
             .filter(|h| h.len() == cone.region(0).width() * cone.region(0).height());
-        let fixed = match (window0, prev_heights) {
+        // The fixed-point heights are kept only for the next frame.
+        let keep = frames.is_some();
+        let (heightfield, fixed) = match (window0, prev_heights) {
             // Heights depend on their 3×3 neighbourhood's S and V, which
             // differ from the previous frame's only inside the window.
             (Some(win), Some(prev)) => {
                 let r = cone.region(0);
                 let read = widen(win, 1, r.width(), r.height());
-                b.reconstruct_rect(&state, prev, read)?
+                let fixed = b.reconstruct_rect(&state, prev, read)?;
+                (self.to_metres(&fixed, cone)?, Some(fixed))
             }
-            _ => b.reconstruct(&state)?,
+            _ => b.reconstruct_with(&state, |fixed| {
+                let hf = self.to_metres(fixed, cone)?;
+                Ok::<_, SynthError>((hf, keep.then(|| fixed.to_vec())))
+            })??,
         };
-        let heightfield = self.to_metres(&fixed, cone)?;
-        if let Some(f) = frames.as_mut() {
+        if let (Some(f), Some(fixed)) = (frames.as_mut(), fixed) {
             f.heights = fixed;
         }
         timings.reconstruct = t.elapsed();

@@ -68,7 +68,15 @@ impl Backend for Gpu {
     }
 
     fn reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
-        self.dispatch_reconstruct(st)
+        self.dispatch_reconstruct(st, <[i32]>::to_vec)
+    }
+
+    fn reconstruct_with<R>(
+        &self,
+        st: &GpuState,
+        f: impl FnOnce(&[i32]) -> R,
+    ) -> Result<R, BackendError> {
+        self.dispatch_reconstruct(st, f)
     }
 
     fn download(&self, st: &GpuState) -> Result<(Vec<Coord>, Vec<i32>), BackendError> {

@@ -3,8 +3,12 @@
 
 use super::Context;
 use crate::backend::BackendError;
+use rayon::prelude::*;
 use std::sync::mpsc;
 use wgpu::util::DeviceExt;
+
+/// Bytes per task of the parallel read-back copy (whole pages).
+const COPY_CHUNK: usize = 256 << 10;
 
 impl Context {
     /// Largest storage buffer the device binds.
@@ -64,13 +68,34 @@ impl Context {
         }))
     }
 
-    /// Copies a device buffer back to the host (waits for queued work).
     /// Copies `buffer` back to the host as `T`s, after every pass recorded
-    /// so far (one copy on the host: mapped bytes straight into the `Vec`).
-    pub(super) fn read<T: bytemuck::Pod>(
+    /// so far.
+    pub(super) fn read<T: bytemuck::Pod + Send + Sync>(
         &self,
         buffer: &wgpu::Buffer,
     ) -> Result<Vec<T>, BackendError> {
+        self.read_with(buffer, |from: &[T]| {
+            // Copied in parallel chunks: one thread read the mapped memory
+            // at ~1.7 GB/s on an H100's host (2.2 ms of an 11 ms 1024²
+            // synthesis), and the fresh Vec's page faults spread over the
+            // threads too.
+            let mut data = vec![T::zeroed(); from.len()];
+            let chunk = (COPY_CHUNK / std::mem::size_of::<T>()).max(1);
+            data.par_chunks_mut(chunk)
+                .zip(from.par_chunks(chunk))
+                .for_each(|(to, from)| to.copy_from_slice(from));
+            data
+        })
+    }
+
+    /// Hands `buffer`'s contents, after every pass recorded so far, to `f`
+    /// as `T`s where the device maps them (no copy on the host: the
+    /// synthesis converts its heights to metres straight from there).
+    pub(super) fn read_with<T: bytemuck::Pod, R>(
+        &self,
+        buffer: &wgpu::Buffer,
+        f: impl FnOnce(&[T]) -> R,
+    ) -> Result<R, BackendError> {
         let size = buffer.size();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -93,12 +118,14 @@ impl Context {
         rx.recv()
             .map_err(|e| BackendError::Gpu(e.to_string()))?
             .map_err(|e| BackendError::Gpu(e.to_string()))?;
-        let data = bytemuck::pod_collect_to_vec(
-            &staging
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| BackendError::Gpu(e.to_string()))?,
-        );
-        Ok(data)
+        let mapped = staging
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| BackendError::Gpu(e.to_string()))?;
+        // Mapped ranges are aligned (wgpu::MAP_ALIGNMENT) and buffers hold
+        // whole words, so this fails only on a broken driver.
+        let data = bytemuck::try_cast_slice(&mapped)
+            .map_err(|e| BackendError::Gpu(format!("mapped read-back: {e}")))?;
+        Ok(f(data))
     }
 }

@@ -6,7 +6,13 @@ use crate::backend::{BackendError, Stage};
 use crate::stages::reconstruct::ReconstructUniform;
 
 impl Gpu {
-    pub(super) fn dispatch_reconstruct(&self, st: &GpuState) -> Result<Vec<i32>, BackendError> {
+    /// Stage `reconstruct`; `f` gets the heights where the device maps
+    /// them.
+    pub(super) fn dispatch_reconstruct<R>(
+        &self,
+        st: &GpuState,
+        f: impl FnOnce(&[i32]) -> R,
+    ) -> Result<R, BackendError> {
         let u = ReconstructUniform {
             width: st.width as u32,
             height: st.height as u32,
@@ -22,6 +28,6 @@ impl Gpu {
             &[&st.s, &st.v, &self.levels[0].columns, &self.heights, &out],
             (groups(st.width), groups(st.height)),
         );
-        self.ctx.read(&out)
+        self.ctx.read_with(&out, f)
     }
 }

@@ -350,7 +350,14 @@ pub(super) fn layouts(
     seed: u32,
     blocks: impl Iterator<Item = (i32, i32)>,
 ) -> HashMap<(i32, i32), u32> {
-    let mut groups: Vec<(i32, i32)> = blocks.map(|(bx, by)| (bx >> 1, by >> 1)).collect();
+    // Runs of pixels share a group: dropping repeats first leaves a few
+    // thousand to sort where a 512² start level has 262 144 pixels.
+    let mut groups: Vec<(i32, i32)> = Vec::new();
+    for g in blocks.map(|(bx, by)| (bx >> 1, by >> 1)) {
+        if groups.last() != Some(&g) {
+            groups.push(g);
+        }
+    }
     groups.sort_unstable();
     groups.dedup();
     let world = [
@@ -359,16 +366,23 @@ pub(super) fn layouts(
         shift.0 + world.0 as i32,
         shift.1 + world.1 as i32,
     ];
-    groups
+    // Every (group, layout) distance in parallel: an output the exemplars'
+    // size is one group, whose eight layouts were one thread's work.
+    let distances: Vec<_> = (0..groups.len() * LAYOUTS as usize)
         .into_par_iter()
-        .map(|g| {
-            let distance = |c: u32| profile.distance(draws, seed, c, g, world);
+        .map(|k| {
+            let (g, c) = (groups[k / LAYOUTS as usize], k as u32 % LAYOUTS);
+            profile.distance(draws, seed, c, g, world)
+        })
+        .collect();
+    groups
+        .iter()
+        .zip(distances.chunks(LAYOUTS as usize))
+        .map(|(&g, d)| {
             // Ties keep the earlier layout.
-            let best = (1..LAYOUTS).fold((0, distance(0)), |(b, d), c| {
-                let dc = distance(c);
-                if dc < d { (c, dc) } else { (b, d) }
-            });
-            (g, best.0)
+            let best =
+                (1..LAYOUTS).fold(0, |b, c| if d[c as usize] < d[b as usize] { c } else { b });
+            (g, best)
         })
         .collect()
 }
