@@ -263,8 +263,9 @@ struct Best {
     q: vec2<i32>,
 }
 
-// The u already tried for a pixel (at most eight before the ninth
-// neighbour); unused fields hold UNSEEN, which no u equals.
+// The u already tried for a pixel, latest first: at most eight matter
+// (the ninth neighbour's is never compared); unused fields hold UNSEEN,
+// which no u equals.
 struct Seen {
     s0: vec2<i32>,
     s1: vec2<i32>,
@@ -316,55 +317,37 @@ fn try_source(ns: Hood, n: Neighbour, admit: u32, best: ptr<function, Best>) -> 
     return admitted;
 }
 
+// Neighbour dl's source u, unless already `seen` (then nothing: the Rust
+// loop skips a repeated u); else it joins `seen` and its two candidates
+// are tried. Whether any candidate was admitted.
+fn visit(
+    ns: Hood, x: i32, y: i32, dl: vec2<i32>, seen: ptr<function, Seen>, admit: u32,
+    best: ptr<function, Best>,
+) -> bool {
+    let n = shifted(x, y, dl);
+    let s = *seen;
+    if (is_seen(s, n.t)) {
+        return false;
+    }
+    *seen = Seen(n.t, s.s0, s.s1, s.s2, s.s3, s.s4, s.s5, s.s6);
+    return try_source(ns, n, admit, best);
+}
+
 // The k-coherence candidates of pixel (x, y) admitted by `admit` (the
 // closure `candidates` of scalar::correct_pixel_guided); whether any was.
 // The nine neighbours in correct::DELTAS order (the tie-break order),
 // written out: a loop over an array of them kept its arrays in local memory.
 fn candidates(ns: Hood, x: i32, y: i32, admit: u32, best: ptr<function, Best>) -> bool {
     var seen = Seen(UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN);
-    var admitted = false;
-    let n0 = shifted(x, y, vec2<i32>(0, 0));
-    seen.s0 = n0.t;
-    admitted = try_source(ns, n0, admit, best) || admitted;
-    let n1 = shifted(x, y, vec2<i32>(-1, -1));
-    if (!is_seen(seen, n1.t)) {
-        seen.s1 = n1.t;
-        admitted = try_source(ns, n1, admit, best) || admitted;
-    }
-    let n2 = shifted(x, y, vec2<i32>(0, -1));
-    if (!is_seen(seen, n2.t)) {
-        seen.s2 = n2.t;
-        admitted = try_source(ns, n2, admit, best) || admitted;
-    }
-    let n3 = shifted(x, y, vec2<i32>(1, -1));
-    if (!is_seen(seen, n3.t)) {
-        seen.s3 = n3.t;
-        admitted = try_source(ns, n3, admit, best) || admitted;
-    }
-    let n4 = shifted(x, y, vec2<i32>(-1, 0));
-    if (!is_seen(seen, n4.t)) {
-        seen.s4 = n4.t;
-        admitted = try_source(ns, n4, admit, best) || admitted;
-    }
-    let n5 = shifted(x, y, vec2<i32>(1, 0));
-    if (!is_seen(seen, n5.t)) {
-        seen.s5 = n5.t;
-        admitted = try_source(ns, n5, admit, best) || admitted;
-    }
-    let n6 = shifted(x, y, vec2<i32>(-1, 1));
-    if (!is_seen(seen, n6.t)) {
-        seen.s6 = n6.t;
-        admitted = try_source(ns, n6, admit, best) || admitted;
-    }
-    let n7 = shifted(x, y, vec2<i32>(0, 1));
-    if (!is_seen(seen, n7.t)) {
-        seen.s7 = n7.t;
-        admitted = try_source(ns, n7, admit, best) || admitted;
-    }
-    let n8 = shifted(x, y, vec2<i32>(1, 1));
-    if (!is_seen(seen, n8.t)) {
-        admitted = try_source(ns, n8, admit, best) || admitted;
-    }
+    var admitted = visit(ns, x, y, vec2<i32>(0, 0), &seen, admit, best);
+    admitted = visit(ns, x, y, vec2<i32>(-1, -1), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(0, -1), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(1, -1), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(-1, 0), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(1, 0), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(-1, 1), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(0, 1), &seen, admit, best) || admitted;
+    admitted = visit(ns, x, y, vec2<i32>(1, 1), &seen, admit, best) || admitted;
     return admitted;
 }
 
