@@ -313,7 +313,7 @@ impl SceneEdits {
                         },
                     ));
                 }
-                let r = db.level(0).layout.rects[e];
+                let r = &db.meta().exemplars[e];
                 if let Some((k, q)) = p
                     .lasso
                     .iter()
