@@ -128,31 +128,17 @@ fn pca_modes_are_orthonormal_and_heights_quantize_within_half_a_unit() {
             }
         }
     }
-    // Every atlas texel, the mirrored pad included, holds the height of
-    // the exemplar pixel `to_exemplar` names.
     let q = db.quantization();
-    for (e, original) in inputs().iter().enumerate() {
-        let (r, m) = (db.level(0).layout.rects[e], &db.meta().exemplars[e]);
-        assert_eq!(m.pad, database::pad::PAD);
-        assert_eq!(
-            (m.width as usize, m.height as usize),
-            (original.heights.width(), original.heights.height())
-        );
-        assert_eq!((r.width, r.height), m.atlas_size());
-        for y in 0..r.height {
-            for x in 0..r.width {
-                let back = q.metres(db.heights()[r.index(r.x0 + x, y)] as f64);
-                let (ox, oy) = m.to_exemplar(x, y);
-                let want = original.heights.get(ox as usize, oy as usize) as f64;
-                assert!(
-                    (back - want).abs() <= q.scale_m * 0.5 + 1e-6,
-                    "{e}: ({x}, {y})"
-                );
-            }
+    let r = db.level(0).layout.rects[0];
+    let original = &inputs()[0].heights;
+    for y in 0..r.height {
+        for x in 0..r.width {
+            let back = q.metres(db.heights()[r.index(r.x0 + x, y)] as f64);
+            assert!(
+                (back - original.get(x as usize, y as usize) as f64).abs()
+                    <= q.scale_m * 0.5 + 1e-6
+            );
         }
-        let own = db.exemplar_heights(e);
-        assert_eq!(own.len(), (m.width * m.height) as usize);
-        assert_eq!(own[0], db.heights()[r.index(r.x0 + m.pad, m.pad)]);
     }
 }
 
@@ -311,62 +297,5 @@ fn fuzz_seeds_load_and_their_prefixes_fail_cleanly() {
         for cut in (0..png.len() - 12).step_by(7) {
             assert!(TypeMask::decode(&png[..cut], None).is_err(), "cut at {cut}");
         }
-    }
-}
-
-/// A database written before exemplars had a pad (the fuzz seed
-/// `tiny.tsdb`, whose metadata has no `pad`) loads with pad 0: atlas texels
-/// are exemplar pixels as they were.
-#[test]
-fn a_database_without_pads_still_loads() {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/tsdb/tiny.tsdb");
-    let bytes = std::fs::read(&p).unwrap();
-    let json_start = bytes.windows(2).position(|w| w == b"{\"").unwrap();
-    assert!(
-        !String::from_utf8_lossy(&bytes[json_start..json_start + 2000]).contains("\"pad\""),
-        "the seed predates the pad"
-    );
-    let db = Database::from_bytes(&bytes, &p).unwrap();
-    let (m, r) = (&db.meta().exemplars[0], db.level(0).layout.rects[0]);
-    assert_eq!(m.pad, 0);
-    assert_eq!((r.width, r.height), (m.width, m.height));
-    assert_eq!(m.to_exemplar(7, 40), (7, 40));
-    assert_eq!(db.exemplar_heights(0), db.heights());
-}
-
-/// Metadata declaring a pad the layout does not have, or an absurd one, is
-/// refused (the layout is checked against the padded sizes).
-#[test]
-fn pads_are_checked_against_the_layout() {
-    use database::file::{self, Kind, Section};
-    let db = built();
-    let path = std::path::Path::new("p.tsdb");
-    let found = file::decode(db.file_bytes(), path).unwrap();
-    let with_meta = |meta: &database::Meta| {
-        let json = serde_json::to_vec(meta).unwrap();
-        let sections: Vec<Section> = found
-            .iter()
-            .map(|f| Section {
-                kind: f.kind,
-                level: f.level,
-                bytes: if f.kind == Kind::Meta {
-                    &json
-                } else {
-                    &db.file_bytes()[f.range.clone()]
-                },
-            })
-            .collect();
-        let words = file::encode(&sections);
-        Database::from_bytes(bytemuck::cast_slice(&words), path).map(|_| ())
-    };
-    assert!(with_meta(db.meta()).is_ok());
-    for pad in [0, database::pad::PAD + 1, database::pad::MAX_PAD + 1] {
-        let mut meta = db.meta().clone();
-        meta.exemplars[1].pad = pad;
-        let err = with_meta(&meta).unwrap_err().to_string();
-        assert!(
-            err.contains("layout") || err.contains("pad"),
-            "pad {pad}: {err}"
-        );
     }
 }

@@ -361,9 +361,9 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
 }
 
 /// A paste from an exemplar copies the exemplar's own pixels (lasso in its
-/// coordinates) to their targets, near the exemplar's edge too: the
-/// database pads every exemplar with mirrored texels, and the paste must
-/// address past the pad (`Paste::in_atlas`) — 16 pixels off otherwise.
+/// coordinates) to their targets, near the exemplar's edge too: a paste
+/// that addressed the atlas in other coordinates than the exemplar's (a
+/// pad, an offset) would land other pixels there.
 #[test]
 fn an_exemplar_paste_copies_the_exemplar_pixels() {
     let Some(db) = db() else { return };
@@ -381,11 +381,10 @@ fn an_exemplar_paste_copies_the_exemplar_pixels() {
         })])
         .unwrap()
         .heightfield;
-    let (q, m) = (db.quantization(), &db.meta().exemplars[e]);
-    let own = db.exemplar_heights(e);
+    let (q, r) = (db.quantization(), db.level(0).layout.rects[e]);
     let mut n = 0;
-    for y in 0..m.height as usize {
-        for x in 0..m.width as usize {
+    for y in 0..r.height {
+        for x in 0..r.width {
             let within = |dx: f64, dy: f64| {
                 terrasynth::synth::control::inside(&lasso, x as f64 + 0.5 + dx, y as f64 + 0.5 + dy)
             };
@@ -393,8 +392,8 @@ fn an_exemplar_paste_copies_the_exemplar_pixels() {
                 .iter()
                 .all(|&dy| [-1.0, 0.0, 1.0].iter().all(|&dx| within(dx, dy)))
             {
-                let want = q.metres(f64::from(own[y * m.width as usize + x]));
-                let got = out.get(x + ox as usize, y + oy as usize) as f64;
+                let want = q.metres(f64::from(db.heights()[r.index(r.x0 + x, y)]));
+                let got = out.get(x as usize + ox as usize, y as usize + oy as usize) as f64;
                 assert!((got - want).abs() < 0.02, "({x}, {y}): {got} vs {want}");
                 n += 1;
             }

@@ -4,7 +4,6 @@ use super::appearance;
 use super::error::DbError;
 use super::file::{self, Bytes, Kind, Section};
 use super::layout::{self, MAX_EXEMPLARS};
-use super::pad::{self, PAD};
 use super::patchmatch;
 use super::pyramid::{self, Grid, Quantization};
 use super::types::{self, TypeMask};
@@ -156,11 +155,7 @@ pub fn build(
         .iter()
         .map(|e| (e.heights.width() as u32, e.heights.height() as u32))
         .collect();
-    let padded: Vec<(u32, u32)> = sizes
-        .iter()
-        .map(|&(w, h)| (w + 2 * PAD, h + 2 * PAD))
-        .collect();
-    let plan = layout::plan(&padded, levels).ok_or(DbError::AtlasTooLarge)?;
+    let plan = layout::plan(&sizes, levels).ok_or(DbError::AtlasTooLarge)?;
 
     let (gmin, gmax) = inputs
         .iter()
@@ -189,37 +184,24 @@ pub fn build(
                 cell_size_m: e.heights.cell_size(),
                 min_m: s.min as f64,
                 max_m: s.max as f64,
-                pad: PAD,
             }
         })
         .collect();
 
-    // Everything from here on sees the padded exemplars (see [`pad`]).
-    let bases: Vec<Grid> = inputs
+    let heights0: Vec<u16> = inputs
         .iter()
-        .map(|e| {
-            let (w, h) = (e.heights.width(), e.heights.height());
-            Grid {
-                width: w + 2 * PAD as usize,
-                height: h + 2 * PAD as usize,
-                data: pad::pad_grid(e.heights.data(), w, h, PAD),
-            }
-        })
+        .flat_map(|e| e.heights.data().iter().map(|&m| q.quantize(m as f64)))
         .collect();
-    drop(inputs);
-    let t0: Vec<Vec<u8>> = t0
-        .iter()
-        .zip(&usizes)
-        .map(|(t, &(w, h))| pad::pad_grid(t, w, h, PAD))
-        .collect();
-    let usizes: Vec<(usize, usize)> = bases.iter().map(|g| (g.width, g.height)).collect();
-    let heights0: Vec<u16> = bases
-        .iter()
-        .flat_map(|g| g.data.iter().map(|&m| q.quantize(m as f64)))
-        .collect();
-    let pyramids: Vec<Vec<Grid>> = bases
+    let pyramids: Vec<Vec<Grid>> = inputs
         .into_iter()
-        .map(|base| pyramid::pyramid(base, levels))
+        .map(|e| {
+            let base = Grid {
+                width: e.heights.width(),
+                height: e.heights.height(),
+                data: e.heights.into_vec(),
+            };
+            pyramid::pyramid(base, levels)
+        })
         .collect();
 
     let total: u64 = plan.iter().map(|l| l.texels()).sum();

@@ -15,7 +15,7 @@ use crate::progress::Progress;
 use std::path::{Path, PathBuf};
 
 /// Bump when the build algorithm changes its output (PatchMatch, PCA…).
-pub const BUILD_REVISION: u32 = 2;
+pub const BUILD_REVISION: u32 = 1;
 
 /// A CRC-32 over length-prefixed parts, then the crate version,
 /// [`FORMAT_VERSION`] and [`BUILD_REVISION`].

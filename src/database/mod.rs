@@ -13,10 +13,6 @@
 //! That is 15 B/px at level 0 and 13 B/px at each coarser level, ≈ 19.3 B per
 //! base pixel with the pyramid (the paper: 32, 42⅔ with the pyramid). Coarse
 //! heights E^{i>0} are not stored: synthesis reads heights only at level 0.
-//!
-//! Every exemplar is stored with a mirrored pad of [`pad::PAD`] texels on
-//! each side ([`pad`]), so a base pixel above is a padded one: the pad adds
-//! 2·PAD·(w + h + 2·PAD) texels: +8.9 % for a 733² exemplar, +6.3 % for 1024².
 
 pub mod appearance;
 mod build;
@@ -26,7 +22,6 @@ pub mod error;
 pub mod file;
 pub mod kdtree;
 pub mod layout;
-pub mod pad;
 pub mod patchmatch;
 pub mod pyramid;
 pub mod types;
@@ -59,41 +54,11 @@ pub struct Meta {
 #[serde(deny_unknown_fields)]
 pub struct ExemplarMeta {
     pub name: String,
-    /// The exemplar's own size, without its pad.
     pub width: u32,
     pub height: u32,
     pub cell_size_m: f64,
     pub min_m: f64,
     pub max_m: f64,
-    /// Mirrored texels around the exemplar in the atlas, per side at level
-    /// 0 ([`pad`]); files written before the pad existed have none.
-    #[serde(default)]
-    pub pad: u32,
-}
-
-impl ExemplarMeta {
-    /// Level-0 size in the atlas: the exemplar and its pad.
-    pub fn atlas_size(&self) -> (u32, u32) {
-        (self.width + 2 * self.pad, self.height + 2 * self.pad)
-    }
-
-    /// The exemplar pixel whose height atlas texel (x, y) of this exemplar's
-    /// level-0 rectangle holds (x, y relative to the rectangle's corner):
-    /// the pad subtracted, and mirrored back where it lies in the pad.
-    pub fn to_exemplar(&self, x: u32, y: u32) -> (u32, u32) {
-        let p = i64::from(self.pad);
-        (
-            pad::reflect(i64::from(x) - p, self.width),
-            pad::reflect(i64::from(y) - p, self.height),
-        )
-    }
-
-    /// Whether atlas texel (x, y) of this exemplar's level-0 rectangle is
-    /// the exemplar's own, not its pad.
-    pub fn is_real(&self, x: u32, y: u32) -> bool {
-        let p = self.pad;
-        x >= p && y >= p && x - p < self.width && y - p < self.height
-    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -230,19 +195,7 @@ impl Database {
             seeds: bytemuck::cast_slice(&b[r.seeds.clone()]),
         }
     }
-    /// Exemplar `e`'s own level-0 heights in height units, row-major, its
-    /// pad left out.
-    pub fn exemplar_heights(&self, e: usize) -> Vec<u16> {
-        let (r, m) = (self.meta.levels[0].layout.rects[e], &self.meta.exemplars[e]);
-        let heights = self.heights();
-        (0..m.height)
-            .flat_map(|y| {
-                let row = r.index(r.x0 + m.pad, y + m.pad);
-                heights[row..row + m.width as usize].iter().copied()
-            })
-            .collect()
-    }
-    /// Exemplar base pixels (level 0), pads included.
+    /// Exemplar base pixels (level 0).
     pub fn base_pixels(&self) -> u64 {
         self.meta.levels[0].layout.texels()
     }
@@ -393,21 +346,7 @@ fn check_meta(m: &Meta) -> Result<(), String> {
     if !(q.offset_m.is_finite() && q.scale_m.is_finite() && q.scale_m > 0.0) {
         return Err("invalid height quantization".into());
     }
-    if let Some(e) = m.exemplars.iter().find(|e| {
-        let side = 1..layout::MAX_ATLAS_SIDE;
-        e.pad > pad::MAX_PAD || !side.contains(&e.width) || !side.contains(&e.height)
-    }) {
-        return Err(format!(
-            "exemplar {:?}: size {}×{} with pad {} (expected sides in 1..{} and a pad of at most {})",
-            e.name,
-            e.width,
-            e.height,
-            e.pad,
-            layout::MAX_ATLAS_SIDE,
-            pad::MAX_PAD
-        ));
-    }
-    let sizes: Vec<(u32, u32)> = m.exemplars.iter().map(ExemplarMeta::atlas_size).collect();
+    let sizes: Vec<(u32, u32)> = m.exemplars.iter().map(|e| (e.width, e.height)).collect();
     let planned = layout::plan(&sizes, m.levels.len() - 1).ok_or("atlas too large")?;
     for (i, (lm, p)) in m.levels.iter().zip(&planned).enumerate() {
         if lm.layout != *p {

@@ -43,16 +43,12 @@ pub struct TypeUsage {
 pub fn type_usage(map: &CoordsMap, db: &Database) -> Result<TypeUsage, EvalError> {
     let level = db.level(0);
     let rects = &level.layout.rects;
-    let metas = &db.meta().exemplars;
     let ntypes = db.type_names().len();
     let mut used_types = vec![0u64; ntypes];
     let mut used_exemplars = vec![0u64; rects.len()];
     for (i, s) in map.sources.iter().enumerate() {
         let (x, y) = (i % map.width, i / map.width);
-        let (Some(r), Some(m)) = (
-            rects.get(s.exemplar as usize),
-            metas.get(s.exemplar as usize),
-        ) else {
+        let Some(r) = rects.get(s.exemplar as usize) else {
             return Err(EvalError::NoSuchExemplar {
                 x,
                 y,
@@ -60,34 +56,27 @@ pub fn type_usage(map: &CoordsMap, db: &Database) -> Result<TypeUsage, EvalError
                 count: rects.len(),
             });
         };
-        if s.x as u32 >= m.width || s.y as u32 >= m.height {
+        if s.x as u32 >= r.width || s.y as u32 >= r.height {
             return Err(EvalError::OutsideExemplar {
                 x,
                 y,
                 sx: s.x,
                 sy: s.y,
                 exemplar: s.exemplar,
-                width: m.width,
-                height: m.height,
+                width: r.width,
+                height: r.height,
             });
         }
-        let t = level.types[r.index(r.x0 + m.pad + s.x as u32, m.pad + s.y as u32)];
+        let t = level.types[r.index(r.x0 + s.x as u32, s.y as u32)];
         used_types[t as usize] += 1;
         used_exemplars[s.exemplar as usize] += 1;
     }
-    // Shares of the exemplars' own texels: their pads repeat their rims.
     let mut texel_types = vec![0u64; ntypes];
-    for (r, m) in rects.iter().zip(metas) {
-        for k in r.offset..r.offset + r.texels() {
-            let (x, y) = r.coords(k);
-            if m.is_real(x - r.x0, y) {
-                texel_types[level.types[k as usize] as usize] += 1;
-            }
-        }
+    for &t in level.types {
+        texel_types[t as usize] += 1;
     }
-    let real = |m: &crate::database::ExemplarMeta| u64::from(m.width) * u64::from(m.height);
     let pixels = map.sources.len() as u64;
-    let texels = metas.iter().map(real).sum::<u64>() as f64;
+    let texels = level.types.len() as f64;
     let types = db
         .type_names()
         .iter()
@@ -102,11 +91,12 @@ pub fn type_usage(map: &CoordsMap, db: &Database) -> Result<TypeUsage, EvalError
         .meta()
         .exemplars
         .iter()
+        .zip(rects)
         .enumerate()
-        .map(|(e, m)| Share {
+        .map(|(e, (m, r))| Share {
             name: m.name.clone(),
             used: used_exemplars[e] as f64 / pixels as f64,
-            exemplars: real(m) as f64 / texels,
+            exemplars: r.texels() as f64 / texels,
         })
         .collect();
     Ok(TypeUsage {

@@ -313,7 +313,7 @@ impl SceneEdits {
                         },
                     ));
                 }
-                let r = &db.meta().exemplars[e];
+                let r = db.level(0).layout.rects[e];
                 if let Some((k, q)) = p
                     .lasso
                     .iter()

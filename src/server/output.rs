@@ -54,14 +54,16 @@ pub async fn exemplar(State(app): State<Arc<App>>, PathParam(index): PathParam) 
 
 /// An exemplar's level-0 heights, rendered like the terrain.
 fn exemplar_png(db: &Database, i: usize) -> Api<Vec<u8>> {
-    let m = &db.meta().exemplars[i];
+    let r = db.level(0).layout.rects[i];
     let q = db.quantization();
-    let data: Vec<f32> = db
-        .exemplar_heights(i)
+    let n = r.texels() as usize;
+    let start = r.offset as usize;
+    let data: Vec<f32> = db.heights()[start..start + n]
         .iter()
         .map(|&u| q.metres(u as f64) as f32)
         .collect();
-    let hf = Heightfield::from_vec(m.width as usize, m.height as usize, m.cell_size_m, data)
+    let cell = db.meta().exemplars[i].cell_size_m;
+    let hf = Heightfield::from_vec(r.width as usize, r.height as usize, cell, data)
         .map_err(|e| ApiError::Internal(e.to_string()))?;
     let style = super::view::Style::new(db);
     let view = View {

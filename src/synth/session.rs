@@ -409,7 +409,6 @@ impl Session<'_> {
     /// margin around it unweighted in this step.
     fn paste(&mut self, p: &Paste, weights0: &mut [u8]) {
         let db = self.synth.database();
-        let p = &p.in_atlas(db);
         let frames = self.frames.as_mut().expect("a frame exists before a paste");
         let delta = (p.delta_m / db.quantization().scale_m).round() as i32;
         // Source mask at level 0, then dilated upwards (any child inside).

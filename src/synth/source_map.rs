@@ -11,9 +11,7 @@ use crate::io::coords_map::{CoordsMap, NO_EXEMPLAR, Source};
 /// [`super::PassResult`] keep them). A coordinate is fixed point; its
 /// source is the **nearest** texel (half up, [`round`]): reconstruction
 /// interpolates between it and its neighbours, but the nearest texel is the
-/// one that dominates. A texel in an exemplar's mirrored pad maps to the
-/// exemplar pixel it mirrors ([`crate::database::pad`]): users see only
-/// the exemplars' own coordinates. A coordinate outside every exemplar (never made by
+/// one that dominates. A coordinate outside every exemplar (never made by
 /// synthesis; coordinates stay in exemplar interiors) maps to
 /// [`NO_EXEMPLAR`].
 pub fn source_map(
@@ -41,14 +39,10 @@ pub fn source_map(
                         y: 0,
                         exemplar: NO_EXEMPLAR,
                     },
-                    |e| {
-                        let local = tx as u32 - level.layout.rects[e].x0;
-                        let (x, y) = db.meta().exemplars[e].to_exemplar(local, ty as u32);
-                        Source {
-                            x: x as u16,
-                            y: y as u16,
-                            exemplar: e as u16,
-                        }
+                    |e| Source {
+                        x: (tx as u32 - level.layout.rects[e].x0) as u16,
+                        y: ty as u16,
+                        exemplar: e as u16,
                     },
                 );
             sources.push(src);

@@ -147,26 +147,6 @@ pub struct Controls {
 pub const PASTE_FEATHER: f64 = 16.0;
 
 impl Paste {
-    /// This paste in the atlas's coordinates: an exemplar's lasso moved by
-    /// the exemplar's pad ([`crate::database::pad`]) and the offset back by
-    /// it, so that each exemplar pixel still lands where the user asked.
-    /// A terrain paste is returned as it is.
-    pub fn in_atlas(&self, db: &crate::database::Database) -> Paste {
-        let PasteSource::Exemplar(e) = self.source else {
-            return self.clone();
-        };
-        let pad = db.meta().exemplars.get(e).map_or(0, |m| m.pad);
-        let p = f64::from(pad);
-        Paste {
-            lasso: self.lasso.iter().map(|&(x, y)| (x + p, y + p)).collect(),
-            offset: (
-                self.offset.0 - i64::from(pad),
-                self.offset.1 - i64::from(pad),
-            ),
-            ..self.clone()
-        }
-    }
-
     /// The height offset (database units; `delta` is δ in units) that the
     /// paste adds at source pixel (x, y) of level `level`: δ·w with w a
     /// smoothstep of the pixel centre's distance inside the lasso over

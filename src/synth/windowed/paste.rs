@@ -47,7 +47,6 @@ impl PasteGeometry {
     /// The geometry of `p` in a `world` (output pixels), levels 0..=last.
     /// Its masks are computed over the lasso's bounding box only.
     pub(super) fn new(p: &Paste, db: &Database, world: (usize, usize), last: usize) -> Self {
-        let p = &p.in_atlas(db);
         let src_size = |i: usize| match p.source {
             PasteSource::Terrain => level_size(world.0, world.1, i),
             PasteSource::Exemplar(e) => {
