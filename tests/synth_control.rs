@@ -360,6 +360,48 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
     }
 }
 
+/// A paste from an exemplar copies the exemplar's own pixels (lasso in its
+/// coordinates) to their targets, near the exemplar's edge too: a paste
+/// that addressed the atlas in other coordinates than the exemplar's (a
+/// pad, an offset) would land other pixels there.
+#[test]
+fn an_exemplar_paste_copies_the_exemplar_pixels() {
+    let Some(db) = db() else { return };
+    let mut s = session(db);
+    s.apply(vec![]).unwrap();
+    let e = 1;
+    let lasso = vec![(3.0, 4.0), (70.0, 3.0), (66.0, 58.0), (4.0, 62.0)];
+    let (ox, oy) = (120i64, 90i64);
+    let out = s
+        .apply(vec![Edit::Paste(Paste {
+            source: PasteSource::Exemplar(e),
+            lasso: lasso.clone(),
+            offset: (ox, oy),
+            delta_m: 0.0,
+        })])
+        .unwrap()
+        .heightfield;
+    let (q, r) = (db.quantization(), db.level(0).layout.rects[e]);
+    let mut n = 0;
+    for y in 0..r.height {
+        for x in 0..r.width {
+            let within = |dx: f64, dy: f64| {
+                terrasynth::synth::control::inside(&lasso, x as f64 + 0.5 + dx, y as f64 + 0.5 + dy)
+            };
+            if [-1.0, 0.0, 1.0]
+                .iter()
+                .all(|&dy| [-1.0, 0.0, 1.0].iter().all(|&dx| within(dx, dy)))
+            {
+                let want = q.metres(f64::from(db.heights()[r.index(r.x0 + x, y)]));
+                let got = out.get(x as usize + ox as usize, y as usize + oy as usize) as f64;
+                assert!((got - want).abs() < 0.02, "({x}, {y}): {got} vs {want}");
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 3000, "{n} pixels checked");
+}
+
 #[test]
 fn pasted_region_keeps_its_source_heights_plus_delta() {
     let Some(db) = db() else { return };
