@@ -138,9 +138,9 @@ pub trait Backend {
     /// `stages::reconstruct`), row-major.
     fn reconstruct(&self, st: &Self::State) -> Result<Vec<i32>, BackendError>;
     /// [`Backend::reconstruct`], the heights handed to `f` where they lie
-    /// rather than returned: the GPU's mapped read-back, which a copy into
-    /// a `Vec` read at a few GB/s (0.6 ms of a 5 ms 1024² synthesis on an
-    /// H100). Default: `f` of the returned heights.
+    /// rather than returned: on the GPU, the mapped read-back itself, not a
+    /// copy of it in a `Vec` (the copy cost 0.6 ms of a 5 ms 1024²
+    /// synthesis on an H100). Default: `f` of the returned heights.
     fn reconstruct_with<R>(
         &self,
         st: &Self::State,
