@@ -24,8 +24,8 @@
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 //! - **AVX2 where the CPU has it.** The span is compiled twice, for the
-//!   SSE2 baseline and for AVX2, and picked at run time (integer
-//!   arithmetic: the same bytes either way).
+//!   SSE2 baseline and for AVX2 with BMI1/BMI2/LZCNT/POPCNT, and picked at
+//!   run time (integer arithmetic: the same bytes either way).
 
 mod gather;
 mod grid;
@@ -81,8 +81,8 @@ pub fn correct_span<const P: u32>(
     };
     #[cfg(target_arch = "x86_64")]
     if crate::stages::isa::avx2() {
-        // SAFETY: the CPU supports AVX2 (`isa::avx2` checks it), the one
-        // feature the function enables.
+        // SAFETY: the CPU supports AVX2, BMI1, BMI2, LZCNT and POPCNT
+        // (`isa::avx2` checks them), the features the function enables.
         unsafe { span_avx2::<P>(&span) };
         return;
     }
@@ -101,9 +101,11 @@ struct Span<'s> {
     g: &'s Guide<'s>,
 }
 
-/// [`run_span`] compiled for AVX2.
+/// [`run_span`] compiled for AVX2 and the scalar extensions every AVX2 CPU
+/// has: BMI's flag-free shifts and `tzcnt` shorten the scalar half of the
+/// kernel (candidate listing, the closed-form offset, the prior).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 fn span_avx2<const P: u32>(span: &Span<'_>) {
     run_span::<P>(span);
 }
