@@ -1,6 +1,6 @@
 //! Stage `correct`: the scalar oracle (`correct::scalar`, the code the WGSL
-//! kernel mirrors line by line), the CPU's fast path (SIMD inside, scalar
-//! frame) and, with `--features gpu` and an adapter,
+//! kernel mirrors line by line), the CPU's fast path (SIMD, the level's
+//! border included) and, with `--features gpu` and an adapter,
 //! `kernels/correct.wgsl` give the same bytes — without control inputs on
 //! random states (proptest) and on the real levels of syntheses from the
 //! default database and from a database of ../shared/dem crops; under

@@ -55,9 +55,10 @@
 //!
 //! Two implementations produce the same bytes: [`scalar`], the readable
 //! reference that the WGSL kernel mirrors line by line and the oracle of the
-//! tests, and [`simd`], the fast path for pixels at least two texels from
-//! the level border (all but a thin frame), which addresses texels by index
-//! arithmetic instead of coordinates and scores with `wide` vectors.
+//! tests, and [`simd`], the fast path for every pixel (the level's border
+//! included: its neighbours outside the level take the scalar path's
+//! reflection), which addresses texels by index arithmetic instead of
+//! coordinates and scores with `wide` vectors.
 //!
 //! Reads never touch another pixel of the same subpass (neighbours at odd
 //! offsets, or at (±2, ±1)/(±1, ±2)), and borders reflect by 2 so parity is
@@ -302,9 +303,9 @@ pub const SEEDS_PER_ALLOWED_TYPE: u32 = 9;
 /// Hash salt of type seeding.
 pub const SEED_SALT: u32 = 0x7E5E_0000;
 
-/// Runs one subpass in place over the level: [`simd`] inside, [`scalar`]
-/// on the two-texel frame where neighbours reflect. `parent` is the level
-/// above (the height prior's anchor; none at the coarsest corrected level).
+/// Runs one subpass in place over the level by the [`simd`] path. `parent`
+/// is the level above (the height prior's anchor; none at the coarsest
+/// corrected level).
 pub fn correct(atlas: &AtlasLevel<'_>, st: &State, parent: Option<&State>, p: &CorrectParams) {
     correct_guided(atlas, st, parent, p, &Guide::NONE)
 }
@@ -340,16 +341,17 @@ fn guided<const P: u32>(
     keep_outside(st, p, g);
     let (w, h) = (st.width, st.height);
     let [wx0, wy0, wx1, wy1] = g.window.unwrap_or([0, 0, w, h]);
-    let px = p.px as usize;
     // First row/column of the class at or after a bound.
     let class_from = |start: usize, parity: usize| start + ((parity + 2 - start % 2) % 2);
-    let (y_first, x_first) = (class_from(wy0, p.py as usize), class_from(wx0, px));
+    let (y_first, x_first) = (
+        class_from(wy0, p.py as usize),
+        class_from(wx0, p.px as usize),
+    );
     let x_end = wx1.min(w);
-    // Interior span: first class pixel ≥ 2, last one < w − 2.
-    let x0 = class_from(x_first.max(2), px);
-    let x1 = x_end.min(w.saturating_sub(2));
-    let interior = |y: usize| y >= 2 && y + 2 < h && w >= 5;
     let rows = (wy1.min(h).saturating_sub(y_first)).div_ceil(2);
+    if x_first >= x_end {
+        return;
+    }
     // Blocks of consecutive class rows per task: the SIMD span walks a
     // block's rows chunk by chunk and reuses grid rows between them.
     (0..rows.div_ceil(ROWS_PER_TASK))
@@ -358,28 +360,7 @@ fn guided<const P: u32>(
             let first = b * ROWS_PER_TASK;
             let ys: [usize; ROWS_PER_TASK] = std::array::from_fn(|j| y_first + 2 * (first + j));
             let ys = &ys[..ROWS_PER_TASK.min(rows - first)];
-            for &y in ys {
-                let scalar_at = |x: usize| {
-                    let prior = Prior::at(P, parent, x, y);
-                    let (s, v) =
-                        scalar::correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
-                    st.set(y * w + x, s, v);
-                };
-                if !interior(y) {
-                    (x_first..x_end).step_by(2).for_each(scalar_at);
-                    continue;
-                }
-                (x_first..x0.min(x_end)).step_by(2).for_each(scalar_at);
-                (x0.max(x_first) + x1.saturating_sub(x0).div_ceil(2) * 2..x_end)
-                    .step_by(2)
-                    .for_each(scalar_at);
-            }
-            // The interior rows of the block are consecutive.
-            let a = ys.iter().position(|&y| interior(y)).unwrap_or(ys.len());
-            let n = ys[a..].iter().take_while(|&&y| interior(y)).count();
-            if x0 < x1 && n > 0 {
-                simd::correct_span::<P>(atlas, st, parent, &ys[a..a + n], x0, x1, g);
-            }
+            simd::correct_span::<P>(atlas, st, parent, ys, x_first, x_end, g);
         });
 }
 

@@ -10,14 +10,21 @@
 
 use std::sync::OnceLock;
 
-/// Whether the stages run their AVX2 copies: the CPU has AVX2 and
-/// `TERRASYNTH_PORTABLE_SIMD` is unset (read once per process).
+/// Whether the stages run their AVX2 copies: the CPU has AVX2 and the
+/// scalar extensions that come with it on every AVX2 CPU (BMI1, BMI2,
+/// LZCNT, POPCNT: x86-64-v3's integer set, which `correct`'s copy also
+/// compiles for), and `TERRASYNTH_PORTABLE_SIMD` is unset (read once per
+/// process).
 #[inline]
 pub fn avx2() -> bool {
     static AVX2: OnceLock<bool> = OnceLock::new();
     *AVX2.get_or_init(|| {
         #[cfg(target_arch = "x86_64")]
-        let has = std::is_x86_feature_detected!("avx2");
+        let has = std::is_x86_feature_detected!("avx2")
+            && std::is_x86_feature_detected!("bmi1")
+            && std::is_x86_feature_detected!("bmi2")
+            && std::is_x86_feature_detected!("lzcnt")
+            && std::is_x86_feature_detected!("popcnt");
         #[cfg(not(target_arch = "x86_64"))]
         let has = false;
         has && std::env::var_os("TERRASYNTH_PORTABLE_SIMD").is_none()

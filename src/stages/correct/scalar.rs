@@ -19,7 +19,7 @@ use rayon::prelude::*;
 /// Reflects a coordinate at the level border by 2 (keeps parity); the
 /// level is at least 2 wide and offsets are at most ±2.
 #[inline(always)]
-fn reflect(c: i32, n: i32) -> i32 {
+pub(super) fn reflect(c: i32, n: i32) -> i32 {
     if c < 0 {
         c + 2
     } else if c >= n {
@@ -101,11 +101,11 @@ pub fn texel_height(texel: u64) -> i32 {
 /// What a neighbour contributes: the texel its coordinate points at (as
 /// seen from where the neighbour should be), the fraction of that
 /// coordinate, and its offset V.
-struct Neighbour {
-    tx: i32,
-    ty: i32,
-    frac: (i32, i32),
-    v: i32,
+pub(super) struct Neighbour {
+    pub tx: i32,
+    pub ty: i32,
+    pub frac: (i32, i32),
+    pub v: i32,
 }
 
 /// Reads the neighbour at (x, y), which may lie outside the level.
@@ -117,7 +117,7 @@ struct Neighbour {
 /// the border instead of folding back on itself, which would make border
 /// pixels mismatch and seed offsets V that diffuse inward level after level.
 #[inline(always)]
-fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> Neighbour {
+pub(super) fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> Neighbour {
     let (w, h) = (st.width as i32, st.height as i32);
     let (rx, ry) = (reflect(x, w), reflect(y, h));
     let i = (ry * w + rx) as usize;

@@ -1,13 +1,15 @@
-//! The fast correction for pixels at least two texels inside the level,
-//! byte-identical to [`super::scalar`] (tested on real and random states).
+//! The fast correction, byte-identical to [`super::scalar`] (tested on
+//! real and random states of every size from 2×2).
 //!
 //! What makes it faster, without changing a single result:
 //! - **Index arithmetic.** Every texel the pixel reads lies within one texel
 //!   of a coordinate that is interior to its exemplar (two-texel margin), so
 //!   after one column-table lookup per neighbour, `A(S(n) − v)` and the
 //!   diagonals of a candidate are that index plus `±1 ± stride` — no
-//!   per-texel exemplar lookup, no border reflection (interior pixels never
-//!   reflect).
+//!   per-texel exemplar lookup. Neighbours outside the level (two texels
+//!   deep around it) are reflected and extrapolated by the scalar path's
+//!   rule once, when the chunk reads them; the extrapolated texel stays
+//!   one texel inside its exemplar's interior, so the arithmetic holds.
 //! - **Each neighbour read once.** A pixel reads 17 neighbours (3×3 plus
 //!   the eight at (±2, ±1), (±1, ±2)); consecutive pixels of a subpass share
 //!   half of them, so a chunk of a row reads its neighbours once into a
@@ -22,14 +24,15 @@
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 //! - **AVX2 where the CPU has it.** The span is compiled twice, for the
-//!   SSE2 baseline and for AVX2, and picked at run time (integer
-//!   arithmetic: the same bytes either way).
+//!   SSE2 baseline and for AVX2 with BMI1/BMI2/LZCNT/POPCNT, and picked at
+//!   run time (integer arithmetic: the same bytes either way).
 
 mod gather;
 mod grid;
 mod score;
 
 use super::nudge::nudge;
+use super::scalar::reflect;
 use super::{ALL_TYPES, DELTAS, Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
@@ -47,8 +50,7 @@ const RING: usize = 8;
 const _: () = assert!(RING > LOOKAHEAD && RING.is_power_of_two());
 
 /// Corrects the pixels `x0, x0 + 2, … < x1` of the class rows `ys`
-/// (consecutive: y, y + 2, …), all at least two texels inside the level,
-/// writing each result as it is found.
+/// (consecutive: y, y + 2, …), writing each result as it is found.
 ///
 /// The rows are walked one column chunk at a time, top to bottom, so that
 /// each chunk's next row reuses two of the grid rows of the one before
@@ -79,8 +81,8 @@ pub fn correct_span<const P: u32>(
     };
     #[cfg(target_arch = "x86_64")]
     if crate::stages::isa::avx2() {
-        // SAFETY: the CPU supports AVX2 (`isa::avx2` checks it), the one
-        // feature the function enables.
+        // SAFETY: the CPU supports AVX2, BMI1, BMI2, LZCNT and POPCNT
+        // (`isa::avx2` checks them), the features the function enables.
         unsafe { span_avx2::<P>(&span) };
         return;
     }
@@ -99,9 +101,11 @@ struct Span<'s> {
     g: &'s Guide<'s>,
 }
 
-/// [`run_span`] compiled for AVX2.
+/// [`run_span`] compiled for AVX2 and the scalar extensions every AVX2 CPU
+/// has: BMI's flag-free shifts and `tzcnt` shorten the scalar half of the
+/// kernel (candidate listing, the closed-form offset, the prior).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
 fn span_avx2<const P: u32>(span: &Span<'_>) {
     run_span::<P>(span);
 }
@@ -180,7 +184,10 @@ fn correct_chunk<const P: u32>(
                     let (x, y) = ((x0 + 2 * k) as i32, y as i32);
                     scalar::correct_pixel_guided(atlas, st, x, y, g, prior)
                 }
-                _ => decide::<P>(atlas, st, grid, 2 * k + 2, i, &ring[k % RING], g, prior.v),
+                _ => {
+                    let at = (x0 + 2 * k, y);
+                    decide::<P>(atlas, st, grid, 2 * k + 2, at, &ring[k % RING], g, prior.v)
+                }
             };
             st.set(i, s, v);
         }
@@ -197,11 +204,12 @@ fn decide<const P: u32>(
     st: &State,
     grid: &Grid,
     c: usize,
-    pixel: usize,
+    at: (usize, usize),
     p: &Pending,
     g: &Guide<'_>,
     vp: i32,
 ) -> (Coord, i32) {
+    let pixel = at.1 * st.width + at.0;
     let app = atlas.level.appearance;
     let ns = &neighbourhood(app, grid, c);
     // The coherence candidate first (a tie keeps the previous result), then
@@ -227,10 +235,10 @@ fn decide<const P: u32>(
                 false => (prev, v),
             };
         }
-        return finish(atlas, st, pixel, p, (cost, i, hh), g);
+        return finish(atlas, st, at, p, (cost, i, hh), g);
     }
     let winner = best_of::<P>(app, ns, p, u32::MAX, vp);
-    finish(atlas, st, pixel, p, winner, g)
+    finish(atlas, st, at, p, winner, g)
 }
 
 /// The winner's offset `v`, nudged towards the pixel's geometric target
@@ -252,7 +260,7 @@ fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>)
 fn finish(
     atlas: &AtlasLevel<'_>,
     st: &State,
-    pixel: usize,
+    (x, y): (usize, usize),
     p: &Pending,
     best: (u32, usize, i32),
     g: &Guide<'_>,
@@ -260,7 +268,11 @@ fn finish(
     debug_assert!(best.1 < p.count);
     let q = p.cands[best.1];
     let (dx, dy) = DELTAS[q.from as usize];
-    let n = st.s((pixel as isize + dy as isize * st.width as isize + dx as isize) as usize);
+    // The neighbour it came from, reflected at the level border.
+    let (w, h) = (st.width as i32, st.height as i32);
+    let (nx, ny) = (reflect(x as i32 + dx, w), reflect(y as i32 + dy, h));
+    let n = st.s((ny * w + nx) as usize);
+    let pixel = y * st.width + x;
     let frac = |v: i32| v - (round(v) << FRAC_BITS);
     let s = Coord {
         x: (q.x << FRAC_BITS) + frac(n.x),
