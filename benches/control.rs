@@ -2,7 +2,9 @@
 //! constraint re-synthesized coherently (`edit/cpu/1024/moved_point`:
 //! restricted to the region that can change, byte-identical to the full
 //! re-synthesis; `edit/cpu/1024/moved_point_full`: every pixel corrected)
-//! against a full synthesis without controls (`edit/cpu/1024/full_synthesis`).
+//! against a full synthesis without controls (`edit/cpu/1024/full_synthesis`);
+//! with `--features gpu` and an adapter, the moved point on the GPU too
+//! (`edit/gpu/1024/moved_point`).
 //! Issue 5's target: the edit in ≤ 50% of the full time; issue 18's: the
 //! moved point in ≤ 30 ms on 2 cores.
 
@@ -44,6 +46,28 @@ fn bench(c: &mut Criterion) {
                     .unwrap()
             })
         });
+    }
+    #[cfg(feature = "gpu")]
+    {
+        let mut s = Session::new(&db, Params::default(), N, N, 1).unwrap();
+        match s
+            .synthesizer_mut()
+            .use_backend(terrasynth::backend::Choice::Gpu)
+        {
+            Err(e) => eprintln!("edit/gpu: skipped, no GPU adapter ({e})"),
+            Ok(_) => {
+                s.apply(vec![point(400.0)]).unwrap();
+                s.apply(vec![point(420.0)]).unwrap();
+                let mut k = 0;
+                g.bench_function("gpu/1024/moved_point", |b| {
+                    b.iter(|| {
+                        k += 1;
+                        s.apply(vec![point(if k % 2 == 0 { 420.0 } else { 400.0 })])
+                            .unwrap()
+                    })
+                });
+            }
+        }
     }
     let synth = Synthesizer::new(&db, Params::default()).unwrap();
     g.bench_function("cpu/1024/full_synthesis", |b| {

@@ -57,10 +57,6 @@ impl Backend for Cpu<'_, '_> {
         upsample_jitter::upsample_jitter_rect(parent, child, atlas, p, rect);
     }
 
-    fn crops_windows(&self) -> bool {
-        true
-    }
-
     fn correct(&self, st: &State, parent: Option<&State>, level: usize, p: &CorrectParams) {
         correct::correct(&self.atlas[level], st, parent, p);
     }

@@ -97,14 +97,6 @@ pub trait Backend {
         let _ = rect;
         self.upsample_jitter(parent, child, level, p);
     }
-    /// Whether an edit's restricted re-synthesis should correct a level's
-    /// window on a crop of the level (`synth::restricted`) rather than on
-    /// the whole level: on the CPU the stage's writes outside the window
-    /// sweep the whole level in every subpass; a GPU does them in-kernel
-    /// and would pay a host round trip for the crop. Default: no.
-    fn crops_windows(&self) -> bool {
-        false
-    }
     /// One subpass of stage `correct` at database level `level`, in place;
     /// `parent` is the level above (the height prior's anchor), none at the
     /// coarsest corrected level.

@@ -348,7 +348,7 @@ impl<'db> Synthesizer<'db> {
                         }
                     }
                     Some(c) => {
-                        changed_parent = match window.filter(|_| self.can_crop(b, c, level)) {
+                        changed_parent = match window.filter(|_| self.can_crop(c, level)) {
                             Some(win) => {
                                 let buf = LevelBuffers {
                                     state: &state,
