@@ -29,23 +29,26 @@ fn bench(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("edit");
     g.sample_size(10);
+    // Back and forth by 20 px: every iteration moves the point.
+    let mut moves = |name: &str, mut s: Session<'_>| {
+        s.apply(vec![point(400.0)]).unwrap();
+        s.apply(vec![point(420.0)]).unwrap();
+        let mut k = 0;
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                k += 1;
+                s.apply(vec![point(if k % 2 == 0 { 420.0 } else { 400.0 })])
+                    .unwrap()
+            })
+        });
+    };
     for (name, restrict) in [
         ("cpu/1024/moved_point", true),
         ("cpu/1024/moved_point_full", false),
     ] {
         let mut s = Session::new(&db, Params::default(), N, N, 1).unwrap();
         s.restrict = restrict;
-        s.apply(vec![point(400.0)]).unwrap();
-        s.apply(vec![point(420.0)]).unwrap();
-        let mut k = 0;
-        g.bench_function(name, |b| {
-            b.iter(|| {
-                // Back and forth by 20 px: every iteration moves the point.
-                k += 1;
-                s.apply(vec![point(if k % 2 == 0 { 420.0 } else { 400.0 })])
-                    .unwrap()
-            })
-        });
+        moves(name, s);
     }
     #[cfg(feature = "gpu")]
     {
@@ -54,19 +57,8 @@ fn bench(c: &mut Criterion) {
             .synthesizer_mut()
             .use_backend(terrasynth::backend::Choice::Gpu)
         {
+            Ok(_) => moves("gpu/1024/moved_point", s),
             Err(e) => eprintln!("edit/gpu: skipped, no GPU adapter ({e})"),
-            Ok(_) => {
-                s.apply(vec![point(400.0)]).unwrap();
-                s.apply(vec![point(420.0)]).unwrap();
-                let mut k = 0;
-                g.bench_function("gpu/1024/moved_point", |b| {
-                    b.iter(|| {
-                        k += 1;
-                        s.apply(vec![point(if k % 2 == 0 { 420.0 } else { 400.0 })])
-                            .unwrap()
-                    })
-                });
-            }
         }
     }
     let synth = Synthesizer::new(&db, Params::default()).unwrap();
