@@ -1,7 +1,9 @@
-// Stage `reconstruct`: the mirror of src/synth/stages/reconstruct.rs — each
-// level-0 pixel the mean of its 3×3 neighbours' predictions
-// E⁰(round(S(n)) − Δ) + V(n), in database units with 8 fractional bits
-// (sum of at most nine predictions, then floor division by their count).
+// Stage `reconstruct`: the mirror of src/stages/reconstruct.rs — each
+// level-0 pixel the mean of its 3×3 neighbours' smooth predictions
+// μ(t(n) − Δ) + V(n) plus its own texel's detail E⁰ − μ, in database units
+// with 8 fractional bits (sum of at most nine smooth predictions shifted
+// once, floor division by their count, plus the detail shifted). Stage
+// `repair_extrema` reads what this writes.
 
 struct ReconstructParams {
     width: u32,
@@ -14,9 +16,13 @@ struct ReconstructParams {
 @group(0) @binding(1) var<storage, read> state_s: array<vec2<i32>>;
 @group(0) @binding(2) var<storage, read> state_v: array<i32>;
 @group(0) @binding(3) var<storage, read> columns: array<Column>;
+@group(0) @binding(4) var<storage, read> appearance: array<vec2<u32>>;
 // Level-0 heights, two u16 per word (little-endian, the Rust slice's bytes).
-@group(0) @binding(4) var<storage, read> heights: array<u32>;
-@group(0) @binding(5) var<storage, read_write> out: array<i32>;
+@group(0) @binding(5) var<storage, read> heights: array<u32>;
+@group(0) @binding(6) var<storage, read_write> blended: array<i32>;
+
+// appearance::MODE1_BIAS.
+const MODE1_BIAS: i32 = -32768;
 
 // AtlasLevel::index.
 fn atlas_index(x: i32, y: i32) -> u32 {
@@ -24,8 +30,13 @@ fn atlas_index(x: i32, y: i32) -> u32 {
     return u32(c.base + y * i32(c.stride) + x);
 }
 
-fn height(x: i32, y: i32) -> i32 {
-    let i = atlas_index(x, y);
+// reconstruct::smooth_height: appearance mode 1 of atlas texel i (its low 16 bits,
+// sign-extended), unbiased.
+fn smooth_height(i: u32) -> i32 {
+    return (bitcast<i32>(appearance[i].x << 16u) >> 16u) - MODE1_BIAS;
+}
+
+fn height(i: u32) -> i32 {
     return i32((heights[i >> 1u] >> ((i & 1u) * 16u)) & 0xFFFFu);
 }
 
@@ -47,10 +58,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
             let n = u32(ny) * p.width + u32(nx);
             let s = state_s[n];
-            let e = height(round_fixed(s.x) - dx, round_fixed(s.y) - dy);
-            sum += (e + state_v[n]) << 8u;
+            sum += smooth_height(atlas_index(round_fixed(s.x) - dx, round_fixed(s.y) - dy)) + state_v[n];
             count += 1;
         }
     }
-    out[gid.y * p.width + gid.x] = div_floor(sum, count);
+    let s = state_s[gid.y * p.width + gid.x];
+    let own = atlas_index(round_fixed(s.x), round_fixed(s.y));
+    blended[gid.y * p.width + gid.x] = div_floor(sum << 8u, count) + ((height(own) - smooth_height(own)) << 8u);
 }

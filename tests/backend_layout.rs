@@ -226,15 +226,19 @@ fn parameter_structs_match_their_wgsl_declarations() {
             child_height
         })
     );
-    assert_eq!(
-        wgsl_struct(&module(kernels::RECONSTRUCT), "ReconstructParams"),
-        rust_layout!(ReconstructUniform {
-            width,
-            height,
-            pad0,
-            pad1
-        })
-    );
+    for k in [kernels::RECONSTRUCT, kernels::REPAIR_EXTREMA] {
+        assert_eq!(
+            wgsl_struct(&module(k), "ReconstructParams"),
+            rust_layout!(ReconstructUniform {
+                width,
+                height,
+                pad0,
+                pad1
+            }),
+            "ReconstructParams in {}",
+            k.name
+        );
+    }
     assert_eq!(
         wgsl_struct(&module(kernels::SHADE), "ShadeParams"),
         rust_layout!(ShadeParams {
@@ -286,6 +290,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
         kernels::UPSAMPLE_JITTER,
         kernels::CORRECT,
         kernels::RECONSTRUCT,
+        kernels::REPAIR_EXTREMA,
     ] {
         assert_eq!(
             wgsl_struct(&module(k), "Column"),
@@ -369,6 +374,24 @@ fn correct_constants_match() {
             "{name} must be {v} in correct.wgsl"
         );
     }
+}
+
+#[test]
+fn reconstruct_constants_match() {
+    use terrasynth::database::appearance::MODE1_BIAS;
+    use terrasynth::stages::repair_extrema::SUPPORT;
+    assert!(
+        kernels::RECONSTRUCT
+            .source
+            .contains(&format!("const MODE1_BIAS: i32 = {MODE1_BIAS};")),
+        "MODE1_BIAS must be {MODE1_BIAS} in reconstruct.wgsl"
+    );
+    assert!(
+        kernels::REPAIR_EXTREMA
+            .source
+            .contains(&format!("const SUPPORT: u32 = {SUPPORT}u;")),
+        "SUPPORT must be {SUPPORT} in repair_extrema.wgsl"
+    );
 }
 
 #[test]

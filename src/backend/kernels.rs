@@ -42,6 +42,7 @@ macro_rules! kernel {
 pub const UPSAMPLE_JITTER: Kernel = kernel!("upsample_jitter");
 pub const CORRECT: Kernel = kernel!("correct");
 pub const RECONSTRUCT: Kernel = kernel!("reconstruct");
+pub const REPAIR_EXTREMA: Kernel = kernel!("repair_extrema");
 
 pub const REDUCE_TYPES: Kernel = kernel!("reduce_types");
 pub const REDUCE_WEIGHTS: Kernel = kernel!("reduce_weights");
@@ -55,12 +56,13 @@ pub const SHADE: Kernel = kernel!("shade");
 pub const FILL_SSD: Kernel = kernel!("fill_ssd");
 
 /// Every kernel, for tests that check them all.
-pub const ALL: [Kernel; 7] = [
+pub const ALL: [Kernel; 8] = [
     UPSAMPLE_JITTER,
     CORRECT,
     REDUCE_TYPES,
     REDUCE_WEIGHTS,
     RECONSTRUCT,
+    REPAIR_EXTREMA,
     SHADE,
     FILL_SSD,
 ];

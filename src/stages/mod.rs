@@ -13,8 +13,9 @@
 pub mod correct; // one subpass of the correction, under control inputs (paper eq. 3–9)
 pub mod fill_ssd; // round one of the patch engine's hole filling: DC-corrected SSD table
 pub mod isa; // which copy (baseline or AVX2) the run-time-dispatched stages run (not a stage)
-pub mod reconstruct; // level-0 coordinates and offsets → fixed-point heights
+pub mod reconstruct; // level-0 coordinates and offsets → blended fixed-point heights
 pub mod reduce_types; // one level's allowed type sets R^i from the finer level's
 pub mod reduce_weights; // one level's coherence weights W^i from the finer level's
+pub mod repair_extrema; // reconstruct's second half: spurious pits and peaks at patch joins
 pub mod shade; // one RGBA8 preview pixel from quantized heights (the renderer's)
 pub mod upsample_jitter; // a level's coordinates from the coarser level's, jittered

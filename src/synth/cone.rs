@@ -7,8 +7,9 @@
 //! bounded neighbourhood of the levels above it. Going down a level, a
 //! window's dependencies are, per level i (absolute level-i pixels,
 //! half-open):
-//! - **level 0**: the window widened by 1 (`reconstruct` averages 3×3
-//!   predictions);
+//! - **level 0**: the window widened by `reconstruct::REACH` = 2
+//!   (`reconstruct` blends 3×3 predictions, then repairs extrema among
+//!   3×3 blends);
 //! - **correction** (levels ≤ L): a subpass reads up to
 //!   [`REACH_PER_SUBPASS`] = 2 pixels away, so what must be right after the
 //!   level's `4 · passes` subpasses is computed over a region widened by
@@ -33,6 +34,7 @@
 //! absolute position and is computed over the top region only.
 
 use super::stages::correct::SUBPASSES;
+use super::stages::reconstruct::REACH as RECONSTRUCT_REACH;
 use super::state::{State, level_size};
 use super::window::REACH_PER_SUBPASS;
 
@@ -168,7 +170,7 @@ impl Cone {
         let mut from_below: Option<Rect> = None;
         for i in 0..=top {
             let size = level_size(world.0, world.1, i);
-            let mut need = from_below.unwrap_or_else(|| window.widen(1, size));
+            let mut need = from_below.unwrap_or_else(|| window.widen(RECONSTRUCT_REACH, size));
             if let Some(r) = needs.get(i).copied().flatten() {
                 need = need.union(r.widen(0, size));
             }

@@ -36,7 +36,7 @@ use cone::{Cone, Rect};
 use fixed::FRAC_BITS;
 use restricted::LevelBuffers;
 use stages::correct::{CorrectParams, SUBPASSES};
-use stages::reconstruct::HEIGHT_FRAC_BITS;
+use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
 use std::sync::OnceLock;
@@ -399,11 +399,11 @@ impl<'db> Synthesizer<'db> {
         // The fixed-point heights are kept only for the next frame.
         let keep = frames.is_some();
         let (heightfield, fixed) = match (window0, prev_heights) {
-            // Heights depend on their 3×3 neighbourhood's S and V, which
-            // differ from the previous frame's only inside the window.
+            // Heights depend on the S and V within `reconstruct::REACH`,
+            // which differ from the previous frame's only inside the window.
             (Some(win), Some(prev)) => {
                 let r = cone.region(0);
-                let read = widen(win, 1, r.width(), r.height());
+                let read = widen(win, reconstruct::REACH, r.width(), r.height());
                 let fixed = b.reconstruct_rect(&state, prev, read)?;
                 (self.to_metres(&fixed, cone)?, Some(fixed))
             }

@@ -19,6 +19,7 @@ pub struct Context {
     pub(super) reduce_types: wgpu::ComputePipeline,
     pub(super) reduce_weights: wgpu::ComputePipeline,
     pub(super) reconstruct: wgpu::ComputePipeline,
+    pub(super) repair_extrema: wgpu::ComputePipeline,
     pub(super) shade: wgpu::ComputePipeline,
     pub(super) fill_ssd: wgpu::ComputePipeline,
     /// Timestamp queries (two per timed dispatch), where the adapter has them.
@@ -81,6 +82,7 @@ impl Context {
         let reduce_types = pipeline(kernels::REDUCE_TYPES);
         let reduce_weights = pipeline(kernels::REDUCE_WEIGHTS);
         let reconstruct = pipeline(kernels::RECONSTRUCT);
+        let repair_extrema = pipeline(kernels::REPAIR_EXTREMA);
         let shade = pipeline(kernels::SHADE);
         let fill_ssd = pipeline(kernels::FILL_SSD);
         if let Some(e) = scope.pop().await {
@@ -105,6 +107,7 @@ impl Context {
             reduce_types,
             reduce_weights,
             reconstruct,
+            repair_extrema,
             shade,
             fill_ssd,
         }))

@@ -1,13 +1,14 @@
-//! Stage `reconstruct` on the GPU (`kernels/reconstruct.wgsl`): the final
-//! heights, read back to the host.
+//! Stages `reconstruct` and `repair_extrema` on the GPU
+//! (`kernels/reconstruct.wgsl`, `kernels/repair_extrema.wgsl`): the blended
+//! heights, then the final ones, read back to the host.
 
 use super::{Gpu, GpuState, groups};
 use crate::backend::{BackendError, Stage};
 use crate::stages::reconstruct::ReconstructUniform;
 
 impl Gpu {
-    /// Stage `reconstruct`; `f` gets the heights where the device maps
-    /// them.
+    /// Stages `reconstruct` and `repair_extrema`; `f` gets the heights
+    /// where the device maps them.
     pub(super) fn dispatch_reconstruct<R>(
         &self,
         st: &GpuState,
@@ -18,15 +19,31 @@ impl Gpu {
             height: st.height as u32,
             ..Default::default()
         };
-        let out = self
-            .ctx
-            .storage_empty("heights out", (st.width * st.height * 4) as u64)?;
+        let bytes = (st.width * st.height * 4) as u64;
+        let blended = self.ctx.storage_empty("blended heights", bytes)?;
+        let level = &self.levels[0];
+        let groups = (groups(st.width), groups(st.height));
         self.ctx.dispatch(
             Some((Stage::Reconstruct, 0)),
             &self.ctx.reconstruct,
             bytemuck::bytes_of(&u),
-            &[&st.s, &st.v, &self.levels[0].columns, &self.heights, &out],
-            (groups(st.width), groups(st.height)),
+            &[
+                &st.s,
+                &st.v,
+                &level.columns,
+                &level.appearance,
+                &self.heights,
+                &blended,
+            ],
+            groups,
+        );
+        let out = self.ctx.storage_empty("heights out", bytes)?;
+        self.ctx.dispatch(
+            Some((Stage::Reconstruct, 0)),
+            &self.ctx.repair_extrema,
+            bytemuck::bytes_of(&u),
+            &[&st.s, &st.v, &level.columns, &self.heights, &blended, &out],
+            groups,
         );
         self.ctx.read_with(&out, f)
     }
