@@ -427,7 +427,7 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
         let t = (distance_to(&lasso, x, y) / PASTE_FEATHER).min(1.0);
         (units * t * t * (3.0 - 2.0 * t)).round() * q.scale_m
     };
-    let (mut n, mut full, mut rim, mut rim_n) = (0, 0, 0.0, 0);
+    let (mut n, mut full, mut rim, mut rim_n, mut repaired) = (0, 0, 0.0, 0, 0);
     for y in 0..N {
         for x in 0..N {
             // Pixels whose 3×3 neighbourhood lies in the paste: reconstruct
@@ -449,7 +449,18 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
                 }
                 let want = base.get(x, y) as f64 + lift;
                 let got = out.get(x + ox as usize, y + oy as usize) as f64;
-                assert!((got - want).abs() < 0.02, "({x}, {y}): {got} vs {want}");
+                // Where the lift varies within the 5×5 a height depends on
+                // (the feather), a join's pit or peak may be repaired in
+                // one output and not the other (`repair_extrema`): those
+                // few pixels take a neighbour's height instead.
+                if (got - want).abs() >= 0.02 {
+                    let d = distance_to(&lasso, cx, cy);
+                    assert!(
+                        d < PASTE_FEATHER + 3.0,
+                        "({x}, {y}): {got} vs {want}, {d:.1} px in"
+                    );
+                    repaired += 1;
+                }
                 n += 1;
                 full += usize::from(distance_to(&lasso, cx, cy) > PASTE_FEATHER + 1.5);
                 if distance_to(&lasso, cx, cy) < 3.0 {
@@ -460,10 +471,18 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
         }
     }
     let rim = rim / rim_n as f64;
-    println!("paste: {full} pixels lifted by the full δ; the rim within 3 px by {rim:.1} m");
+    println!(
+        "paste: {full} pixels lifted by the full δ; the rim within 3 px by {rim:.1} m; \
+         {repaired} of {n} repaired differently"
+    );
     assert!(
         n > 2000 && full > 100,
         "{n} pixels checked, {full} at full δ"
+    );
+    // About the density of join extrema in the feather zone (2 % here).
+    assert!(
+        repaired * 20 <= n,
+        "{repaired} of {n} pixels off base + lift"
     );
     assert!(
         rim < 0.15 * delta,

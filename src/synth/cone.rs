@@ -28,7 +28,7 @@
 //!
 //! So per level the region is ≈ `window / 2^i` plus a margin that converges
 //! to ~`2 · 16` pixels (16 from the level's own correction, half the margin
-//! of the level below): a 1024² window computes a 1058² level 0 and ever
+//! of the level below): a 1024² window computes a 1060² level 0 and ever
 //! smaller levels above, whatever the world's size. The coarse start (level
 //! L's hashed blocks, or the exemplar centre) is a pure function of
 //! absolute position and is computed over the top region only.
@@ -262,10 +262,11 @@ mod tests {
     fn a_window_widens_by_its_reach_and_halves_per_level() {
         let world = (65536, 65536);
         let c = Cone::plan(world, Rect::new(30001, 40000, 1024, 1024), (5, 5, 2), &[]);
-        // Level 0: the window ± 1, then ± 16, corner made even.
+        // Level 0: the window ± 2 (reconstruct's reach), then ± 16, corner
+        // made even.
         let r = c.region(0);
-        assert_eq!((r.x0, r.x1), (30001 - 17, 30001 + 1024 + 17));
-        assert_eq!((r.y0, r.y1), (40000 - 18, 40000 + 1024 + 17));
+        assert_eq!((r.x0, r.x1), (30001 - 19, 30001 + 1024 + 18));
+        assert_eq!((r.y0, r.y1), (40000 - 18, 40000 + 1024 + 18));
         for i in 0..5 {
             let (r, above) = (c.region(i), c.region(i + 1));
             assert_eq!(r.x0 % 2, 0);
