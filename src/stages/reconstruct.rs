@@ -38,7 +38,7 @@
 //! (the block's blend plus a row above and below, then its repair), so no
 //! level-sized intermediate is needed.
 
-use super::repair_extrema::{RING, mean, repair};
+use super::repair_extrema::{mean, repair};
 use crate::database::appearance::MODE1_BIAS;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{div_floor, round};
@@ -202,7 +202,7 @@ pub fn reconstruct_rect(
             // few pixels outside that range.
             let brow = |y: usize| &blended[(y - ra) * bcols..(y - ra + 1) * bcols];
             let (mut lo, mut hi) = (vec![0i32; bcols], vec![0i32; bcols]);
-            let mut odd = vec![0u8; bcols];
+            let (mut near_lo, mut near_hi) = (vec![0i32; bcols], vec![0i32; bcols]);
             for (r, row) in block.chunks_mut(w).enumerate() {
                 let y = ys + r;
                 let mid = brow(y);
@@ -216,40 +216,35 @@ pub fn reconstruct_rect(
                     (*l, *g) = ((*a).min(*b), (*a).max(*b));
                 }
                 // Interior columns of the row, as indices into the blends;
-                // first which of them are extrema (a branch-free sweep),
-                // then those few.
+                // first the range of each one's eight neighbours (a
+                // branch-free sweep), then the few outside theirs.
                 let (ia, ib) = (x0.max(1) - ca, x1.min(w - 1) - ca);
                 if ia >= ib {
                     continue;
                 }
-                let odd = &mut odd[..ib - ia];
+                let n = ib - ia;
                 let cols = (&lo[ia - 1..], &lo[ia..], &lo[ia + 1..]);
                 let gcols = (&hi[ia - 1..], &hi[ia..], &hi[ia + 1..]);
                 let sides = (&mid[ia - 1..], &mid[ia..], &mid[ia + 1..]);
-                for (k, f) in odd.iter_mut().enumerate() {
-                    let c = sides.1[k];
-                    let l = cols.0[k]
+                for (k, (l, g)) in near_lo[..n].iter_mut().zip(&mut near_hi[..n]).enumerate() {
+                    *l = cols.0[k]
                         .min(cols.1[k])
                         .min(cols.2[k])
                         .min(sides.0[k])
                         .min(sides.2[k]);
-                    let g = gcols.0[k]
+                    *g = gcols.0[k]
                         .max(gcols.1[k])
                         .max(gcols.2[k])
                         .max(sides.0[k])
                         .max(sides.2[k]);
-                    *f = u8::from(c < l) | u8::from(c > g);
                 }
-                for i in (ia..ib).filter(|&i| odd[i - ia] != 0) {
-                    let c = mid[i];
-                    let (x, ring) = (
-                        i + ca,
-                        RING.map(|(dx, dy)| {
-                            let rows = [up, mid, down];
-                            rows[(dy + 1) as usize][(i as i32 + dx) as usize]
-                        }),
-                    );
-                    row[x - x0] = repair(heights, c, ring, tex(x, y), || {
+                for (k, &c) in sides.1[..n].iter().enumerate() {
+                    let range = (near_lo[k], near_hi[k]);
+                    if c >= range.0 && c <= range.1 {
+                        continue;
+                    }
+                    let x = ia + k + ca;
+                    row[x - x0] = repair(heights, c, range, tex(x, y), || {
                         mean(heights, |dx, dy| {
                             tex((x as i32 + dx) as usize, (y as i32 + dy) as usize)
                         })

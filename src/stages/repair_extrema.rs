@@ -29,6 +29,7 @@
 //! `kernels/repair_extrema.wgsl`; the CPU runs it fused with the blend,
 //! row block by row block (see [`super::reconstruct`]).
 
+use super::correct::DELTAS;
 use super::reconstruct::{HEIGHT_FRAC_BITS, Texel};
 use crate::level::fixed::div_floor;
 
@@ -40,43 +41,27 @@ use crate::level::fixed::div_floor;
 /// majority, keeps both within bounds.
 pub const SUPPORT: u32 = 5;
 
-/// The eight neighbours' offsets, row by row (the order the kernels read).
-pub const RING: [(i32, i32); 8] = [
-    (-1, -1),
-    (0, -1),
-    (1, -1),
-    (-1, 0),
-    (1, 0),
-    (-1, 1),
-    (0, 1),
-    (1, 1),
-];
-
 /// The repaired height of an interior pixel whose blended height is `c`
-/// and whose eight neighbours' blended heights are `ring` (in [`RING`]
-/// order); `texel` is the pixel's own (its rounded coordinate's), `mean`
-/// the plain mean of its nine neighbours' predictions ([`mean`]), asked
-/// for only when needed.
+/// and whose eight neighbours' blended heights lie in `(lo, hi)` (least,
+/// greatest); `texel` is the pixel's own (its rounded coordinate's),
+/// `mean` the plain mean of its nine neighbours' predictions ([`mean`]),
+/// asked for only when needed.
 #[inline(always)]
 pub fn repair(
     heights: &[u16],
     c: i32,
-    ring: [i32; 8],
+    (lo, hi): (i32, i32),
     texel: Texel,
     mean: impl FnOnce() -> i32,
 ) -> i32 {
-    let (mut lo, mut hi) = (i32::MAX, i32::MIN);
-    for r in ring {
-        lo = lo.min(r);
-        hi = hi.max(r);
-    }
     let pit = c < lo;
     if !pit && c <= hi {
         return c;
     }
     let e = heights[texel.k as usize];
     let mut support = 0;
-    for (dx, dy) in RING {
+    // The texel's eight neighbours: `correct`'s 3×3 offsets but (0, 0).
+    for &(dx, dy) in &DELTAS[1..] {
         let n = heights[(texel.k + dx + dy * texel.stride) as usize];
         support += if pit { n > e } else { n < e } as u32;
     }
@@ -126,9 +111,9 @@ mod tests {
     #[test]
     fn a_pixel_within_its_neighbours_range_is_kept() {
         let e = exemplar(|x, _| 10 * x as u16);
-        assert_eq!(repair(&e, 5, [4, 9, 6, 5, 7, 1, 2, 3], texel(), NO_MEAN), 5);
+        assert_eq!(repair(&e, 5, (1, 9), texel(), NO_MEAN), 5);
         assert_eq!(
-            repair(&e, 5, [5; 8], texel(), NO_MEAN),
+            repair(&e, 5, (5, 5), texel(), NO_MEAN),
             5,
             "ties are no extremum"
         );
@@ -137,10 +122,10 @@ mod tests {
     #[test]
     fn a_pit_the_exemplar_has_stays() {
         let e = exemplar(|x, y| if (x, y) == (2, 2) { 1 } else { 9 });
-        assert_eq!(repair(&e, -7, [0; 8], texel(), NO_MEAN), -7);
+        assert_eq!(repair(&e, -7, (0, 0), texel(), NO_MEAN), -7);
         let e = exemplar(|x, y| if (x, y) == (2, 2) { 9 } else { 1 });
         assert_eq!(
-            repair(&e, 7, [0; 8], texel(), NO_MEAN),
+            repair(&e, 7, (0, 0), texel(), NO_MEAN),
             7,
             "a summit stays too"
         );
@@ -151,10 +136,10 @@ mod tests {
         // A plane rising to the east: 3 of the centre's neighbours are
         // higher, 3 lower; no hollow, no summit.
         let e = exemplar(|x, _| 10 * x as u16);
-        let ring = [3, 8, 4, 6, 5, 9, 7, 2];
-        assert_eq!(repair(&e, -1, ring, texel(), NO_MEAN), 2);
+        let range = (2, 9);
+        assert_eq!(repair(&e, -1, range, texel(), NO_MEAN), 2);
         assert_eq!(
-            repair(&e, 12, ring, texel(), NO_MEAN),
+            repair(&e, 12, range, texel(), NO_MEAN),
             9,
             "a peak is lowered"
         );
@@ -173,7 +158,7 @@ mod tests {
                 1
             }
         });
-        assert_eq!(repair(&e, -1, [0; 8], texel(), || 42), 42);
+        assert_eq!(repair(&e, -1, (0, 0), texel(), || 42), 42);
         // Four higher neighbours are a slope, not a hollow.
         let e = exemplar(|x, y| {
             if y == 1 || (x, y) == (1, 2) {
@@ -184,7 +169,7 @@ mod tests {
                 1
             }
         });
-        assert_eq!(repair(&e, -1, [0; 8], texel(), NO_MEAN), 0);
+        assert_eq!(repair(&e, -1, (0, 0), texel(), NO_MEAN), 0);
     }
 
     #[test]
