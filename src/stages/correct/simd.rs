@@ -43,10 +43,10 @@ use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
-/// Three is enough to hide them: at 1024², 3 took level 0's correction
-/// from ~128 to ~125 ms against 6 (4: ~128, 10: ~137; medians of 8
-/// interleaved runs), prefetched lines being used sooner and the ring of
-/// gathered pixels halving.
+/// Three is enough to hide them. Measured at 1024² (level 0's correction,
+/// medians of 8 interleaved runs, shared N_S columns in place): 3 ~125 ms,
+/// 4 and 6 ~128, 10 ~137 (prefetched lines wait longer to be used, and
+/// the ring of gathered pixels grows).
 const LOOKAHEAD: usize = 3;
 /// Gathered pixels awaiting scoring: more than [`LOOKAHEAD`], and a power
 /// of two so that the ring index is a mask.
