@@ -5,7 +5,7 @@
 use super::super::{CLAMP, DIAGONALS, FLAT, Prior};
 use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
-use wide::{i16x8, i32x8};
+use wide::{i16x8, i32x4, i32x8};
 
 /// Two packed appearance texels as eight i16 lanes.
 #[inline(always)]
@@ -92,40 +92,63 @@ pub(super) fn score_with<const P: u32>(
 
 /// N_S (eq. 5–6) of the pixel in grid column `c`: per diagonal δ,
 /// g(p+δ, v) = A(S(p+δ+v) − v) + V(p+δ+v)·a for v ∈ {0, (δx, 0), (0, δy)}.
-/// Two diagonals per vector, three texels each; V joins mode 1.
+/// Two diagonals per vector, three texels each; V joins mode 1. Two of a
+/// diagonal's texels lie in the grid column c + δx, which the pixels on
+/// either side of it share: they come summed in `left` and `right`
+/// ([`column`] of c − 1 and c + 1); only v = (δx, 0) is read here.
 #[inline(always)]
-pub(super) fn neighbourhood(app: &[u64], grid: &Grid, c: usize) -> Neighbourhood {
+pub(super) fn neighbourhood(
+    app: &[u64],
+    grid: &Grid,
+    c: usize,
+    left: &Column,
+    right: &Column,
+) -> Neighbourhood {
     let win = window(grid, c);
+    let [up_l, down_l] = *left;
+    let [up_r, down_r] = *right;
     Neighbourhood {
-        ns01: diagonals(app, &win, 0),
-        ns23: diagonals(app, &win, 2),
+        ns01: wide::bytemuck::cast::<_, i32x8>([up_l, up_r]) + outer(app, &win, 0),
+        ns23: wide::bytemuck::cast::<_, i32x8>([down_l, down_r]) + outer(app, &win, 2),
     }
 }
 
-/// Diagonals k and k + 1 of N_S, summed, as one vector.
-#[inline(always)]
-fn diagonals(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
-    let ((t0, v0), (t1, v1)) = (diagonal(app, win, k), diagonal(app, win, k + 1));
-    let mut sum = i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0]);
-    for j in 0..3 {
-        sum += i32x8::from_i16x8(wide::bytemuck::cast([t0[j], t1[j]]));
-    }
-    sum
-}
+/// The texels of N_S that grid column j (odd) gives the diagonals of both
+/// pixels beside it, per δy (−1, then 1): A(S(p+δ)) and A(S(p+δ+(0, δy)) −
+/// (0, δy)), summed, with their V on mode 1. Consecutive pixels of a
+/// subpass are two columns apart, so each such sum serves two pixels and
+/// is formed once.
+pub(super) type Column = [i32x4; 2];
 
-/// Diagonal k of N_S: its three appearance texels and their ΣV.
+/// The [`Column`] of grid column `j`.
 #[inline(always)]
-fn diagonal(app: &[u64], win: &Window<'_>, k: usize) -> ([u64; 3], i32) {
-    let (dx, dy) = DIAGONALS[k];
-    let a = at(win, dx, dy);
-    let b = at(win, 2 * dx, dy);
-    let cc = at(win, dx, 2 * dy);
-    let texels = [
-        app[a.idx as usize],
-        app[(b.idx - dx) as usize],
-        app[(cc.idx - dy * cc.stride) as usize],
+pub(super) fn column(app: &[u64], grid: &Grid, j: usize) -> Column {
+    // Rows 1 and 0 (δy = −1), rows 3 and 4 (δy = 1); the pixel's row is 2.
+    let (a_up, c_up) = (&grid[1][j], &grid[0][j]);
+    let (a_down, c_down) = (&grid[3][j], &grid[4][j]);
+    let near = [app[a_up.idx as usize], app[a_down.idx as usize]];
+    let far = [
+        app[(c_up.idx + c_up.stride) as usize],
+        app[(c_down.idx - c_down.stride) as usize],
     ];
-    (texels, a.v + b.v + cc.v)
+    let v = i32x8::new([a_up.v + c_up.v, 0, 0, 0, a_down.v + c_down.v, 0, 0, 0]);
+    let sum = i32x8::from_i16x8(wide::bytemuck::cast(near))
+        + i32x8::from_i16x8(wide::bytemuck::cast(far))
+        + v;
+    wide::bytemuck::cast(sum)
+}
+
+/// The texels of N_S's diagonals k and k + 1 (δy alike) at v = (δx, 0),
+/// with their V on mode 1, as one vector.
+#[inline(always)]
+fn outer(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
+    let texel = |k: usize| {
+        let (dx, dy) = DIAGONALS[k];
+        let b = at(win, 2 * dx, dy);
+        (app[(b.idx - dx) as usize], b.v)
+    };
+    let ((t0, v0), (t1, v1)) = (texel(k), texel(k + 1));
+    i32x8::from_i16x8(wide::bytemuck::cast([t0, t1])) + i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0])
 }
 
 /// The best gathered candidate whose cost is below `bar`:
