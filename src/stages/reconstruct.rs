@@ -38,8 +38,8 @@
 //! (the block's blend plus a row above and below, then its repair), so no
 //! level-sized intermediate is needed.
 
+use super::correct::scalar::texel_height;
 use super::repair_extrema::{mean, repair};
-use crate::database::appearance::MODE1_BIAS;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{div_floor, round};
 use crate::level::state::State;
@@ -66,17 +66,18 @@ const ROWS: usize = 64;
 /// rounded texel t(n), its exemplar's row stride and its offset V(n).
 /// S(n) is interior (two texels from every exemplar edge), so the texel one
 /// step away is in its exemplar, at `k − dx − dy·stride`.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct Texel {
     pub k: i32,
     pub stride: i32,
     pub v: i32,
 }
 
-/// The smooth height μ of atlas texel `k`: its appearance mode 1.
+/// The smooth height μ of atlas texel `k`: its appearance mode 1, the
+/// height `correct` attributes to a texel.
 #[inline(always)]
 fn smooth_height(app: &[u64], k: i32) -> i32 {
-    app[k as usize] as i16 as i32 - MODE1_BIAS
+    texel_height(app[k as usize])
 }
 
 /// The blended height b(p) of a pixel whose neighbour at offset (dx, dy)
@@ -87,13 +88,14 @@ fn blend(app: &[u64], heights: &[u16], texel: impl Fn(i32, i32) -> Option<Texel>
     for dy in -1..=1 {
         for dx in -1..=1 {
             if let Some(t) = texel(dx, dy) {
-                sum += (smooth_height(app, t.k - dx - dy * t.stride) + t.v) << HEIGHT_FRAC_BITS;
+                sum += smooth_height(app, t.k - dx - dy * t.stride) + t.v;
                 count += 1;
             }
         }
     }
     let own = texel(0, 0).expect("the pixel itself is in the level");
-    div_floor(sum, count) + detail(app, heights, own.k)
+    // Σ (a << 8) = (Σ a) << 8, in wrapping arithmetic too: shifted once.
+    div_floor(sum << HEIGHT_FRAC_BITS, count) + detail(app, heights, own.k)
 }
 
 /// The detail `E⁰ − μ` of texel `k`, ×2^8.
@@ -176,11 +178,16 @@ pub fn reconstruct_rect(
                 // Inside the level every pixel has nine neighbours: no edge
                 // tests, and the mean divides by the constant 9.
                 let lines = [line(y - 1), line(y), line(y + 1)];
-                let (lo, hi) = (ca.max(1), cb.min(w - 1));
-                for x in (ca..lo).chain(hi.max(lo)..cb) {
+                let (inner0, inner1) = (ca.max(1), cb.min(w - 1));
+                for x in (ca..inner0).chain(inner1.max(inner0)..cb) {
                     brow[x - ca] = edge(x);
                 }
-                for (x, o) in brow.iter_mut().enumerate().take(hi - ca).skip(lo - ca) {
+                for (x, o) in brow
+                    .iter_mut()
+                    .enumerate()
+                    .take(inner1 - ca)
+                    .skip(inner0 - ca)
+                {
                     let x = x + ca;
                     let mut sum = 0i32;
                     for (l, dy) in lines.iter().zip(-1..=1i32) {
@@ -191,7 +198,6 @@ pub fn reconstruct_rect(
                             sum += smooth_height(app, t.k - dx - dy * t.stride) + t.v;
                         }
                     }
-                    // Σ (a << 8) = (Σ a) << 8 in wrapping arithmetic too.
                     *o = div_floor(sum << HEIGHT_FRAC_BITS, 9)
                         + detail(app, heights, lines[1][x - xa].k);
                 }
