@@ -7,6 +7,9 @@ use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
 use wide::{i16x8, i32x4, i32x8};
 
+#[cfg(target_arch = "x86_64")]
+pub(super) mod avx2;
+
 /// Two packed appearance texels as eight i16 lanes.
 #[inline(always)]
 fn pair(app: &[u64], a: i32, b: i32) -> i16x8 {
