@@ -18,7 +18,7 @@
 //! squares summed by `madd` (16 terms ≤ 9459² each: no i32 overflow).
 
 use super::super::super::{CLAMP, FLAT, Prior};
-use super::super::gather::Pending;
+use super::super::gather::{Candidate, Pending};
 use super::Neighbourhood;
 use core::arch::x86_64::*;
 
@@ -78,79 +78,134 @@ unsafe fn candidate_texels(app: &[u64], q: i32, s: i32) -> __m256i {
     _mm256_unpacklo_epi64(up, down)
 }
 
-/// Score (×κ) and optimal offset of the candidate at `q` (stride `s`),
-/// as the scalar `score`.
+/// A candidate's residuals before its offset is known: `d_even`, `d_odd`
+/// as [`Ns256`]'s lanes (N_S − 3·A), and its flat test.
+struct Residuals {
+    even: __m256i,
+    odd: __m256i,
+    flat: bool,
+}
+
+/// [`Residuals`] of the candidate at `q` (stride `s`).
 ///
 /// # Safety
 /// As [`candidate_texels`].
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn score<const P: u32>(
-    app: &[u64],
-    ns: &Ns256,
-    q: i32,
-    s: i32,
-    kappa: u32,
-    vp: i32,
-) -> (u32, i32) {
+unsafe fn residuals<const P: u32>(app: &[u64], ns: &Ns256, q: i32, s: i32) -> Residuals {
     // SAFETY: forwarded from the caller.
     let t = unsafe { candidate_texels(app, q, s) };
-    let d_even = _mm256_sub_epi32(ns.even, _mm256_madd_epi16(t, _mm256_set1_epi32(3)));
-    let d_odd = _mm256_sub_epi32(ns.odd, _mm256_madd_epi16(t, _mm256_set1_epi32(3 << 16)));
-    // Σ d₁: the mode-0 lanes 0, 2, 4, 6 of d_even.
-    let x = _mm_add_epi32(
-        _mm256_castsi256_si128(d_even),
-        _mm256_extracti128_si256::<1>(d_even),
-    );
-    let sum1 = _mm_cvtsi128_si32(_mm_add_epi32(x, _mm_unpackhi_epi64(x, x)));
     // Flat: the four mode-0 words (0, 4, 8, 12) equal word 0.
     let flat = P > 0 && {
         let first = _mm256_broadcastw_epi16(_mm256_castsi256_si128(t));
         let eq = _mm256_movemask_epi8(_mm256_cmpeq_epi16(t, first)) as u32;
         eq & 0x0101_0101 == 0x0101_0101
     };
-    let (prior, h) = if flat {
+    Residuals {
+        even: _mm256_sub_epi32(ns.even, _mm256_madd_epi16(t, _mm256_set1_epi32(3))),
+        odd: _mm256_sub_epi32(ns.odd, _mm256_madd_epi16(t, _mm256_set1_epi32(3 << 16))),
+        flat,
+    }
+}
+
+/// The optimal offset of a candidate with residuals `r` and Σ d₁ = `sum1`,
+/// its prior's cost, and its clamped residuals squared and summed in
+/// pairs (eight i32 lanes; their sum is the score before the prior).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
+    let (prior, h) = if r.flat {
         (FLAT, FLAT.optimal(sum1))
     } else {
         let prior = Prior { weight: P, v: vp };
         (prior, prior.optimal(sum1))
     };
     let off = _mm256_blend_epi32::<0b0101_0101>(_mm256_setzero_si256(), _mm256_set1_epi32(3 * h));
-    let r = _mm256_packs_epi32(_mm256_sub_epi32(d_even, off), d_odd);
-    let r = _mm256_min_epi16(
-        _mm256_max_epi16(r, _mm256_set1_epi16(-CLAMP as i16)),
+    let d = _mm256_packs_epi32(_mm256_sub_epi32(r.even, off), r.odd);
+    let d = _mm256_min_epi16(
+        _mm256_max_epi16(d, _mm256_set1_epi16(-CLAMP as i16)),
         _mm256_set1_epi16(CLAMP as i16),
     );
-    let sq = _mm256_madd_epi16(r, r);
-    let x = _mm_add_epi32(
-        _mm256_castsi256_si128(sq),
-        _mm256_extracti128_si256::<1>(sq),
-    );
-    let x = _mm_add_epi32(x, _mm_unpackhi_epi64(x, x));
-    let x = _mm_add_epi32(x, _mm_shuffle_epi32::<0b01>(x));
-    let sum = (_mm_cvtsi128_si32(x) as u32).wrapping_add(prior.cost(h));
-    (sum * kappa, h)
+    (h, prior.cost(h), _mm256_madd_epi16(d, d))
+}
+
+/// Scores and optimal offsets of a C₁ (κ = 1) and the C₂ (κ = 2) listed
+/// after it, as the scalar `score`. Two at a time so that their
+/// horizontal sums share shuffles.
+///
+/// # Safety
+/// As [`candidate_texels`], for both.
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn score_pair<const P: u32>(
+    app: &[u64],
+    ns: &Ns256,
+    c1: &Candidate,
+    c2: &Candidate,
+    vp: i32,
+) -> [(u32, i32); 2] {
+    // SAFETY: forwarded from the caller.
+    let (a, b) = unsafe {
+        (
+            residuals::<P>(app, ns, c1.idx, c1.stride),
+            residuals::<P>(app, ns, c2.idx, c2.stride),
+        )
+    };
+    // Σ d₁ of both: the mode-0 lanes 0, 2, 4, 6 of each `even`,
+    // interleaved (a's in even lanes, b's in odd) and summed.
+    let x = _mm256_blend_epi32::<0b1010_1010>(a.even, _mm256_slli_epi64::<32>(b.even));
+    let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+    let sums = _mm_cvtsi128_si64(_mm_add_epi32(x, _mm_unpackhi_epi64(x, x)));
+    let (ha, ca, sa) = fit::<P>(&a, sums as i32, vp);
+    let (hb, cb, sb) = fit::<P>(&b, (sums >> 32) as i32, vp);
+    // [a, a, b, b | a, a, b, b] → [a, a, b, b] → [a, b, a, b].
+    let x = _mm256_hadd_epi32(sa, sb);
+    let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+    let sums = _mm_cvtsi128_si64(_mm_hadd_epi32(x, x));
+    // The squares sum to at most 16·9459² < 2³¹; with the prior < 2³², and
+    // doubled (κ = 2) still (see `CLAMP`).
+    let s1 = (sums as u32).wrapping_add(ca);
+    let s2 = ((sums >> 32) as u32).wrapping_add(cb) << 1;
+    [(s1, ha), (s2, hb)]
 }
 
 /// [`super::best_of`]: the same candidates in the same order, the same
-/// strict `<` (ties keep the earlier).
-#[inline]
-#[target_feature(enable = "avx2")]
-pub(in super::super) fn best_of<const P: u32>(
+/// strict `<` (ties keep the earlier). Candidates come in (C₁, C₂) pairs
+/// of one u ([`super::super::gather`]).
+///
+/// Not a `#[target_feature]` function itself: those cannot be
+/// `#[inline(always)]`, and left to itself the compiler called this one
+/// once per pixel. Inlined into the span's AVX2 copy, its AVX2 helpers are
+/// inlined in turn.
+///
+/// # Safety
+/// The CPU has AVX2.
+#[inline(always)]
+pub(in super::super) unsafe fn best_of<const P: u32>(
     app: &[u64],
     ns: &Neighbourhood,
     p: &Pending,
     bar: u32,
     vp: i32,
 ) -> (u32, usize, i32) {
-    let ns = ns256(ns);
+    debug_assert!(p.count % 2 == 0);
+    debug_assert!(
+        p.cands[..p.count]
+            .iter()
+            .enumerate()
+            .all(|(i, c)| c.kappa == 1 + i as u32 % 2)
+    );
+    // SAFETY: the CPU has AVX2 (the caller's promise).
+    let ns = unsafe { ns256(ns) };
     let mut best = (bar, usize::MAX, 0i32);
-    for (i, c) in p.cands[..p.count].iter().enumerate() {
-        // SAFETY: gathered candidates are interior coordinates (see
-        // `candidate_texels`).
-        let (sc, hh) = unsafe { score::<P>(app, &ns, c.idx, c.stride, c.kappa, vp) };
-        if sc < best.0 {
-            best = (sc, i, hh);
+    for (j, pair) in p.cands[..p.count].chunks_exact(2).enumerate() {
+        // SAFETY: the CPU has AVX2, and gathered candidates are interior
+        // coordinates (see `candidate_texels`).
+        let scored = unsafe { score_pair::<P>(app, &ns, &pair[0], &pair[1], vp) };
+        for (i, (sc, hh)) in scored.into_iter().enumerate() {
+            if sc < best.0 {
+                best = (sc, 2 * j + i, hh);
+            }
         }
     }
     best
