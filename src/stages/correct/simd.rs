@@ -122,7 +122,8 @@ fn span_avx2<const P: u32>(span: &Span<'_>) {
 }
 
 /// [`correct_span`] for any instruction set; `AVX2`: compiled into
-/// [`span_avx2`], where the candidates are scored by [`score::avx2`].
+/// [`span_avx2`], where the candidates are scored by [`score::avx2`]
+/// ([`best_of`]).
 #[inline(always)]
 fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
     let Span {
@@ -244,7 +245,7 @@ fn decide<const P: u32, const AVX2: bool>(
         let free = w >= W_FREE;
         let fixed = (!free).then_some(v);
         let (sc, h_prev) = score_with::<P>(app, ns, idx, col.stride as i32, 1, fixed, vp);
-        let (cost, i, hh) = best::<P, AVX2>(app, ns, p, weigh(sc, w), vp);
+        let (cost, i, hh) = best_of::<P, AVX2>(app, ns, p, weigh(sc, w), vp);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -253,26 +254,8 @@ fn decide<const P: u32, const AVX2: bool>(
         }
         return finish(atlas, st, at, p, (cost, i, hh), g);
     }
-    let winner = best::<P, AVX2>(app, ns, p, u32::MAX, vp);
+    let winner = best_of::<P, AVX2>(app, ns, p, u32::MAX, vp);
     finish(atlas, st, at, p, winner, g)
-}
-
-/// [`best_of`], by the AVX2 scorer in the span's AVX2 copy.
-#[inline(always)]
-fn best<const P: u32, const AVX2: bool>(
-    app: &[u64],
-    ns: &Neighbourhood,
-    p: &Pending,
-    bar: u32,
-    vp: i32,
-) -> (u32, usize, i32) {
-    #[cfg(target_arch = "x86_64")]
-    if AVX2 {
-        // SAFETY: `AVX2` is set only in `span_avx2`, which runs only where
-        // the CPU has AVX2.
-        return unsafe { score::avx2::best_of::<P>(app, ns, p, bar, vp) };
-    }
-    best_of::<P>(app, ns, p, bar, vp)
 }
 
 /// The winner's offset `v`, nudged towards the pixel's geometric target

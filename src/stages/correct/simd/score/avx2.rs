@@ -18,7 +18,7 @@
 //! squares summed by `madd` (16 terms ≤ 9459² each: no i32 overflow).
 
 use super::super::super::{CLAMP, FLAT, Prior};
-use super::super::gather::{Candidate, Pending};
+use super::super::gather::Candidate;
 use super::Neighbourhood;
 use core::arch::x86_64::*;
 
@@ -27,7 +27,7 @@ use core::arch::x86_64::*;
 /// modes 1 and 3, of the diagonals (−1,−1), (−1,1) in the low half and
 /// (1,−1), (1,1) in the high half.
 #[derive(Clone, Copy)]
-pub(in super::super) struct Ns256 {
+pub(super) struct Ns256 {
     even: __m256i,
     odd: __m256i,
 }
@@ -35,7 +35,7 @@ pub(in super::super) struct Ns256 {
 /// [`Ns256`] of a pixel's [`Neighbourhood`] (once per pixel).
 #[inline]
 #[target_feature(enable = "avx2")]
-pub(in super::super) fn ns256(ns: &Neighbourhood) -> Ns256 {
+pub(super) fn ns256(ns: &Neighbourhood) -> Ns256 {
     // ns01: diagonals (−1,−1), (1,−1); ns23: (−1,1), (1,1); four modes each.
     let a: __m256i = wide::bytemuck::cast(ns.ns01);
     let b: __m256i = wide::bytemuck::cast(ns.ns23);
@@ -137,7 +137,7 @@ fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
 /// As [`candidate_texels`], for both.
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn score_pair<const P: u32>(
+pub(super) unsafe fn score_pair<const P: u32>(
     app: &[u64],
     ns: &Ns256,
     c1: &Candidate,
@@ -167,46 +167,4 @@ unsafe fn score_pair<const P: u32>(
     let s1 = (sums as u32).wrapping_add(ca);
     let s2 = ((sums >> 32) as u32).wrapping_add(cb) << 1;
     [(s1, ha), (s2, hb)]
-}
-
-/// [`super::best_of`]: the same candidates in the same order, the same
-/// strict `<` (ties keep the earlier). Candidates come in (C₁, C₂) pairs
-/// of one u ([`super::super::gather`]).
-///
-/// Not a `#[target_feature]` function itself: those cannot be
-/// `#[inline(always)]`, and left to itself the compiler called this one
-/// once per pixel. Inlined into the span's AVX2 copy, its AVX2 helpers are
-/// inlined in turn.
-///
-/// # Safety
-/// The CPU has AVX2.
-#[inline(always)]
-pub(in super::super) unsafe fn best_of<const P: u32>(
-    app: &[u64],
-    ns: &Neighbourhood,
-    p: &Pending,
-    bar: u32,
-    vp: i32,
-) -> (u32, usize, i32) {
-    debug_assert!(p.count % 2 == 0);
-    debug_assert!(
-        p.cands[..p.count]
-            .iter()
-            .enumerate()
-            .all(|(i, c)| c.kappa == 1 + i as u32 % 2)
-    );
-    // SAFETY: the CPU has AVX2 (the caller's promise).
-    let ns = unsafe { ns256(ns) };
-    let mut best = (bar, usize::MAX, 0i32);
-    for (j, pair) in p.cands[..p.count].chunks_exact(2).enumerate() {
-        // SAFETY: the CPU has AVX2, and gathered candidates are interior
-        // coordinates (see `candidate_texels`).
-        let scored = unsafe { score_pair::<P>(app, &ns, &pair[0], &pair[1], vp) };
-        for (i, (sc, hh)) in scored.into_iter().enumerate() {
-            if sc < best.0 {
-                best = (sc, 2 * j + i, hh);
-            }
-        }
-    }
-    best
 }
