@@ -28,7 +28,7 @@
 //! - **AVX2 where the CPU has it.** The span is compiled twice, for the
 //!   SSE2 baseline and for AVX2 with BMI1/BMI2/LZCNT/POPCNT, and picked at
 //!   run time (integer arithmetic: the same bytes either way). The AVX2
-//!   copy scores with [`score::avx2`] instead: a candidate's four diagonal
+//!   copy scores with `score::avx2` instead: a candidate's four diagonal
 //!   texels in one 256-bit vector, two candidates' horizontal sums shared
 //!   (~60 instructions per candidate instead of ~90; at 1024² level 0's
 //!   correction took ~2–3 % less time, the rest of it being the gathering's
