@@ -30,7 +30,7 @@
 //!   run time (integer arithmetic: the same bytes either way). The AVX2
 //!   copy scores with `score::avx2` instead: a candidate's four diagonal
 //!   texels in one 256-bit vector, two candidates' horizontal sums shared
-//!   (~50 instructions per candidate instead of ~90; at 1024² level 0's
+//!   (~60 instructions per candidate instead of ~90; at 1024² level 0's
 //!   correction took ~4 % less time: much of the rest waits on the
 //!   gathered candidates' cache misses).
 
