@@ -146,17 +146,18 @@ fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending
         from: k as u8,
         kappa: 2,
     };
-    // Scoring reads q − s ± 1 and q + s ± 1: two texels apart, on two
-    // lines of one row when they straddle a cache line (a quarter of the
-    // time). C₂ lands anywhere, so both of its lines are asked for; C₁ is
-    // near S(p), whose lines N_S reads anyway.
+    // Scoring reads q − s ± 1 and q + s ± 1, and the AVX2 scorer the
+    // 32 bytes q ± s − 1 … q ± s + 2 (one load per row): per row one or two
+    // cache lines, those of its first and last texel. C₂ lands anywhere,
+    // so both are asked for; C₁ is near S(p), whose lines N_S reads
+    // anyway.
     for q in &out.cands[count..count + 2] {
         prefetch(app, q.idx - q.stride - 1);
         prefetch(app, q.idx + q.stride - 1);
     }
     let q = &out.cands[count + 1];
-    prefetch(app, q.idx - q.stride + 1);
-    prefetch(app, q.idx + q.stride + 1);
+    prefetch(app, q.idx - q.stride + 2);
+    prefetch(app, q.idx + q.stride + 2);
     out.count = count + 2;
 }
 

@@ -7,6 +7,9 @@ use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
 use wide::{i16x8, i32x4, i32x8};
 
+#[cfg(target_arch = "x86_64")]
+pub(super) mod avx2;
+
 /// Two packed appearance texels as eight i16 lanes.
 #[inline(always)]
 fn pair(app: &[u64], a: i32, b: i32) -> i16x8 {
@@ -152,9 +155,15 @@ fn outer(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
 }
 
 /// The best gathered candidate whose cost is below `bar`:
-/// (cost, index, optimal offset), index `usize::MAX` if none is.
+/// (cost, index, optimal offset), index `usize::MAX` if none is. `AVX2`:
+/// in the span's AVX2 copy, by [`avx2`]'s scorer (the same candidates in
+/// the same order, the same strict `<`: ties keep the earlier).
+///
+/// The dispatch is a constant, not a `#[target_feature]` function: those
+/// cannot be `#[inline(always)]`, and left to itself the compiler called
+/// the AVX2 loop once per pixel instead of inlining it.
 #[inline(always)]
-pub(super) fn best_of<const P: u32>(
+pub(super) fn best_of<const P: u32, const AVX2: bool>(
     app: &[u64],
     ns: &Neighbourhood,
     p: &Pending,
@@ -162,6 +171,26 @@ pub(super) fn best_of<const P: u32>(
     vp: i32,
 ) -> (u32, usize, i32) {
     let mut best = (bar, usize::MAX, 0i32);
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // Candidates come in (C₁, C₂) pairs of one u (see `gather`).
+        debug_assert!(p.count % 2 == 0);
+        debug_assert!((0..p.count).all(|i| p.cands[i].kappa == 1 + i as u32 % 2));
+        // SAFETY: `AVX2` is set only in the span's AVX2 copy, which runs
+        // only where the CPU has AVX2.
+        let ns = unsafe { avx2::ns256(ns) };
+        for (j, pair) in p.cands[..p.count].chunks_exact(2).enumerate() {
+            // SAFETY: the CPU has AVX2 (as above), and gathered candidates
+            // are interior coordinates (see `avx2::score_pair`).
+            let scored = unsafe { avx2::score_pair::<P>(app, &ns, &pair[0], &pair[1], vp) };
+            for (i, (sc, hh)) in scored.into_iter().enumerate() {
+                if sc < best.0 {
+                    best = (sc, 2 * j + i, hh);
+                }
+            }
+        }
+        return best;
+    }
     for (i, c) in p.cands[..p.count].iter().enumerate() {
         let (sc, hh) = score::<P>(app, ns, c.idx, c.stride, c.kappa, vp);
         if sc < best.0 {

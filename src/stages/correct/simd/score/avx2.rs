@@ -1,0 +1,170 @@
+//! [`super::best_of`] in 256-bit AVX2 vectors, for the span's AVX2 copy.
+//!
+//! Why a second scorer: in `wide`'s 128-bit form a candidate took four
+//! 64-bit loads with a bounds check each, sign extensions by unpack and
+//! shift, and two narrowings — about 90 instructions per candidate, the
+//! largest share of the kernel. Here one candidate is one vector of its
+//! four diagonal texels (16 i16 lanes), built from two unaligned loads:
+//! - `_mm256_madd_epi16` against (3, 0) and (0, 3) word pairs widens and
+//!   triples modes 0/2 and 1/3 of every texel in one instruction each (the
+//!   products are exact: |3·m| < 2¹⁷), so N_S is kept in the same
+//!   even/odd-mode order ([`Ns256`]);
+//! - the texel reads need no bounds checks (see [`candidate_texels`]);
+//! - the flat test is one word compare against the broadcast first height.
+//!
+//! The arithmetic is the scalar `score`'s, step for step: the same i32
+//! residuals, the same sum Σ d₁, the same closed form and prior, clamping
+//! after the saturating narrowing (as in [`super::score_with`]), and the
+//! squares summed by `madd` (16 terms ≤ 9459² each: no i32 overflow).
+
+use super::super::super::{CLAMP, FLAT, Prior};
+use super::super::gather::Candidate;
+use super::Neighbourhood;
+use core::arch::x86_64::*;
+
+/// N_S (×3, V on mode 1) in the lane order of a candidate's
+/// [`candidate_texels`] after `madd`: `even` holds modes 0 and 2, `odd`
+/// modes 1 and 3, of the diagonals (−1,−1), (−1,1) in the low half and
+/// (1,−1), (1,1) in the high half.
+#[derive(Clone, Copy)]
+pub(super) struct Ns256 {
+    even: __m256i,
+    odd: __m256i,
+}
+
+/// [`Ns256`] of a pixel's [`Neighbourhood`] (once per pixel).
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) fn ns256(ns: &Neighbourhood) -> Ns256 {
+    // ns01: diagonals (−1,−1), (1,−1); ns23: (−1,1), (1,1); four modes each.
+    let a: __m256i = wide::bytemuck::cast(ns.ns01);
+    let b: __m256i = wide::bytemuck::cast(ns.ns23);
+    // Modes 0, 2, 1, 3 within each diagonal, then pair the diagonals.
+    let a = _mm256_shuffle_epi32::<0b11_01_10_00>(a);
+    let b = _mm256_shuffle_epi32::<0b11_01_10_00>(b);
+    Ns256 {
+        even: _mm256_unpacklo_epi64(a, b),
+        odd: _mm256_unpackhi_epi64(a, b),
+    }
+}
+
+/// The four diagonal texels of the candidate whose texel index is `q` in
+/// an exemplar of row stride `s`, as 16 i16 lanes: (−1,−1), (−1,1) in the
+/// low half, (1,−1), (1,1) in the high half.
+///
+/// # Safety
+/// `q ± s − 1 … q ± s + 2` must be indices of `app`. Every candidate is an
+/// interior coordinate of its exemplar, [`MARGIN`] = 2 texels from each
+/// edge: C₁ by `AtlasLevel::clamp_interior`, C₂ because the database
+/// checks every similarity entry when it is opened (`check_level`). So the
+/// rows above and below and the columns up to two to the right lie in the
+/// same exemplar, whose texels are all in `app`.
+///
+/// [`MARGIN`]: crate::database::layout::MARGIN
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn candidate_texels(app: &[u64], q: i32, s: i32) -> __m256i {
+    debug_assert!(q - s > 0 && ((q + s + 2) as usize) < app.len());
+    let p = app.as_ptr();
+    // SAFETY: the caller guarantees both 32-byte reads (texels q − s − 1 …
+    // q − s + 2 and q + s − 1 … q + s + 2) lie in `app`; unaligned loads.
+    let (up, down) = unsafe {
+        (
+            _mm256_loadu_si256(p.offset((q - s - 1) as isize).cast()),
+            _mm256_loadu_si256(p.offset((q + s - 1) as isize).cast()),
+        )
+    };
+    // Texels 0 and 2 of each row: columns q − 1 and q + 1.
+    _mm256_unpacklo_epi64(up, down)
+}
+
+/// A candidate's residuals before its offset is known: `d_even`, `d_odd`
+/// as [`Ns256`]'s lanes (N_S − 3·A), and its flat test.
+struct Residuals {
+    even: __m256i,
+    odd: __m256i,
+    flat: bool,
+}
+
+/// [`Residuals`] of the candidate at `q` (stride `s`).
+///
+/// # Safety
+/// As [`candidate_texels`].
+#[inline]
+#[target_feature(enable = "avx2")]
+unsafe fn residuals<const P: u32>(app: &[u64], ns: &Ns256, q: i32, s: i32) -> Residuals {
+    // SAFETY: forwarded from the caller.
+    let t = unsafe { candidate_texels(app, q, s) };
+    // Flat: the four mode-0 words (0, 4, 8, 12) equal word 0.
+    let flat = P > 0 && {
+        let first = _mm256_broadcastw_epi16(_mm256_castsi256_si128(t));
+        let eq = _mm256_movemask_epi8(_mm256_cmpeq_epi16(t, first)) as u32;
+        eq & 0x0101_0101 == 0x0101_0101
+    };
+    Residuals {
+        even: _mm256_sub_epi32(ns.even, _mm256_madd_epi16(t, _mm256_set1_epi32(3))),
+        odd: _mm256_sub_epi32(ns.odd, _mm256_madd_epi16(t, _mm256_set1_epi32(3 << 16))),
+        flat,
+    }
+}
+
+/// The optimal offset of a candidate with residuals `r` and Σ d₁ = `sum1`,
+/// its prior's cost, and its clamped residuals squared and summed in
+/// pairs (eight i32 lanes; their sum is the score before the prior).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
+    let (prior, h) = if r.flat {
+        (FLAT, FLAT.optimal(sum1))
+    } else {
+        let prior = Prior { weight: P, v: vp };
+        (prior, prior.optimal(sum1))
+    };
+    let off = _mm256_blend_epi32::<0b0101_0101>(_mm256_setzero_si256(), _mm256_set1_epi32(3 * h));
+    let d = _mm256_packs_epi32(_mm256_sub_epi32(r.even, off), r.odd);
+    let d = _mm256_min_epi16(
+        _mm256_max_epi16(d, _mm256_set1_epi16(-CLAMP as i16)),
+        _mm256_set1_epi16(CLAMP as i16),
+    );
+    (h, prior.cost(h), _mm256_madd_epi16(d, d))
+}
+
+/// Scores and optimal offsets of a C₁ (κ = 1) and the C₂ (κ = 2) listed
+/// after it, as the scalar `score`. Two at a time so that their
+/// horizontal sums share shuffles.
+///
+/// # Safety
+/// As [`candidate_texels`], for both.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn score_pair<const P: u32>(
+    app: &[u64],
+    ns: &Ns256,
+    c1: &Candidate,
+    c2: &Candidate,
+    vp: i32,
+) -> [(u32, i32); 2] {
+    // SAFETY: forwarded from the caller.
+    let (a, b) = unsafe {
+        (
+            residuals::<P>(app, ns, c1.idx, c1.stride),
+            residuals::<P>(app, ns, c2.idx, c2.stride),
+        )
+    };
+    // Σ d₁ of both: the mode-0 lanes 0, 2, 4, 6 of each `even`,
+    // interleaved (a's in even lanes, b's in odd) and summed.
+    let x = _mm256_blend_epi32::<0b1010_1010>(a.even, _mm256_slli_epi64::<32>(b.even));
+    let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+    let sums = _mm_cvtsi128_si64(_mm_add_epi32(x, _mm_unpackhi_epi64(x, x)));
+    let (ha, ca, sa) = fit::<P>(&a, sums as i32, vp);
+    let (hb, cb, sb) = fit::<P>(&b, (sums >> 32) as i32, vp);
+    // [a, a, b, b | a, a, b, b] → [a, a, b, b] → [a, b, a, b].
+    let x = _mm256_hadd_epi32(sa, sb);
+    let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+    let sums = _mm_cvtsi128_si64(_mm_hadd_epi32(x, x));
+    // The squares sum to at most 16·9459² < 2³¹; with the prior < 2³², and
+    // doubled (κ = 2) still (see `CLAMP`).
+    let s1 = (sums as u32).wrapping_add(ca);
+    let s2 = ((sums >> 32) as u32).wrapping_add(cb) << 1;
+    [(s1, ha), (s2, hb)]
+}
