@@ -35,39 +35,25 @@ pub struct State {
 
 /// `n` zeroed atomics from one zeroed allocation (`calloc`): pages fresh
 /// from the OS come zeroed, so nothing is written here, and the first
-/// stage to write a pixel (an upsampling, in parallel) pays for its page.
+/// stage to write a pixel (an upsampling, in parallel) pays for its page
+/// (a huge one: [`crate::pages`]).
 /// Zeroing them one by one was a serial pass over the level, half of
 /// `upsample_jitter`'s time at level 0.
 fn zeroed_u64(n: usize) -> Vec<AtomicU64> {
     const { assert!(align_of::<AtomicU64>() == align_of::<u64>()) };
     let mut v = std::mem::ManuallyDrop::new(vec![0u64; n]);
-    huge_pages(&v);
+    crate::pages::advise_huge(&v);
     // SAFETY: AtomicU64 has the size and bit validity of u64 and (asserted
     // above) its alignment, so the allocation, handed over whole (pointer,
     // length, capacity), is a valid Vec<AtomicU64> of zeros.
     unsafe { Vec::from_raw_parts(v.as_mut_ptr().cast(), v.len(), v.capacity()) }
 }
 
-/// Asks Linux to back the 2 MiB-aligned part of `v` with huge pages.
-fn huge_pages<T>(v: &[T]) {
-    #[cfg(target_os = "linux")]
-    {
-        const HUGE: usize = 2 << 20;
-        let a = v.as_ptr() as usize;
-        let b = a + std::mem::size_of_val(v);
-        let (a, b) = (a.next_multiple_of(HUGE), b / HUGE * HUGE);
-        if b > a {
-            // SAFETY: advice only.
-            unsafe { libc::madvise(a as *mut libc::c_void, b - a, libc::MADV_HUGEPAGE) };
-        }
-    }
-}
-
 /// [`zeroed_u64`] for the offsets.
 fn zeroed_i32(n: usize) -> Vec<AtomicI32> {
     const { assert!(align_of::<AtomicI32>() == align_of::<i32>()) };
     let mut v = std::mem::ManuallyDrop::new(vec![0i32; n]);
-    huge_pages(&v);
+    crate::pages::advise_huge(&v);
     // SAFETY: as in `zeroed_u64`, for AtomicI32 and i32.
     unsafe { Vec::from_raw_parts(v.as_mut_ptr().cast(), v.len(), v.capacity()) }
 }

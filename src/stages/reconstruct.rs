@@ -119,12 +119,15 @@ fn detail(heights: &[u16], k: i32, mu: i32) -> i32 {
 /// t(n), of the texel a row above it (`k − stride`: what n predicts for
 /// the pixel above it) and a row below it (`k + stride`: for the pixel
 /// below), and V(n). Precomputing both saves a multiply per prediction.
-#[derive(Default)]
 struct Resolved {
     up: Vec<i32>,
     k: Vec<i32>,
     down: Vec<i32>,
     v: Vec<i32>,
+    /// Whether every pixel's texel block, `up − 1 ..= down + 1`, lies in
+    /// the appearance and height arrays: S is interior, so it always
+    /// does, and the blend then reads them without bounds checks.
+    inside: bool,
 }
 
 impl Resolved {
@@ -151,6 +154,8 @@ fn resolve(
 ) {
     let app = atlas.level.appearance;
     let (s, v) = st.run(y * st.width + xa, r.k.len());
+    let len = app.len().min(heights.len()) as u64;
+    let mut inside = true;
     let out = r.up.iter_mut().zip(&mut r.k).zip(&mut r.down).zip(&mut r.v);
     for ((((up, k), down), ov), (s, v)) in out.zip(s.iter().zip(v)) {
         let c = Coord::unpack(s.load(Relaxed));
@@ -160,7 +165,12 @@ fn resolve(
         prefetch(app, t);
         prefetch(heights, t);
         (*up, *k, *down, *ov) = (t - stride, t, t + stride, v.load(Relaxed));
+        // In i64, the block's ends cannot wrap; as u64, a negative one is
+        // out of range too.
+        let (first, last) = (t as i64 - stride as i64 - 1, t as i64 + stride as i64 + 1);
+        inside &= ((first as u64) < len) & ((last as u64) < len);
     }
+    r.inside = inside;
 }
 
 /// The blends of an interior row's pixels in resolved columns `lo..`
@@ -178,30 +188,71 @@ fn blend_interior(
     lo: usize,
     out: &mut [i32],
 ) {
+    if above.inside && mid.inside && below.inside {
+        // SAFETY: every index `blend_row` reads is in one pixel's texel
+        // block `up − 1 ..= down + 1` of these rows (row y − 1 gives
+        // `down ± 1`, row y `k ± 1`, row y + 1 `up ± 1`, the height
+        // `k`), which `resolve` found inside `app` and `heights`.
+        let mu = |k: i32| texel_height(unsafe { *app.get_unchecked(k as usize) });
+        let e = |k: i32| unsafe { *heights.get_unchecked(k as usize) };
+        blend_row([above, mid, below], vcol, lo, out, mu, e);
+    } else {
+        let mu = |k: i32| smooth_height(app, k);
+        blend_row([above, mid, below], vcol, lo, out, mu, |k| {
+            heights[k as usize]
+        });
+    }
+}
+
+/// [`blend_interior`] with μ and E⁰ of a texel read by `mu` and `e`.
+#[inline(always)]
+fn blend_row(
+    [above, mid, below]: [&Resolved; 3],
+    vcol: &[i32],
+    lo: usize,
+    out: &mut [i32],
+    mu: impl Fn(i32) -> i32,
+    e: impl Fn(i32) -> u16,
+) {
     // The row above predicts from the texels below its own (`down`), the
     // row below from those above (`up`); the neighbours at dx = ±1 from
-    // one texel back across (−dx).
+    // one texel back across (−dx). Windows of three columns centred on
+    // column i start at i − 1.
     let (a, b, c) = (&above.down, &mid.k, &below.up);
-    let mu = |k: i32| smooth_height(app, k);
-    for (i, o) in (lo..).zip(out) {
-        let own = mu(b[i]);
-        let middle = mu(b[i - 1] + 1) + own + mu(b[i + 1] - 1);
-        let v = vcol[i - 1] + vcol[i] + vcol[i + 1];
-        let sum = mu(a[i - 1] + 1)
-            + mu(a[i])
-            + mu(a[i + 1] - 1)
-            + middle
-            + mu(c[i - 1] + 1)
-            + mu(c[i])
-            + mu(c[i + 1] - 1)
-            + v;
-        *o = div_floor(sum << HEIGHT_FRAC_BITS, 9) + detail(heights, b[i], own);
+    // Each column's indices and V sum are read once and kept for the
+    // next two pixels (as their centre and left neighbour).
+    let (hi, at) = (lo + out.len(), |r: &[i32], i| (r[i - 1], r[i]));
+    let ((mut a0, mut a1), (mut b0, mut b1), (mut c0, mut c1)) = (at(a, lo), at(b, lo), at(c, lo));
+    let (mut v0, mut v1) = at(vcol, lo);
+    let next = a[lo + 1..=hi]
+        .iter()
+        .zip(&b[lo + 1..=hi])
+        .zip(&c[lo + 1..=hi])
+        .zip(&vcol[lo + 1..=hi]);
+    for ((((&a2, &b2), &c2), &v2), o) in next.zip(out) {
+        let own = mu(b1);
+        let sum = mu(a0 + 1)
+            + mu(a1)
+            + mu(a2 - 1)
+            + mu(b0 + 1)
+            + own
+            + mu(b2 - 1)
+            + mu(c0 + 1)
+            + mu(c1)
+            + mu(c2 - 1)
+            + v0
+            + v1
+            + v2;
+        let detail = (e(b1) as i32 - own) << HEIGHT_FRAC_BITS;
+        *o = div_floor(sum << HEIGHT_FRAC_BITS, 9) + detail;
+        (a0, a1, b0, b1, c0, c1, v0, v1) = (a1, a2, b1, b2, c1, c2, v1, v2);
     }
 }
 
 /// Heights of level 0, row-major, in units × 2^8.
 pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
     let mut out = vec![0i32; st.width * st.height];
+    crate::pages::advise_huge(&out);
     reconstruct_rect(atlas, heights, st, &mut out, [0, 0, st.width, st.height]);
     out
 }
@@ -279,6 +330,7 @@ fn reconstruct_block(
                 k: row(),
                 down: row(),
                 v: row(),
+                inside: false,
             }
         })
         .collect();
