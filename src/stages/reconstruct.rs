@@ -154,7 +154,8 @@ fn resolve(
 ) {
     let app = atlas.level.appearance;
     let (s, v) = st.run(y * st.width + xa, r.k.len());
-    let len = app.len().min(heights.len()) as u64;
+    // Indices the blend forms in i32 must not wrap there either.
+    let len = app.len().min(heights.len()).min(1 << 31) as u64;
     let mut inside = true;
     let out = r.up.iter_mut().zip(&mut r.k).zip(&mut r.down).zip(&mut r.v);
     for ((((up, k), down), ov), (s, v)) in out.zip(s.iter().zip(v)) {
@@ -166,9 +167,9 @@ fn resolve(
         prefetch(heights, t);
         (*up, *k, *down, *ov) = (t - stride, t, t + stride, v.load(Relaxed));
         // In i64, the block's ends cannot wrap; as u64, a negative one is
-        // out of range too.
+        // out of range too. With stride ≥ 0 the block holds `k ± 1`.
         let (first, last) = (t as i64 - stride as i64 - 1, t as i64 + stride as i64 + 1);
-        inside &= ((first as u64) < len) & ((last as u64) < len);
+        inside &= (stride >= 0) & ((first as u64) < len) & ((last as u64) < len);
     }
     r.inside = inside;
 }
@@ -192,7 +193,8 @@ fn blend_interior(
         // SAFETY: every index `blend_row` reads is in one pixel's texel
         // block `up − 1 ..= down + 1` of these rows (row y − 1 gives
         // `down ± 1`, row y `k ± 1`, row y + 1 `up ± 1`, the height
-        // `k`), which `resolve` found inside `app` and `heights`.
+        // `k`), which `resolve` found inside `app` and `heights` (and
+        // below 2^31, so the i32 index arithmetic did not wrap).
         let mu = |k: i32| texel_height(unsafe { *app.get_unchecked(k as usize) });
         let e = |k: i32| unsafe { *heights.get_unchecked(k as usize) };
         blend_row([above, mid, below], vcol, lo, out, mu, e);
