@@ -34,9 +34,11 @@
 //!
 //! On the GPU the blend (`kernels/reconstruct.wgsl`) and the repair
 //! (`kernels/repair_extrema.wgsl`) are two dispatches with the blended
-//! heights between them; here they run fused, one block of rows at a time
-//! (the block's blend plus a row above and below, then its repair), so no
-//! level-sized intermediate is needed.
+//! heights between them; here they run fused, each parallel task streaming
+//! through a block of rows (resolving a row's texels a few rows ahead of
+//! its blend, repairing a row as soon as the blends below it are known),
+//! so no level-sized intermediate is needed and the rows in flight stay
+//! in cache.
 
 use super::correct::scalar::texel_height;
 use super::isa::prefetch;
@@ -57,15 +59,17 @@ pub const REACH: usize = 2;
 
 /// Rows per parallel task. A task streams through its rows and the two
 /// around them on each side (the halo, which the neighbouring tasks
-/// resolve too): 64 rows cost 1/16 more blends than the level has.
+/// resolve too): at 64 rows, 1/32 more blends and 1/16 more resolved
+/// rows than the level has.
 const ROWS: usize = 64;
 
 /// How many rows ahead of the row being blended a task resolves the
 /// texels of its pixels, and asks the cache for their appearance and
 /// height. The level's texels are scattered over an atlas larger than
-/// the L2 cache, one run per patch; blending without the hint waited on
-/// those misses one after the other (12 ms of 1024² on 2 cores, ~3 less
-/// with it; 2 and 3 rows ahead measured alike, 1 and 6 slower).
+/// the L2 cache, one run per patch; blending without the hint waits on
+/// those misses one after the other (the stage at 1024² on 2 cores took
+/// ~19 ms without it, ~14 with it, on a loaded machine; 2 and 3 rows
+/// ahead measured alike, 1 and 6 slower).
 const AHEAD: usize = 3;
 
 /// Resolved rows a task keeps: the three a blend reads and the `AHEAD`
@@ -179,7 +183,10 @@ fn resolve(
 /// `out`: `above`, `mid` and `below` are the resolved rows y − 1, y and
 /// y + 1, `vcol[i]` the sum of the three rows' V in column i. Inside the
 /// level every pixel has nine neighbours: no edge tests, and the mean
-/// divides by the constant 9.
+/// divides by the constant 9. Where `resolve` proved the rows' texels
+/// inside the arrays (always, for a valid state) they are read without
+/// bounds checks (together with index rows read as slices checked once
+/// per row, ~70 fewer instructions per pixel: cachegrind, 512²).
 #[inline(always)]
 fn blend_interior(
     app: &[u64],
@@ -218,11 +225,11 @@ fn blend_row(
 ) {
     // The row above predicts from the texels below its own (`down`), the
     // row below from those above (`up`); the neighbours at dx = ±1 from
-    // one texel back across (−dx). Windows of three columns centred on
-    // column i start at i − 1.
+    // one texel back across (−dx).
     let (a, b, c) = (&above.down, &mid.k, &below.up);
     // Each column's indices and V sum are read once and kept for the
-    // next two pixels (as their centre and left neighbour).
+    // next two pixels (as their centre and left neighbour): 3 loads of
+    // indices per pixel, not 9.
     let (hi, at) = (lo + out.len(), |r: &[i32], i| (r[i - 1], r[i]));
     let ((mut a0, mut a1), (mut b0, mut b1), (mut c0, mut c1)) = (at(a, lo), at(b, lo), at(c, lo));
     let (mut v0, mut v1) = at(vcol, lo);
