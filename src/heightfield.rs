@@ -39,11 +39,13 @@ impl Heightfield {
     pub fn new(width: usize, height: usize, cell_size: f64) -> Result<Self, SizeError> {
         check_dims(width, height)?;
         check_cell_size(cell_size)?;
+        let data = vec![0.0; width * height];
+        crate::pages::advise_huge(&data);
         Ok(Self {
             width,
             height,
             cell_size,
-            data: vec![0.0; width * height],
+            data,
             georef: None,
         })
     }

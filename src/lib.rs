@@ -21,6 +21,7 @@ pub mod level;
 pub mod masks;
 pub mod nodata;
 pub mod order;
+pub mod pages;
 pub mod patch;
 pub mod poisson;
 pub mod procedural;

@@ -35,12 +35,14 @@ pub struct State {
 
 /// `n` zeroed atomics from one zeroed allocation (`calloc`): pages fresh
 /// from the OS come zeroed, so nothing is written here, and the first
-/// stage to write a pixel (an upsampling, in parallel) pays for its page.
+/// stage to write a pixel (an upsampling, in parallel) pays for its page
+/// (a huge one: [`crate::pages`]).
 /// Zeroing them one by one was a serial pass over the level, half of
 /// `upsample_jitter`'s time at level 0.
 fn zeroed_u64(n: usize) -> Vec<AtomicU64> {
     const { assert!(align_of::<AtomicU64>() == align_of::<u64>()) };
     let mut v = std::mem::ManuallyDrop::new(vec![0u64; n]);
+    crate::pages::advise_huge(&v);
     // SAFETY: AtomicU64 has the size and bit validity of u64 and (asserted
     // above) its alignment, so the allocation, handed over whole (pointer,
     // length, capacity), is a valid Vec<AtomicU64> of zeros.
@@ -51,6 +53,7 @@ fn zeroed_u64(n: usize) -> Vec<AtomicU64> {
 fn zeroed_i32(n: usize) -> Vec<AtomicI32> {
     const { assert!(align_of::<AtomicI32>() == align_of::<i32>()) };
     let mut v = std::mem::ManuallyDrop::new(vec![0i32; n]);
+    crate::pages::advise_huge(&v);
     // SAFETY: as in `zeroed_u64`, for AtomicI32 and i32.
     unsafe { Vec::from_raw_parts(v.as_mut_ptr().cast(), v.len(), v.capacity()) }
 }

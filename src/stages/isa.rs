@@ -30,3 +30,20 @@ pub fn avx2() -> bool {
         has && std::env::var_os("TERRASYNTH_PORTABLE_SIMD").is_none()
     })
 }
+
+/// Asks the cache for the line holding `table[i]` (a hint: no effect on
+/// results). The address is only formed, never read, so it needs no bounds
+/// check: prefetching cannot fault.
+#[inline(always)]
+pub fn prefetch<T>(table: &[T], i: i32) {
+    let t = table.as_ptr().wrapping_offset(i as isize);
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: `prefetch` only hints the cache; it cannot fault or change
+    // memory, and SSE is part of the x86_64 baseline.
+    unsafe {
+        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(t.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = t;
+}

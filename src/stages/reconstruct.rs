@@ -34,17 +34,21 @@
 //!
 //! On the GPU the blend (`kernels/reconstruct.wgsl`) and the repair
 //! (`kernels/repair_extrema.wgsl`) are two dispatches with the blended
-//! heights between them; here they run fused, one block of rows at a time
-//! (the block's blend plus a row above and below, then its repair), so no
-//! level-sized intermediate is needed.
+//! heights between them; here they run fused, each parallel task streaming
+//! through a block of rows (resolving a row's texels a few rows ahead of
+//! its blend, repairing a row as soon as the blends below it are known),
+//! so no level-sized intermediate is needed and the rows in flight stay
+//! in cache.
 
 use super::correct::scalar::texel_height;
+use super::isa::prefetch;
 use super::repair_extrema::{mean, repair};
 use crate::level::atlas::AtlasLevel;
-use crate::level::fixed::{div_floor, round};
+use crate::level::fixed::{Coord, div_floor, round};
 use crate::level::state::State;
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
+use std::sync::atomic::Ordering::Relaxed;
 
 /// Fractional bits of reconstructed heights.
 pub const HEIGHT_FRAC_BITS: u32 = 8;
@@ -53,14 +57,24 @@ pub const HEIGHT_FRAC_BITS: u32 = 8;
 /// reads the 3×3 around it, the repair the blends of the 3×3 around it.
 pub const REACH: usize = 2;
 
-/// Rows per parallel task: each task first resolves the texel index, row
-/// stride and offset of its rows and the two around them on each side, so
-/// the predictions of a pixel cost one load each, not a coordinate decode
-/// and a column lookup, and blends its rows and one more on each side.
-/// Those halo rows are the overhead: 64 rows (1/16 more blends) rather
-/// than 16 (1/8) took the stage from ~15 to ~13 ms at 1024² on 2 cores,
-/// together with the branch-free extrema sweep.
+/// Rows per parallel task. A task streams through its rows and the two
+/// around them on each side (the halo, which the neighbouring tasks
+/// resolve too): at 64 rows, 1/32 more blends and 1/16 more resolved
+/// rows than the level has.
 const ROWS: usize = 64;
+
+/// How many rows ahead of the row being blended a task resolves the
+/// texels of its pixels, and asks the cache for their appearance and
+/// height. The level's texels are scattered over an atlas larger than
+/// the L2 cache, one run per patch; blending without the hint waits on
+/// those misses one after the other (the stage at 1024² on 2 cores took
+/// ~19 ms without it, ~14 with it, on a loaded machine; 2 and 3 rows
+/// ahead measured alike, 1 and 6 slower).
+const AHEAD: usize = 3;
+
+/// Resolved rows a task keeps: the three a blend reads and the `AHEAD`
+/// ones being prefetched fit (a power of two: the slot is `y % RING`).
+const RING: usize = 8;
 
 /// What a pixel gives its neighbours' predictions: the atlas index of its
 /// rounded texel t(n), its exemplar's row stride and its offset V(n).
@@ -95,18 +109,159 @@ fn blend(app: &[u64], heights: &[u16], texel: impl Fn(i32, i32) -> Option<Texel>
     }
     let own = texel(0, 0).expect("the pixel itself is in the level");
     // Σ (a << 8) = (Σ a) << 8, in wrapping arithmetic too: shifted once.
-    div_floor(sum << HEIGHT_FRAC_BITS, count) + detail(app, heights, own.k)
+    div_floor(sum << HEIGHT_FRAC_BITS, count) + detail(heights, own.k, smooth_height(app, own.k))
 }
 
-/// The detail `E⁰ − μ` of texel `k`, ×2^8.
+/// The detail `E⁰ − μ` of texel `k` (whose μ is `mu`), ×2^8.
 #[inline(always)]
-fn detail(app: &[u64], heights: &[u16], k: i32) -> i32 {
-    (heights[k as usize] as i32 - smooth_height(app, k)) << HEIGHT_FRAC_BITS
+fn detail(heights: &[u16], k: i32, mu: i32) -> i32 {
+    (heights[k as usize] as i32 - mu) << HEIGHT_FRAC_BITS
+}
+
+/// One level row's pixels as their neighbours' predictions read them
+/// (columns `xa..xb` of the rect): the atlas index of each pixel's texel
+/// t(n), of the texel a row above it (`k − stride`: what n predicts for
+/// the pixel above it) and a row below it (`k + stride`: for the pixel
+/// below), and V(n). Precomputing both saves a multiply per prediction.
+struct Resolved {
+    up: Vec<i32>,
+    k: Vec<i32>,
+    down: Vec<i32>,
+    v: Vec<i32>,
+    /// Whether every pixel's texel block, `up − 1 ..= down + 1`, lies in
+    /// the appearance and height arrays: S is interior, so it always
+    /// does, and the blend then reads them without bounds checks.
+    inside: bool,
+}
+
+impl Resolved {
+    /// The [`Texel`] of the pixel in column `i` (from `xa`).
+    #[inline(always)]
+    fn texel(&self, i: usize) -> Texel {
+        Texel {
+            k: self.k[i],
+            stride: self.down[i] - self.k[i],
+            v: self.v[i],
+        }
+    }
+}
+
+/// Resolves level row `y`, columns `xa..xa + r.k.len()`, into `r`, and
+/// prefetches each pixel's appearance and height.
+fn resolve(
+    atlas: &AtlasLevel<'_>,
+    heights: &[u16],
+    st: &State,
+    y: usize,
+    xa: usize,
+    r: &mut Resolved,
+) {
+    let app = atlas.level.appearance;
+    let (s, v) = st.run(y * st.width + xa, r.k.len());
+    // Indices the blend forms in i32 must not wrap there either.
+    let len = app.len().min(heights.len()).min(1 << 31) as u64;
+    let mut inside = true;
+    let out = r.up.iter_mut().zip(&mut r.k).zip(&mut r.down).zip(&mut r.v);
+    for ((((up, k), down), ov), (s, v)) in out.zip(s.iter().zip(v)) {
+        let c = Coord::unpack(s.load(Relaxed));
+        let (tx, ty) = (round(c.x), round(c.y));
+        let stride = atlas.columns[tx as usize].stride as i32;
+        let t = atlas.index(tx, ty) as i32;
+        prefetch(app, t);
+        prefetch(heights, t);
+        (*up, *k, *down, *ov) = (t - stride, t, t + stride, v.load(Relaxed));
+        // In i64, the block's ends cannot wrap; as u64, a negative one is
+        // out of range too. With stride ≥ 0 the block holds `k ± 1`.
+        let (first, last) = (t as i64 - stride as i64 - 1, t as i64 + stride as i64 + 1);
+        inside &= (stride >= 0) & ((first as u64) < len) & ((last as u64) < len);
+    }
+    r.inside = inside;
+}
+
+/// The blends of an interior row's pixels in resolved columns `lo..`
+/// (at least 1 from each end of the resolved rows), one per element of
+/// `out`: `above`, `mid` and `below` are the resolved rows y − 1, y and
+/// y + 1, `vcol[i]` the sum of the three rows' V in column i. Inside the
+/// level every pixel has nine neighbours: no edge tests, and the mean
+/// divides by the constant 9. Where `resolve` proved the rows' texels
+/// inside the arrays (always, for a valid state) they are read without
+/// bounds checks (together with index rows read as slices checked once
+/// per row, ~70 fewer instructions per pixel: cachegrind, 512²).
+#[inline(always)]
+fn blend_interior(
+    app: &[u64],
+    heights: &[u16],
+    [above, mid, below]: [&Resolved; 3],
+    vcol: &[i32],
+    lo: usize,
+    out: &mut [i32],
+) {
+    if above.inside && mid.inside && below.inside {
+        // SAFETY: every index `blend_row` reads is in one pixel's texel
+        // block `up − 1 ..= down + 1` of these rows (row y − 1 gives
+        // `down ± 1`, row y `k ± 1`, row y + 1 `up ± 1`, the height
+        // `k`), which `resolve` found inside `app` and `heights` (and
+        // below 2^31, so the i32 index arithmetic did not wrap).
+        let mu = |k: i32| texel_height(unsafe { *app.get_unchecked(k as usize) });
+        let e = |k: i32| unsafe { *heights.get_unchecked(k as usize) };
+        blend_row([above, mid, below], vcol, lo, out, mu, e);
+    } else {
+        let mu = |k: i32| smooth_height(app, k);
+        blend_row([above, mid, below], vcol, lo, out, mu, |k| {
+            heights[k as usize]
+        });
+    }
+}
+
+/// [`blend_interior`] with μ and E⁰ of a texel read by `mu` and `e`.
+#[inline(always)]
+fn blend_row(
+    [above, mid, below]: [&Resolved; 3],
+    vcol: &[i32],
+    lo: usize,
+    out: &mut [i32],
+    mu: impl Fn(i32) -> i32,
+    e: impl Fn(i32) -> u16,
+) {
+    // The row above predicts from the texels below its own (`down`), the
+    // row below from those above (`up`); the neighbours at dx = ±1 from
+    // one texel back across (−dx).
+    let (a, b, c) = (&above.down, &mid.k, &below.up);
+    // Each column's indices and V sum are read once and kept for the
+    // next two pixels (as their centre and left neighbour): 3 loads of
+    // indices per pixel, not 9.
+    let (hi, at) = (lo + out.len(), |r: &[i32], i| (r[i - 1], r[i]));
+    let ((mut a0, mut a1), (mut b0, mut b1), (mut c0, mut c1)) = (at(a, lo), at(b, lo), at(c, lo));
+    let (mut v0, mut v1) = at(vcol, lo);
+    let next = a[lo + 1..=hi]
+        .iter()
+        .zip(&b[lo + 1..=hi])
+        .zip(&c[lo + 1..=hi])
+        .zip(&vcol[lo + 1..=hi]);
+    for ((((&a2, &b2), &c2), &v2), o) in next.zip(out) {
+        let own = mu(b1);
+        let sum = mu(a0 + 1)
+            + mu(a1)
+            + mu(a2 - 1)
+            + mu(b0 + 1)
+            + own
+            + mu(b2 - 1)
+            + mu(c0 + 1)
+            + mu(c1)
+            + mu(c2 - 1)
+            + v0
+            + v1
+            + v2;
+        let detail = (e(b1) as i32 - own) << HEIGHT_FRAC_BITS;
+        *o = div_floor(sum << HEIGHT_FRAC_BITS, 9) + detail;
+        (a0, a1, b0, b1, c0, c1, v0, v1) = (a1, a2, b1, b2, c1, c2, v1, v2);
+    }
 }
 
 /// Heights of level 0, row-major, in units × 2^8.
 pub fn reconstruct(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
     let mut out = vec![0i32; st.width * st.height];
+    crate::pages::advise_huge(&out);
     reconstruct_rect(atlas, heights, st, &mut out, [0, 0, st.width, st.height]);
     out
 }
@@ -130,134 +285,208 @@ pub fn reconstruct_rect(
     if x0 >= x1 || y0 >= y1 {
         return;
     }
-    let app = atlas.level.appearance;
-    // Columns whose blends the repair reads, and whose S and V they read.
-    let (ca, cb) = (x0.saturating_sub(1), (x1 + 1).min(w));
-    let (xa, xb) = (x0.saturating_sub(2), (x1 + 2).min(w));
+    let cols = Cols {
+        x0,
+        x1,
+        ca: x0.saturating_sub(1),
+        cb: (x1 + 1).min(w),
+        xa: x0.saturating_sub(2),
+        xb: (x1 + 2).min(w),
+    };
     out[y0 * w..y1 * w]
         .par_chunks_mut(w * ROWS)
         .enumerate()
         .for_each(|(b, block)| {
             let ys = y0 + b * ROWS;
-            let ye = ys + block.len() / w;
-            let (ra, rb) = (ys.saturating_sub(1), (ye + 1).min(h));
-            let (ya, yb) = (ys.saturating_sub(2), (ye + 2).min(h));
-            // Rows ya..yb, columns xa..xb: each pixel's texel and offset.
-            let cols = xb - xa;
-            let mut base: Vec<Texel> = Vec::with_capacity((yb - ya) * cols);
-            for y in ya..yb {
-                base.extend((y * w + xa..y * w + xb).map(|n| {
-                    let s = st.s(n);
-                    let (tx, ty) = (round(s.x), round(s.y));
-                    Texel {
-                        k: atlas.index(tx, ty) as i32,
-                        stride: atlas.columns[tx as usize].stride as i32,
-                        v: st.v(n),
-                    }
-                }));
-            }
-            let tex = |x: usize, y: usize| base[(y - ya) * cols + x - xa];
-            let line = |y: usize| &base[(y - ya) * cols..(y - ya + 1) * cols];
-            // Rows ra..rb, columns ca..cb: the blended heights.
-            let bcols = cb - ca;
-            let mut blended = vec![0i32; (rb - ra) * bcols];
-            for (y, brow) in (ra..rb).zip(blended.chunks_mut(bcols)) {
-                let edge = |x: usize| {
-                    blend(app, heights, |dx, dy| {
-                        let (nx, ny) = (x as i32 + dx, y as i32 + dy);
-                        let ok = nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32;
-                        ok.then(|| tex(nx as usize, ny as usize))
-                    })
-                };
-                if y == 0 || y + 1 == h || w < 3 {
-                    for (x, o) in (ca..cb).zip(brow.iter_mut()) {
-                        *o = edge(x);
-                    }
-                    continue;
-                }
-                // Inside the level every pixel has nine neighbours: no edge
-                // tests, and the mean divides by the constant 9.
-                let lines = [line(y - 1), line(y), line(y + 1)];
-                let (inner0, inner1) = (ca.max(1), cb.min(w - 1));
-                for x in (ca..inner0).chain(inner1.max(inner0)..cb) {
-                    brow[x - ca] = edge(x);
-                }
-                for (x, o) in brow
-                    .iter_mut()
-                    .enumerate()
-                    .take(inner1 - ca)
-                    .skip(inner0 - ca)
-                {
-                    let x = x + ca;
-                    let mut sum = 0i32;
-                    for (l, dy) in lines.iter().zip(-1..=1i32) {
-                        let n: &[Texel; 3] = l[x - 1 - xa..x + 2 - xa]
-                            .try_into()
-                            .expect("three neighbours");
-                        for (t, dx) in n.iter().zip(-1..=1i32) {
-                            sum += smooth_height(app, t.k - dx - dy * t.stride) + t.v;
-                        }
-                    }
-                    *o = div_floor(sum << HEIGHT_FRAC_BITS, 9)
-                        + detail(app, heights, lines[1][x - xa].k);
-                }
-            }
-            // Per row, the least and greatest of each pixel's eight
-            // neighbours' blends (a vectorisable sweep: column extremes of
-            // the rows above and below, then across), and the repair of the
-            // few pixels outside that range.
-            let brow = |y: usize| &blended[(y - ra) * bcols..(y - ra + 1) * bcols];
-            let (mut lo, mut hi) = (vec![0i32; bcols], vec![0i32; bcols]);
-            let (mut near_lo, mut near_hi) = (vec![0i32; bcols], vec![0i32; bcols]);
-            for (r, row) in block.chunks_mut(w).enumerate() {
-                let y = ys + r;
-                let mid = brow(y);
-                let row = &mut row[x0..x1];
-                row.copy_from_slice(&mid[x0 - ca..x1 - ca]);
-                if y == 0 || y + 1 == h || w < 3 {
-                    continue;
-                }
-                let (up, down) = (brow(y - 1), brow(y + 1));
-                for (((l, g), a), b) in lo.iter_mut().zip(hi.iter_mut()).zip(up).zip(down) {
-                    (*l, *g) = ((*a).min(*b), (*a).max(*b));
-                }
-                // Interior columns of the row, as indices into the blends;
-                // first the range of each one's eight neighbours (a
-                // branch-free sweep), then the few outside theirs.
-                let (ia, ib) = (x0.max(1) - ca, x1.min(w - 1) - ca);
-                if ia >= ib {
-                    continue;
-                }
-                let n = ib - ia;
-                let cols = (&lo[ia - 1..], &lo[ia..], &lo[ia + 1..]);
-                let gcols = (&hi[ia - 1..], &hi[ia..], &hi[ia + 1..]);
-                let sides = (&mid[ia - 1..], &mid[ia..], &mid[ia + 1..]);
-                for (k, (l, g)) in near_lo[..n].iter_mut().zip(&mut near_hi[..n]).enumerate() {
-                    *l = cols.0[k]
-                        .min(cols.1[k])
-                        .min(cols.2[k])
-                        .min(sides.0[k])
-                        .min(sides.2[k]);
-                    *g = gcols.0[k]
-                        .max(gcols.1[k])
-                        .max(gcols.2[k])
-                        .max(sides.0[k])
-                        .max(sides.2[k]);
-                }
-                for (k, &c) in sides.1[..n].iter().enumerate() {
-                    let range = (near_lo[k], near_hi[k]);
-                    if c >= range.0 && c <= range.1 {
-                        continue;
-                    }
-                    let x = ia + k + ca;
-                    row[x - x0] = repair(heights, c, range, tex(x, y), || {
-                        mean(heights, |dx, dy| {
-                            tex((x as i32 + dx) as usize, (y as i32 + dy) as usize)
-                        })
-                    });
-                }
-            }
+            reconstruct_block(atlas, heights, st, &cols, ys, block);
         });
+}
+
+/// The columns a rect's rows involve: its own `x0..x1`, those whose blends
+/// the repair reads (`ca..cb`) and those whose S and V they read (`xa..xb`).
+struct Cols {
+    x0: usize,
+    x1: usize,
+    ca: usize,
+    cb: usize,
+    xa: usize,
+    xb: usize,
+}
+
+/// The rows `ys..` of `block` (whole level rows; columns `x0..x1` written),
+/// streamed: row y + [`AHEAD`] is resolved, row y blended, row y − 1
+/// repaired, so the rows in flight stay in the L1 and L2 caches.
+fn reconstruct_block(
+    atlas: &AtlasLevel<'_>,
+    heights: &[u16],
+    st: &State,
+    c: &Cols,
+    ys: usize,
+    block: &mut [i32],
+) {
+    let (w, h) = (st.width, st.height);
+    let app = atlas.level.appearance;
+    let ye = ys + block.len() / w;
+    // Blended rows ra..rb, resolved rows ya..yb.
+    let (ra, rb) = (ys.saturating_sub(1), (ye + 1).min(h));
+    let (ya, yb) = (ys.saturating_sub(2), (ye + 2).min(h));
+    let (cols, bcols) = (c.xb - c.xa, c.cb - c.ca);
+    let mut ring: Vec<Resolved> = (0..RING)
+        .map(|_| {
+            let row = || vec![0i32; cols];
+            Resolved {
+                up: row(),
+                k: row(),
+                down: row(),
+                v: row(),
+                inside: false,
+            }
+        })
+        .collect();
+    let mut blends = vec![vec![0i32; bcols]; 4];
+    let mut vcol = vec![0i32; cols];
+    let mut sweep = Sweep::new(bcols);
+    let mut next = ya;
+    for y in ra..rb {
+        // Resolve up to AHEAD rows past the ones this blend reads.
+        while next < yb && next <= y + 1 + AHEAD {
+            resolve(atlas, heights, st, next, c.xa, &mut ring[next % RING]);
+            next += 1;
+        }
+        let tex = |x: usize, y: usize| ring[y % RING].texel(x - c.xa);
+        let brow = &mut blends[y % 4];
+        let edge = |x: usize| {
+            blend(app, heights, |dx, dy| {
+                let (nx, ny) = (x as i32 + dx, y as i32 + dy);
+                let ok = nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32;
+                ok.then(|| tex(nx as usize, ny as usize))
+            })
+        };
+        if y == 0 || y + 1 == h || w < 3 {
+            for (x, o) in (c.ca..c.cb).zip(brow.iter_mut()) {
+                *o = edge(x);
+            }
+        } else {
+            let rows = [
+                &ring[(y - 1) % RING],
+                &ring[y % RING],
+                &ring[(y + 1) % RING],
+            ];
+            for (((o, a), b), d) in vcol
+                .iter_mut()
+                .zip(&rows[0].v)
+                .zip(&rows[1].v)
+                .zip(&rows[2].v)
+            {
+                *o = a + b + d;
+            }
+            let (inner0, inner1) = (c.ca.max(1), c.cb.min(w - 1));
+            for x in (c.ca..inner0).chain(inner1.max(inner0)..c.cb) {
+                brow[x - c.ca] = edge(x);
+            }
+            if inner0 < inner1 {
+                let dst = &mut brow[inner0 - c.ca..inner1 - c.ca];
+                blend_interior(app, heights, rows, &vcol, inner0 - c.xa, dst);
+            }
+        }
+        if y > ys && y - 1 < ye {
+            let r = y - 1;
+            let out = &mut block[(r - ys) * w..(r - ys + 1) * w];
+            let near = [&blends[(r + 3) % 4], &blends[r % 4], &blends[(r + 1) % 4]];
+            sweep.finish(heights, c, (w, h), r, near, &tex, out);
+        }
+    }
+    if rb == ye {
+        // The level's last row: an edge row, kept as blended.
+        let r = ye - 1;
+        let out = &mut block[(r - ys) * w..(r - ys + 1) * w];
+        out[c.x0..c.x1].copy_from_slice(&blends[r % 4][c.x0 - c.ca..c.x1 - c.ca]);
+    }
+}
+
+/// The repair of one row's blends: per pixel the least and greatest of its
+/// eight neighbours' blends (a vectorisable sweep: column extremes of the
+/// rows above and below, then across), and [`repair`] of the few pixels
+/// outside that range.
+struct Sweep {
+    lo: Vec<i32>,
+    hi: Vec<i32>,
+    near_lo: Vec<i32>,
+    near_hi: Vec<i32>,
+}
+
+impl Sweep {
+    fn new(bcols: usize) -> Sweep {
+        let row = || vec![0i32; bcols];
+        Sweep {
+            lo: row(),
+            hi: row(),
+            near_lo: row(),
+            near_hi: row(),
+        }
+    }
+
+    /// Writes row y's heights (columns `x0..x1` of `row`) from the blends
+    /// of rows y − 1, y and y + 1 (`[up, mid, down]`, columns `ca..cb`;
+    /// only `mid` on the level's first and last rows); `tex(x, y)` is a
+    /// resolved pixel.
+    #[allow(clippy::too_many_arguments)]
+    fn finish(
+        &mut self,
+        heights: &[u16],
+        c: &Cols,
+        (w, h): (usize, usize),
+        y: usize,
+        [up, mid, down]: [&Vec<i32>; 3],
+        tex: &impl Fn(usize, usize) -> Texel,
+        row: &mut [i32],
+    ) {
+        let row = &mut row[c.x0..c.x1];
+        row.copy_from_slice(&mid[c.x0 - c.ca..c.x1 - c.ca]);
+        if y == 0 || y + 1 == h || w < 3 {
+            return;
+        }
+        for (((l, g), a), b) in self.lo.iter_mut().zip(&mut self.hi).zip(up).zip(down) {
+            (*l, *g) = ((*a).min(*b), (*a).max(*b));
+        }
+        // Interior columns of the row, as indices into the blends; first
+        // the range of each one's eight neighbours (a branch-free sweep),
+        // then the few outside theirs.
+        let (ia, ib) = (c.x0.max(1) - c.ca, c.x1.min(w - 1) - c.ca);
+        if ia >= ib {
+            return;
+        }
+        let n = ib - ia;
+        let (lo, hi) = (&self.lo, &self.hi);
+        let cols = (&lo[ia - 1..], &lo[ia..], &lo[ia + 1..]);
+        let gcols = (&hi[ia - 1..], &hi[ia..], &hi[ia + 1..]);
+        let sides = (&mid[ia - 1..], &mid[ia..], &mid[ia + 1..]);
+        let near = self.near_lo[..n].iter_mut().zip(&mut self.near_hi[..n]);
+        for (k, (l, g)) in near.enumerate() {
+            *l = cols.0[k]
+                .min(cols.1[k])
+                .min(cols.2[k])
+                .min(sides.0[k])
+                .min(sides.2[k]);
+            *g = gcols.0[k]
+                .max(gcols.1[k])
+                .max(gcols.2[k])
+                .max(sides.0[k])
+                .max(sides.2[k]);
+        }
+        for (k, &v) in sides.1[..n].iter().enumerate() {
+            let range = (self.near_lo[k], self.near_hi[k]);
+            if v >= range.0 && v <= range.1 {
+                continue;
+            }
+            let x = ia + k + c.ca;
+            row[x - c.x0] = repair(heights, v, range, tex(x, y), || {
+                mean(heights, |dx, dy| {
+                    tex((x as i32 + dx) as usize, (y as i32 + dy) as usize)
+                })
+            });
+        }
+    }
 }
 
 /// `ReconstructParams` of `kernels/reconstruct.wgsl` (padded to 16 bytes,

@@ -24,6 +24,7 @@ use crate::level::fixed::{Coord, FRAC_BITS};
 use crate::level::state::State;
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
+use std::sync::atomic::Ordering::Relaxed;
 
 /// How children relate to parents at this step.
 #[derive(Debug, Clone, Copy)]
@@ -103,8 +104,37 @@ pub fn upsample_jitter_rect(
             let b = x1.min(a + ROW_CHUNK);
             let jit = &mut jit[..b - a];
             jitter_row(p, ox + a as u32, oy + y as u32, jit);
-            for (x, &j) in (a..b).zip(jit.iter()) {
-                upsample_pixel(parent, child, atlas, p, x, y, j);
+            let run = Run {
+                parent,
+                child,
+                y,
+                a,
+            };
+            // One loop per step kind: the step is the same for the level.
+            match p.step {
+                Step::Pyramid => {
+                    let at = atlas.expect("pyramid steps have an atlas");
+                    run.fill(jit, |s, cx, (dx, dy)| {
+                        let c = Coord {
+                            x: 2 * s.x + dx,
+                            y: 2 * s.y + dy,
+                        };
+                        clamp(at, c, 2 * s.x + (cx << FRAC_BITS))
+                    })
+                }
+                Step::Virtual { shift } => run.fill(jit, |s, _, (dx, dy)| Coord {
+                    x: s.x + (dx << shift),
+                    y: s.y + (dy << shift),
+                }),
+                Step::Wrap {
+                    min_x,
+                    max_x,
+                    min_y,
+                    max_y,
+                } => run.fill(jit, |s, _, (dx, dy)| Coord {
+                    x: wrap(s.x + dx, min_x, max_x),
+                    y: wrap(s.y + dy, min_y, max_y),
+                }),
             }
         }
     });
@@ -145,46 +175,35 @@ fn jitter_row_any(p: &UpsampleParams, ax: u32, ay: u32, out: &mut [(i32, i32)]) 
     }
 }
 
-/// One child pixel (x, y) from its parent, with jitter `(jx, jy)`.
-#[inline(always)]
-fn upsample_pixel(
-    parent: &State,
-    child: &State,
-    atlas: Option<&AtlasLevel<'_>>,
-    p: &UpsampleParams,
-    x: usize,
+/// A run of child pixels, row `y` from column `a` on, and their parents.
+struct Run<'s> {
+    parent: &'s State,
+    child: &'s State,
     y: usize,
-    (jx, jy): (i32, i32),
-) {
-    let pi = (y / 2) * parent.width + x / 2;
-    let (cx, cy) = ((x & 1) as i32, (y & 1) as i32);
-    let s = parent.s(pi);
-    let off_x = (cx << FRAC_BITS) + jx;
-    let off_y = (cy << FRAC_BITS) + jy;
-    let out = match p.step {
-        Step::Pyramid => {
-            let a = atlas.expect("pyramid steps have an atlas");
-            let c = Coord {
-                x: 2 * s.x + off_x,
-                y: 2 * s.y + off_y,
-            };
-            clamp(a, c, 2 * s.x + (cx << FRAC_BITS))
+    a: usize,
+}
+
+impl Run<'_> {
+    /// Sets the run's pixels (one per element of `jit`, their jitter) to
+    /// `step(S(parent), cx, offset)` and V(parent), where `cx` is the
+    /// child's column parity and the offset `(c << FRAC_BITS) + j`.
+    #[inline(always)]
+    fn fill(&self, jit: &[(i32, i32)], step: impl Fn(Coord, i32, (i32, i32)) -> Coord) {
+        let (parent, child, y, a) = (self.parent, self.child, self.y, self.a);
+        let n = jit.len();
+        let (pa, pb) = (a / 2, (a + n - 1) / 2 + 1);
+        let (ps, pv) = parent.run((y / 2) * parent.width + pa, pb - pa);
+        let (cs, cv) = child.run(y * child.width + a, n);
+        let cy = (y & 1) as i32;
+        for (x, ((s_out, v_out), &(jx, jy))) in (a..).zip(cs.iter().zip(cv).zip(jit)) {
+            let pk = x / 2 - pa;
+            let s = Coord::unpack(ps[pk].load(Relaxed));
+            let cx = (x & 1) as i32;
+            let off = ((cx << FRAC_BITS) + jx, (cy << FRAC_BITS) + jy);
+            s_out.store(step(s, cx, off).pack(), Relaxed);
+            v_out.store(pv[pk].load(Relaxed), Relaxed);
         }
-        Step::Virtual { shift } => Coord {
-            x: s.x + (off_x << shift),
-            y: s.y + (off_y << shift),
-        },
-        Step::Wrap {
-            min_x,
-            max_x,
-            min_y,
-            max_y,
-        } => Coord {
-            x: wrap(s.x + off_x, min_x, max_x),
-            y: wrap(s.y + off_y, min_y, max_y),
-        },
-    };
-    child.set(y * child.width + x, out, parent.v(pi));
+    }
 }
 
 /// Clamps a fixed-point coordinate into the interior of the exemplar that
