@@ -1,4 +1,5 @@
-//! Which instruction set the run-time-dispatched CPU stages use.
+//! Which instruction set the run-time-dispatched CPU stages use, and the
+//! cache hint (`prefetch`) the latency-bound ones share.
 //!
 //! `correct` and `upsample_jitter` compile their hot loops twice — for the
 //! build's baseline (SSE2 on x86-64) and for AVX2 — and pick AVX2 where the

@@ -5,6 +5,7 @@
 use super::super::DELTAS;
 use super::grid::{Grid, Tap, at, window};
 use crate::level::atlas::AtlasLevel;
+use crate::stages::isa::prefetch;
 
 /// A pixel whose candidates are gathered, awaiting scoring.
 #[derive(Clone, Copy, Default)]
@@ -159,28 +160,6 @@ fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending
     prefetch(app, q.idx - q.stride + 2);
     prefetch(app, q.idx + q.stride + 2);
     out.count = count + 2;
-}
-
-/// [`prefetch_line`] for element `i` of `table`. The address is only
-/// formed, never read, so it needs no bounds check (prefetching is a hint
-/// that cannot fault).
-#[inline(always)]
-fn prefetch<T>(table: &[T], i: i32) {
-    prefetch_line(table.as_ptr().wrapping_offset(i as isize).cast());
-}
-
-/// Asks the cache for the line holding `t` (a hint: no effect on results).
-#[inline(always)]
-fn prefetch_line(t: *const i8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: `prefetch` only hints the cache; it cannot fault or change
-    // memory, and SSE is part of the x86_64 baseline.
-    unsafe {
-        use core::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>(t);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = t;
 }
 
 #[cfg(test)]
