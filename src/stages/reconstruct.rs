@@ -109,13 +109,15 @@ fn blend(app: &[u64], heights: &[u16], texel: impl Fn(i32, i32) -> Option<Texel>
     }
     let own = texel(0, 0).expect("the pixel itself is in the level");
     // Σ (a << 8) = (Σ a) << 8, in wrapping arithmetic too: shifted once.
-    div_floor(sum << HEIGHT_FRAC_BITS, count) + detail(heights, own.k, smooth_height(app, own.k))
+    div_floor(sum << HEIGHT_FRAC_BITS, count)
+        + detail(heights[own.k as usize], smooth_height(app, own.k))
 }
 
-/// The detail `E⁰ − μ` of texel `k` (whose μ is `mu`), ×2^8.
+/// The detail `E⁰ − μ` of a texel whose height is `e` and smooth height
+/// `mu`, ×2^8.
 #[inline(always)]
-fn detail(heights: &[u16], k: i32, mu: i32) -> i32 {
-    (heights[k as usize] as i32 - mu) << HEIGHT_FRAC_BITS
+fn detail(e: u16, mu: i32) -> i32 {
+    (e as i32 - mu) << HEIGHT_FRAC_BITS
 }
 
 /// One level row's pixels as their neighbours' predictions read them
@@ -252,8 +254,7 @@ fn blend_row(
             + v0
             + v1
             + v2;
-        let detail = (e(b1) as i32 - own) << HEIGHT_FRAC_BITS;
-        *o = div_floor(sum << HEIGHT_FRAC_BITS, 9) + detail;
+        *o = div_floor(sum << HEIGHT_FRAC_BITS, 9) + detail(e(b1), own);
         (a0, a1, b0, b1, c0, c1, v0, v1) = (a1, a2, b1, b2, c1, c2, v1, v2);
     }
 }
