@@ -12,6 +12,7 @@
 
 use proptest::prelude::*;
 use std::path::Path;
+use terrasynth::database::layout;
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::state::{State, level_size};
@@ -75,6 +76,29 @@ proptest! {
 
 /// Every subpass at the default prior on every corrected level of each
 /// real synthesis, each from the same state.
+/// The fast path reads C₂'s diagonal texels from `AtlasLevel::c2` (the
+/// oracle from `similar` and the appearance): every texel's entry holds
+/// those of its similarity entry, found here through the database's own
+/// addressing, in the AVX2 scorer's order (−1,−1), (−1,1), (1,−1), (1,1).
+#[test]
+fn c2_table_holds_the_diagonals_of_every_similarity_entry() {
+    let db = default_db();
+    for i in 0..db.level_count() {
+        let atlas = AtlasLevel::new(db, i);
+        let level = &atlas.level;
+        assert_eq!(atlas.c2.len(), level.appearance.len(), "level {i}");
+        for (u, (&c, quad)) in level.similar.iter().zip(&atlas.c2).enumerate() {
+            let (x, y) = layout::unpack(c);
+            let texel = |dx: i32, dy: i32| {
+                let q = layout::pack(x.wrapping_add_signed(dx), y.wrapping_add_signed(dy));
+                level.appearance[level.index_of(q).unwrap()]
+            };
+            let want = [texel(-1, -1), texel(-1, 1), texel(1, -1), texel(1, 1)];
+            assert_eq!(quad.0, want, "level {i}, texel {u}");
+        }
+    }
+}
+
 #[test]
 fn correct_agrees_on_real_states() {
     for (db, size, seed) in real_syntheses("real-DEM correct cross-checks") {

@@ -7,6 +7,7 @@
 //! (a few KiB: cached) and an index is `base[x] + y·stride[x] + x`.
 
 use crate::database::{Database, Level, layout::MARGIN};
+use crate::level::c2::{self, Quad};
 
 /// Per-column addressing of one level.
 ///
@@ -30,6 +31,10 @@ pub struct AtlasLevel<'a> {
     pub columns: Vec<Column>,
     /// Seed slots filled per type (type seeding draws from these).
     pub seed_counts: Vec<u32>,
+    /// C₂'s four diagonal texels for every texel u (the CPU correction
+    /// scores C₂(u) from here rather than chasing `similar[u]` across the
+    /// atlas; 32 bytes per texel, 32 MiB for the embedded database).
+    pub c2: Vec<Quad>,
 }
 
 impl<'a> AtlasLevel<'a> {
@@ -47,9 +52,11 @@ impl<'a> AtlasLevel<'a> {
                 };
             }
         }
+        let c2 = c2::gather(&level, &columns);
         AtlasLevel {
             level,
             columns,
+            c2,
             seed_counts: db.meta().levels[i].seed_counts.clone(),
         }
     }

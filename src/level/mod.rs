@@ -7,5 +7,6 @@
 //! re-exports them under their old paths (`synth::fixed`, …).
 
 pub mod atlas;
+pub mod c2;
 pub mod fixed;
 pub mod state;

@@ -16,11 +16,16 @@
 //!   small grid and the pixels take them from there. Likewise the two N_S
 //!   texels of a diagonal that lie in the grid column between two pixels
 //!   are summed once for both (8 texel reads per pixel instead of 12).
-//! - **Prefetched candidates.** C₂ entries point anywhere in the atlas; at
-//!   level 0 the atlas outgrows the L2 cache and scoring them one by one
-//!   would serialise cache misses. Candidates are listed a few pixels ahead
-//!   of scoring and their texels prefetched (a software pipeline), and the
-//!   similarity entries a few pixels ahead of listing.
+//! - **C₂ without chasing it.** C₂ entries point anywhere in the atlas,
+//!   which at level 0 outgrows the L2 cache: reading `similar[u]`, then
+//!   the texels it names, were two cache misses in a row per candidate.
+//!   The span reads C₂'s four diagonal texels from `AtlasLevel::c2[u]`
+//!   instead (gathered once per database level, [`crate::level::c2`]),
+//!   near `S(p)` like C₁, and looks up `similar[u]` only for a winner
+//!   (C₂ won 0.4 % of the pixels of a 1024² synthesis; at 1024² the
+//!   correction ran ~8 % fewer instructions).
+//! - **Prefetched candidates.** Candidates are listed a few pixels ahead
+//!   of scoring and their texels prefetched (a software pipeline).
 //! - **Vector scoring.** The four diagonal texels of a candidate are two
 //!   `i16x8` loads; residuals are formed in `i32x8`, clamped to ±[`CLAMP`]
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
@@ -44,9 +49,9 @@ use super::{ALL_TYPES, DELTAS, Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use gather::{Pending, gather, prefetch_similar};
+use gather::{Pending, gather};
 use grid::{CHUNK, GRID_COLS, Grid, Tap};
-use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
+use score::{Neighbourhood, best_of, column, diagonals, neighbourhood, score_with};
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
@@ -177,9 +182,6 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
     // The shared N_S texels of the grid column left of the next pixel.
     let mut left = column(app, grid, 1);
     for i in 0..n + LOOKAHEAD {
-        if i + LOOKAHEAD < n {
-            prefetch_similar(atlas, grid, 2 * (i + LOOKAHEAD) + 2);
-        }
         if i < n {
             gather(atlas, grid, 2 * i + 2, &mut ring[i % RING]);
         }
@@ -244,8 +246,9 @@ fn decide<const P: u32, const AVX2: bool>(
         // coherent: the previous result as is.
         let free = w >= W_FREE;
         let fixed = (!free).then_some(v);
-        let (sc, h_prev) = score_with::<P>(app, ns, idx, col.stride as i32, 1, fixed, vp);
-        let (cost, i, hh) = best_of::<P, AVX2>(app, ns, p, weigh(sc, w), vp);
+        let t = diagonals(app, idx, col.stride as i32);
+        let (sc, h_prev) = score_with::<P>(ns, &t, 1, fixed, vp);
+        let (cost, i, hh) = best_of::<P, AVX2>(app, &atlas.c2, ns, p, weigh(sc, w), vp);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -254,7 +257,7 @@ fn decide<const P: u32, const AVX2: bool>(
         }
         return finish(atlas, st, at, p, (cost, i, hh), g);
     }
-    let winner = best_of::<P, AVX2>(app, ns, p, u32::MAX, vp);
+    let winner = best_of::<P, AVX2>(app, &atlas.c2, ns, p, u32::MAX, vp);
     finish(atlas, st, at, p, winner, g)
 }
 
@@ -283,8 +286,16 @@ fn finish(
     g: &Guide<'_>,
 ) -> (Coord, i32) {
     debug_assert!(best.1 < p.count);
-    let q = p.cands[best.1];
-    let (dx, dy) = DELTAS[q.from as usize];
+    let pair = &p.pairs[best.1 / 2];
+    let (q, idx) = match best.1 % 2 {
+        0 => ((pair.x, pair.y), pair.idx),
+        _ => {
+            let c = atlas.level.similar[pair.u as usize];
+            let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);
+            ((x, y), atlas.index(x, y) as i32)
+        }
+    };
+    let (dx, dy) = DELTAS[pair.from as usize];
     // The neighbour it came from, reflected at the level border.
     let (w, h) = (st.width as i32, st.height as i32);
     let (nx, ny) = (reflect(x as i32 + dx, w), reflect(y as i32 + dy, h));
@@ -292,8 +303,8 @@ fn finish(
     let pixel = y * st.width + x;
     let frac = |v: i32| v - (round(v) << FRAC_BITS);
     let s = Coord {
-        x: (q.x << FRAC_BITS) + frac(n.x),
-        y: (q.y << FRAC_BITS) + frac(n.y),
+        x: (q.0 << FRAC_BITS) + frac(n.x),
+        y: (q.1 << FRAC_BITS) + frac(n.y),
     };
-    (s, nudged(atlas, q.idx, best.2, pixel, g))
+    (s, nudged(atlas, idx, best.2, pixel, g))
 }

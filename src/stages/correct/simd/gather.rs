@@ -7,47 +7,34 @@ use super::grid::{Grid, Tap, at, window};
 use crate::level::atlas::AtlasLevel;
 use crate::stages::isa::prefetch;
 
-/// A pixel whose candidates are gathered, awaiting scoring.
+/// A pixel whose candidates are gathered, awaiting scoring: C₁ and C₂ of
+/// each distinct u, candidate `i` being pair `i / 2`'s C₁ (`i` even) or
+/// C₂ (`i` odd).
 #[derive(Clone, Copy, Default)]
 pub(super) struct Pending {
-    pub cands: [Candidate; 18],
+    pub pairs: [Pair; 9],
+    /// Candidates (twice the pairs).
     pub count: usize,
 }
 
-/// One candidate of the pixel being corrected.
+/// The two candidates of one u.
 #[derive(Clone, Copy, Default)]
-pub(super) struct Candidate {
-    /// Texel index and row stride.
+pub(super) struct Pair {
+    /// C₁: texel index, row stride and atlas texel.
     pub idx: i32,
     pub stride: i32,
-    /// Atlas texel.
     pub x: i32,
     pub y: i32,
-    /// Index into DELTAS of the neighbour it came from.
+    /// u's texel index: C₂ is `similar[u]`, its diagonal texels `c2[u]`
+    /// (`AtlasLevel`). Only the winner's coordinate is ever looked up.
+    pub u: i32,
+    /// Index into DELTAS of the neighbour both came from.
     pub from: u8,
-    pub kappa: u32,
-}
-
-/// Prefetches the similarity entries the gathering of the pixel in grid
-/// column `c` will read, those of `u = S(p + Δ) − Δ` for the three Δ of
-/// its column (in a coherent patch all nine u coincide with these). The
-/// first read of an atlas row near u is this one: gathering's own
-/// prefetches cover only the texels that scoring reads later, and the
-/// profile showed the `similar` load as the costliest instruction.
-#[inline(always)]
-pub(super) fn prefetch_similar(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize) {
-    let similar = atlas.level.similar;
-    let win = window(grid, c);
-    for dy in -1..=1 {
-        let n = at(&win, 0, dy);
-        prefetch(similar, n.idx - dy * n.stride);
-    }
 }
 
 /// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
 /// distinct `u = S(p+Δ) − Δ`, in DELTAS order) and prefetches the texels
-/// scoring will read: C₂ entries point anywhere in the atlas, and at level 0
-/// the atlas is larger than the L2 cache.
+/// scoring will read (at level 0 the atlas is larger than the L2 cache).
 ///
 /// The distinct u are found first, as a bit mask, with a fixed number of
 /// compares; then only they are listed, in one loop. Deciding per Δ
@@ -121,45 +108,27 @@ fn firsts_scalar(u: &[i32; 9]) -> u32 {
 /// is `n` and u's texel index `u_idx`.
 #[inline(always)]
 fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending) {
-    let app = atlas.level.appearance;
     let (dx, dy) = DELTAS[k];
-    let count = out.count;
     // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
     let u = (n.sx - dx, n.sy - dy);
     let (cx, cy) = atlas.clamp_interior(u.0, u.1);
-    out.cands[count] = Candidate {
+    let pair = Pair {
         idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
         stride: n.stride,
         x: cx,
         y: cy,
+        u: u_idx,
         from: k as u8,
-        kappa: 1,
     };
-    // C₂: the stored best other match, anywhere in the atlas.
-    let c2 = atlas.level.similar[u_idx as usize];
-    let (qx, qy) = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
-    let col = &atlas.columns[qx as usize];
-    out.cands[count + 1] = Candidate {
-        idx: col.base + qy * col.stride as i32 + qx,
-        stride: col.stride as i32,
-        x: qx,
-        y: qy,
-        from: k as u8,
-        kappa: 2,
-    };
-    // Scoring reads q − s ± 1 and q + s ± 1, and the AVX2 scorer the
-    // 32 bytes q ± s − 1 … q ± s + 2 (one load per row): per row one or two
-    // cache lines, those of its first and last texel. C₂ lands anywhere,
-    // so both are asked for; C₁ is near S(p), whose lines N_S reads
-    // anyway.
-    for q in &out.cands[count..count + 2] {
-        prefetch(app, q.idx - q.stride - 1);
-        prefetch(app, q.idx + q.stride - 1);
-    }
-    let q = &out.cands[count + 1];
-    prefetch(app, q.idx - q.stride + 2);
-    prefetch(app, q.idx + q.stride + 2);
-    out.count = count + 2;
+    // Scoring reads C₁'s texels q − s ± 1 and q + s ± 1 (the AVX2 scorer
+    // the 32 bytes q ± s − 1 … q ± s + 2), near S(p), whose lines N_S
+    // reads anyway; and C₂'s from `c2[u]`, one line.
+    let app = atlas.level.appearance;
+    prefetch(app, pair.idx - pair.stride - 1);
+    prefetch(app, pair.idx + pair.stride - 1);
+    prefetch(&atlas.c2, u_idx);
+    out.pairs[out.count / 2] = pair;
+    out.count += 2;
 }
 
 #[cfg(test)]

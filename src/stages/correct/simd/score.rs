@@ -5,15 +5,18 @@
 use super::super::{CLAMP, DIAGONALS, FLAT, Prior};
 use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
+use crate::level::c2::Quad;
 use wide::{i16x8, i32x4, i32x8};
 
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2;
 
-/// Two packed appearance texels as eight i16 lanes.
+/// The four diagonal texels of the candidate whose texel index is `q` in
+/// an exemplar of row stride `s`, in [`Quad`]'s order.
 #[inline(always)]
-fn pair(app: &[u64], a: i32, b: i32) -> i16x8 {
-    wide::bytemuck::cast([app[a as usize], app[b as usize]])
+pub(super) fn diagonals(app: &[u64], q: i32, s: i32) -> Quad {
+    let t = |i: i32| app[i as usize];
+    Quad([t(q - s - 1), t(q + s - 1), t(q - s + 1), t(q + s + 1)])
 }
 
 /// The synthesis neighbourhood N_S (×3), two diagonals per vector, mode 1
@@ -24,37 +27,23 @@ pub(super) struct Neighbourhood {
     ns23: i32x8,
 }
 
-/// Score (×κ) and optimal offset of the candidate whose texel index is
-/// `q` in an exemplar of row stride `s` (same arithmetic as the scalar
-/// `score`; the prior's weight P is a constant, so its closed form divides
-/// by a constant).
-#[inline(always)]
-fn score<const P: u32>(
-    app: &[u64],
-    ns: &Neighbourhood,
-    q: i32,
-    s: i32,
-    kappa: u32,
-    vp: i32,
-) -> (u32, i32) {
-    score_with::<P>(app, ns, q, s, kappa, None, vp)
-}
-
-/// [`score`] with the offset fixed to `fixed` when given (a coherent
-/// previous result keeps its own offset).
+/// Score (×κ) and optimal offset of the candidate whose diagonal texels
+/// are `t` (same arithmetic as the scalar `score`; the prior's weight P is
+/// a constant, so its closed form divides by a constant), with the offset
+/// fixed to `fixed` when given (a coherent previous result keeps its own
+/// offset).
 #[inline(always)]
 pub(super) fn score_with<const P: u32>(
-    app: &[u64],
     ns: &Neighbourhood,
-    q: i32,
-    s: i32,
+    t: &Quad,
     kappa: u32,
     fixed: Option<i32>,
     vp: i32,
 ) -> (u32, i32) {
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
-    let m01 = i32x8::from_i16x8(pair(app, q - s - 1, q - s + 1));
-    let m23 = i32x8::from_i16x8(pair(app, q + s - 1, q + s + 1));
+    let [a, b, c, d] = t.0;
+    let m01 = i32x8::from_i16x8(wide::bytemuck::cast([a, c]));
+    let m23 = i32x8::from_i16x8(wide::bytemuck::cast([b, d]));
     let d01 = ns.ns01 - (m01 + m01 + m01);
     let d23 = ns.ns23 - (m23 + m23 + m23);
     let (a, b) = (d01.to_array(), d23.to_array());
@@ -165,24 +154,23 @@ fn outer(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
 #[inline(always)]
 pub(super) fn best_of<const P: u32, const AVX2: bool>(
     app: &[u64],
+    c2: &[Quad],
     ns: &Neighbourhood,
     p: &Pending,
     bar: u32,
     vp: i32,
 ) -> (u32, usize, i32) {
     let mut best = (bar, usize::MAX, 0i32);
+    let pairs = &p.pairs[..p.count / 2];
     #[cfg(target_arch = "x86_64")]
     if AVX2 {
-        // Candidates come in (C₁, C₂) pairs of one u (see `gather`).
-        debug_assert!(p.count % 2 == 0);
-        debug_assert!((0..p.count).all(|i| p.cands[i].kappa == 1 + i as u32 % 2));
         // SAFETY: `AVX2` is set only in the span's AVX2 copy, which runs
         // only where the CPU has AVX2.
         let ns = unsafe { avx2::ns256(ns) };
-        for (j, pair) in p.cands[..p.count].chunks_exact(2).enumerate() {
-            // SAFETY: the CPU has AVX2 (as above), and gathered candidates
-            // are interior coordinates (see `avx2::score_pair`).
-            let scored = unsafe { avx2::score_pair::<P>(app, &ns, &pair[0], &pair[1], vp) };
+        for (j, pair) in pairs.iter().enumerate() {
+            // SAFETY: the CPU has AVX2 (as above), C₁ is an interior
+            // coordinate (see `avx2::score_pair`) and u a texel.
+            let scored = unsafe { avx2::score_pair::<P>(app, c2, &ns, pair, vp) };
             for (i, (sc, hh)) in scored.into_iter().enumerate() {
                 if sc < best.0 {
                     best = (sc, 2 * j + i, hh);
@@ -191,10 +179,16 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         }
         return best;
     }
-    for (i, c) in p.cands[..p.count].iter().enumerate() {
-        let (sc, hh) = score::<P>(app, ns, c.idx, c.stride, c.kappa, vp);
-        if sc < best.0 {
-            best = (sc, i, hh);
+    for (j, pair) in pairs.iter().enumerate() {
+        let c1 = diagonals(app, pair.idx, pair.stride);
+        let scored = [
+            score_with::<P>(ns, &c1, 1, None, vp),
+            score_with::<P>(ns, &c2[pair.u as usize], 2, None, vp),
+        ];
+        for (i, (sc, hh)) in scored.into_iter().enumerate() {
+            if sc < best.0 {
+                best = (sc, 2 * j + i, hh);
+            }
         }
     }
     best

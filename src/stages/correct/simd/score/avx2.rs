@@ -4,7 +4,8 @@
 //! 64-bit loads with a bounds check each, sign extensions by unpack and
 //! shift, and two narrowings — about 90 instructions per candidate, the
 //! largest share of the kernel. Here one candidate is one vector of its
-//! four diagonal texels (16 i16 lanes), built from two unaligned loads:
+//! four diagonal texels (16 i16 lanes): C₁'s built from two unaligned
+//! loads, C₂'s one aligned load of its [`Quad`] (already in this order):
 //! - `_mm256_madd_epi16` against (3, 0) and (0, 3) word pairs widens and
 //!   triples modes 0/2 and 1/3 of every texel in one instruction each (the
 //!   products are exact: |3·m| < 2¹⁷), so N_S is kept in the same
@@ -18,8 +19,9 @@
 //! squares summed by `madd` (16 terms ≤ 9459² each: no i32 overflow).
 
 use super::super::super::{CLAMP, FLAT, Prior};
-use super::super::gather::Candidate;
+use super::super::gather::Pair;
 use super::Neighbourhood;
+use crate::level::c2::Quad;
 use core::arch::x86_64::*;
 
 /// N_S (×3, V on mode 1) in the lane order of a candidate's
@@ -95,6 +97,13 @@ struct Residuals {
 unsafe fn residuals<const P: u32>(app: &[u64], ns: &Ns256, q: i32, s: i32) -> Residuals {
     // SAFETY: forwarded from the caller.
     let t = unsafe { candidate_texels(app, q, s) };
+    residuals_of::<P>(ns, t)
+}
+
+/// [`Residuals`] of the candidate whose diagonal texels are `t`.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn residuals_of<const P: u32>(ns: &Ns256, t: __m256i) -> Residuals {
     // Flat: the four mode-0 words (0, 4, 8, 12) equal word 0.
     let flat = P > 0 && {
         let first = _mm256_broadcastw_epi16(_mm256_castsi256_si128(t));
@@ -129,28 +138,27 @@ fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
     (h, prior.cost(h), _mm256_madd_epi16(d, d))
 }
 
-/// Scores and optimal offsets of a C₁ (κ = 1) and the C₂ (κ = 2) listed
-/// after it, as the scalar `score`. Two at a time so that their
-/// horizontal sums share shuffles.
+/// Scores and optimal offsets of a pair's C₁ (κ = 1) and C₂ (κ = 2), as
+/// the scalar `score`. Two at a time so that their horizontal sums share
+/// shuffles. C₂'s texels are one aligned load from `c2` (its entry is
+/// bounds-checked).
 ///
 /// # Safety
-/// As [`candidate_texels`], for both.
+/// As [`candidate_texels`], for C₁.
 #[inline]
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn score_pair<const P: u32>(
     app: &[u64],
+    c2: &[Quad],
     ns: &Ns256,
-    c1: &Candidate,
-    c2: &Candidate,
+    pair: &Pair,
     vp: i32,
 ) -> [(u32, i32); 2] {
     // SAFETY: forwarded from the caller.
-    let (a, b) = unsafe {
-        (
-            residuals::<P>(app, ns, c1.idx, c1.stride),
-            residuals::<P>(app, ns, c2.idx, c2.stride),
-        )
-    };
+    let a = unsafe { residuals::<P>(app, ns, pair.idx, pair.stride) };
+    let quad: *const Quad = &c2[pair.u as usize];
+    // SAFETY: a `Quad` is 32 bytes, 32-byte aligned.
+    let b = residuals_of::<P>(ns, unsafe { _mm256_load_si256(quad.cast()) });
     // Σ d₁ of both: the mode-0 lanes 0, 2, 4, 6 of each `even`,
     // interleaved (a's in even lanes, b's in odd) and summed.
     let x = _mm256_blend_epi32::<0b1010_1010>(a.even, _mm256_slli_epi64::<32>(b.even));

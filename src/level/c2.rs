@@ -1,0 +1,41 @@
+//! C₂'s diagonal texels, gathered once per database level.
+//!
+//! Why: correction scores every pixel's C₂ candidates, `C₂(u)` of each
+//! distinct `u = S(p+Δ) − Δ`, by the four diagonal texels around them.
+//! C₂ points anywhere in the atlas, so at level 0 (an atlas larger than
+//! the L2 cache) each one cost two or three cache misses that waited on
+//! another (`similar[u]`, then the texels it names). Here texel `u`'s
+//! entry holds those four texels themselves, 32-byte aligned: `u` is near
+//! `S(p)`, which neighbouring pixels share, so the entries are read in
+//! the order the level is walked and come from cache, one line each.
+
+use crate::database::Level;
+use crate::level::atlas::Column;
+use rayon::prelude::*;
+
+/// The four diagonal texels of one C₂, in the AVX2 scorer's order:
+/// (−1,−1), (−1,1), (1,−1), (1,1) (the `u64` appearance texels).
+#[repr(C, align(32))]
+#[derive(Clone, Copy, Default, Debug, PartialEq)]
+pub struct Quad(pub [u64; 4]);
+
+/// The [`Quad`] of `C₂(u)` for every texel `u` of `level`, in texel order.
+///
+/// Every similarity entry is an interior coordinate (the database checks
+/// them when it is opened), so its diagonals lie in its exemplar.
+pub fn gather(level: &Level<'_>, columns: &[Column]) -> Vec<Quad> {
+    let app = level.appearance;
+    let mut out = vec![Quad::default(); level.similar.len()];
+    out.par_chunks_mut(4096)
+        .zip(level.similar.par_chunks(4096))
+        .for_each(|(out, similar)| {
+            for (q, &c) in out.iter_mut().zip(similar) {
+                let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);
+                let col = &columns[x as usize];
+                let (k, s) = (col.base + y * col.stride as i32 + x, col.stride as i32);
+                let t = |i: i32| app[i as usize];
+                *q = Quad([t(k - s - 1), t(k + s - 1), t(k - s + 1), t(k + s + 1)]);
+            }
+        });
+    out
+}
