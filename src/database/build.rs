@@ -312,7 +312,7 @@ pub fn build(
     }
     let words = file::encode(&sections);
     let len = words.len() * 8;
-    let db = Database::parse(Bytes::new(words, len), Path::new("<built database>"))?;
+    let db = Database::parse(Bytes::Owned(words, len), Path::new("<built database>"))?;
     Ok((db, report))
 }
 

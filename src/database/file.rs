@@ -1,5 +1,5 @@
 //! The `.tsdb` file: a versioned, checksummed, little-endian container that
-//! is used in place once in memory (memory-mappable; read, see [`Bytes`]).
+//! is used in place after a memory map.
 //!
 //! ```text
 //! 0   magic   "TSDB\r\n\x1a\n"           (8 bytes; catches text-mode mangling)
@@ -219,42 +219,31 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Vec<Found>, DbError> {
     Ok(found)
 }
 
-/// The bytes a database lives in: 8-byte-aligned words holding `len`
-/// bytes — its own buffer after a build, a copy of the file after a load.
-///
-/// A load reads the file rather than mapping it: synthesis reads a level's
-/// texels all over (every pixel's candidates, prefetched), and a file
-/// mapping lives in the page cache's 4 KiB pages, where those reads missed
-/// the TLB; anonymous memory can be advised onto 2 MiB pages
-/// ([`crate::pages`]). Opening reads every byte anyway (the checksums).
-pub struct Bytes {
-    words: Vec<u64>,
-    len: usize,
+/// The bytes a database lives in: its own buffer after a build, or a
+/// read-only memory map of the file after a load.
+pub enum Bytes {
+    /// 8-byte-aligned words holding `len` bytes.
+    Owned(Vec<u64>, usize),
+    Mapped(memmap2::Mmap),
 }
 
 impl Bytes {
-    /// The first `len` bytes of `words`.
-    pub fn new(words: Vec<u64>, len: usize) -> Bytes {
-        assert!(
-            len <= words.len() * 8,
-            "{len} bytes in {} words",
-            words.len()
-        );
-        Bytes { words, len }
-    }
-
     pub fn as_slice(&self) -> &[u8] {
-        &bytemuck::cast_slice(&self.words)[..self.len]
+        match self {
+            Bytes::Owned(w, len) => &bytemuck::cast_slice(w)[..*len],
+            Bytes::Mapped(m) => m,
+        }
     }
 
-    /// Reads a file into huge-page-advised memory, after checking that the
-    /// system has the memory for it.
-    pub fn read(path: &Path) -> Result<Bytes, DbError> {
+    /// Maps a file read-only. The mapping is private to this process; as with
+    /// any memory map, the file must not be truncated by another process
+    /// while it is in use.
+    pub fn map(path: &Path) -> Result<Bytes, DbError> {
         let os = |source| DbError::Os {
             path: path.to_path_buf(),
             source,
         };
-        let mut file = std::fs::File::open(path).map_err(os)?;
+        let file = std::fs::File::open(path).map_err(os)?;
         let len = file.metadata().map_err(os)?.len();
         if len == 0 {
             return Err(DbError::File {
@@ -262,17 +251,9 @@ impl Bytes {
                 message: "truncated: the file is empty".into(),
             });
         }
-        crate::io::check_memory(&format!("database {}", path.display()), len)?;
-        let len = usize::try_from(len).map_err(|_| DbError::File {
-            path: path.to_path_buf(),
-            message: format!("{len} bytes do not fit this machine's address space"),
-        })?;
-        let mut words: Vec<u64> = Vec::with_capacity(len.div_ceil(8));
-        crate::pages::advise_huge(words.spare_capacity_mut());
-        words.resize(len.div_ceil(8), 0);
-        let bytes = &mut bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..len];
-        std::io::Read::read_exact(&mut file, bytes).map_err(os)?;
-        Ok(Bytes::new(words, len))
+        // SAFETY: read-only private mapping; see the doc comment.
+        let map = unsafe { memmap2::MmapOptions::new().populate().map(&file) }.map_err(os)?;
+        Ok(Bytes::Mapped(map))
     }
 }
 

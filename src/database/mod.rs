@@ -120,7 +120,7 @@ struct LevelRanges {
 }
 
 /// A loaded (or freshly built) database. Cheap to share by reference; the
-/// arrays are views into one buffer.
+/// arrays are views into one buffer or memory map.
 pub struct Database {
     meta: Meta,
     bytes: Bytes,
@@ -140,10 +140,10 @@ impl std::fmt::Debug for Database {
 }
 
 impl Database {
-    /// Loads a `.tsdb` file, verifying every checksum and the contents (see
-    /// [`file`]).
+    /// Loads a `.tsdb` file by memory map, verifying every checksum and the
+    /// contents (see [`file`]).
     pub fn load(path: &Path) -> Result<Database, DbError> {
-        Database::parse(Bytes::read(path)?, path)
+        Database::parse(Bytes::map(path)?, path)
     }
 
     /// Validates an in-memory `.tsdb` image (for embedding, pipes and the
@@ -152,7 +152,7 @@ impl Database {
     pub fn from_bytes(bytes: &[u8], name: &Path) -> Result<Database, DbError> {
         let mut words = vec![0u64; bytes.len().div_ceil(8)];
         bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
-        Database::parse(Bytes::new(words, bytes.len()), name)
+        Database::parse(Bytes::Owned(words, bytes.len()), name)
     }
 
     /// Writes the database atomically.
