@@ -15,6 +15,7 @@ use std::path::Path;
 use terrasynth::database::layout;
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
+use terrasynth::level::c2;
 use terrasynth::level::state::{State, level_size};
 use terrasynth::stages::correct::nudge::{MAX_TOL, Target};
 use terrasynth::stages::correct::{
@@ -83,10 +84,12 @@ proptest! {
 #[test]
 fn c2_table_holds_the_diagonals_of_every_similarity_entry() {
     let db = default_db();
+    let mut bytes = 0;
     for i in 0..db.level_count() {
         let atlas = AtlasLevel::new(db, i);
         let level = &atlas.level;
         assert_eq!(atlas.c2.len(), level.appearance.len(), "level {i}");
+        bytes += std::mem::size_of_val(&atlas.c2[..]);
         for (u, (&c, quad)) in level.similar.iter().zip(&atlas.c2).enumerate() {
             let (x, y) = layout::unpack(c);
             let texel = |dx: i32, dy: i32| {
@@ -97,6 +100,8 @@ fn c2_table_holds_the_diagonals_of_every_similarity_entry() {
             assert_eq!(quad.0, want, "level {i}, texel {u}");
         }
     }
+    // What `db info` reports.
+    assert_eq!(c2::table_bytes(db), bytes);
 }
 
 #[test]

@@ -9,7 +9,7 @@
 //! `S(p)`, which neighbouring pixels share, so the entries are read in
 //! the order the level is walked and come from cache, one line each.
 
-use crate::database::Level;
+use crate::database::{Database, Level};
 use crate::level::atlas::Column;
 use rayon::prelude::*;
 
@@ -44,4 +44,12 @@ pub fn gather(level: &Level<'_>, columns: &[Column]) -> Vec<Quad> {
         .map(quad)
         .collect_into_vec(&mut out);
     out
+}
+
+/// Bytes of the tables of every level of `db` (what CPU synthesis keeps
+/// besides the database: `db info` reports it).
+pub fn table_bytes(db: &Database) -> usize {
+    (0..db.level_count())
+        .map(|i| db.level(i).similar.len() * std::mem::size_of::<Quad>())
+        .sum()
 }

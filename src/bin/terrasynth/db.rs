@@ -4,6 +4,7 @@ use crate::{CliResult, args::Input, progress::Bar};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
+use terrasynth::level::c2;
 
 #[derive(clap::Subcommand)]
 pub enum Command {
@@ -137,6 +138,7 @@ fn info(a: InfoArgs) -> CliResult {
             "base_pixels": db.base_pixels(),
             "bytes_per_pixel": db.bytes_per_pixel(),
             "load_ms": load_ms,
+            "cpu_table_bytes": c2::table_bytes(&db),
             "quantization": {"offset_m": q.offset_m, "scale_m": q.scale_m},
             "exemplars": m.exemplars,
             "levels": m.levels.iter().enumerate().map(|(i, l)| serde_json::json!({
@@ -159,6 +161,10 @@ fn info(a: InfoArgs) -> CliResult {
         db.file_bytes().len() as f64 / (1 << 20) as f64,
         db.base_pixels(),
         db.bytes_per_pixel()
+    );
+    println!(
+        "            + {:.1} MiB while synthesizing on the CPU (C2's diagonal texels, 32 bytes/texel)",
+        c2::table_bytes(&db) as f64 / (1 << 20) as f64
     );
     println!(
         "heights:    h = {:.3} m + {:.5} m x unit (16-bit units)",
