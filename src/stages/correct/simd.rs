@@ -22,7 +22,7 @@
 //!   The span reads C₂'s four diagonal texels from `AtlasLevel::c2[u]`
 //!   instead (gathered once per database level, [`crate::level::c2`]),
 //!   near `S(p)` like C₁, and looks up `similar[u]` only for a winner
-//!   (C₂ won 0.4 % of the pixels of a 1024² synthesis; at 1024² the
+//!   (C₂ won under 0.5 % of the pixels of a 1024² synthesis; at 1024² the
 //!   correction ran ~8 % fewer instructions).
 //! - **Prefetched candidates.** Candidates are listed a few pixels ahead
 //!   of scoring and their texels prefetched (a software pipeline).
