@@ -12,10 +12,10 @@
 
 use proptest::prelude::*;
 use std::path::Path;
+use terrasynth::database::c2;
 use terrasynth::database::layout;
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
-use terrasynth::level::c2;
 use terrasynth::level::state::{State, level_size};
 use terrasynth::stages::correct::nudge::{MAX_TOL, Target};
 use terrasynth::stages::correct::{
@@ -89,8 +89,8 @@ fn c2_table_holds_the_diagonals_of_every_similarity_entry() {
         let atlas = AtlasLevel::new(db, i);
         let level = &atlas.level;
         assert_eq!(atlas.c2.len(), level.appearance.len(), "level {i}");
-        bytes += std::mem::size_of_val(&atlas.c2[..]);
-        for (u, (&c, quad)) in level.similar.iter().zip(&atlas.c2).enumerate() {
+        bytes += std::mem::size_of_val(atlas.c2);
+        for (u, (&c, quad)) in level.similar.iter().zip(atlas.c2).enumerate() {
             let (x, y) = layout::unpack(c);
             let texel = |dx: i32, dy: i32| {
                 let q = layout::pack(x.wrapping_add_signed(dx), y.wrapping_add_signed(dy));
@@ -102,6 +102,9 @@ fn c2_table_holds_the_diagonals_of_every_similarity_entry() {
     }
     // What `db info` reports.
     assert_eq!(c2::table_bytes(db), bytes);
+    // Built once per database: every synthesizer shares the same table.
+    let (a, b) = (AtlasLevel::new(db, 0), AtlasLevel::new(db, 0));
+    assert!(std::ptr::eq(a.c2, b.c2), "the table was built twice");
 }
 
 #[test]

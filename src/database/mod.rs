@@ -16,6 +16,7 @@
 
 pub mod appearance;
 mod build;
+pub mod c2;
 pub mod cache;
 pub mod default;
 pub mod error;
@@ -37,6 +38,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// Metadata stored as JSON in the file's first section.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -127,6 +129,8 @@ pub struct Database {
     heights: Range<usize>,
     levels: Vec<LevelRanges>,
     columns: Vec<Vec<u8>>,
+    /// C₂'s diagonal texels per level, built on first use ([`c2`]).
+    c2: OnceLock<Vec<Vec<c2::Quad>>>,
 }
 
 impl std::fmt::Debug for Database {
@@ -195,6 +199,27 @@ impl Database {
             seeds: bytemuck::cast_slice(&b[r.seeds.clone()]),
         }
     }
+    /// C₂'s diagonal texels of level `i` (the CPU correction's table,
+    /// [`c2`]), gathered for every level on first use.
+    ///
+    /// Built without a lock: a caller that finds the tables missing builds
+    /// them, and where two race one result is kept. No thread ever waits
+    /// on another, so a synthesis started inside a rayon task (tiles run
+    /// them so) cannot deadlock on the build's own parallel loop.
+    pub fn c2(&self, i: usize) -> &[c2::Quad] {
+        let tables = match self.c2.get() {
+            Some(t) => t,
+            None => {
+                let built = (0..self.level_count())
+                    .map(|i| c2::gather(&self.level(i)))
+                    .collect();
+                let _ = self.c2.set(built);
+                self.c2.get().expect("set just above")
+            }
+        };
+        &tables[i]
+    }
+
     /// Exemplar base pixels (level 0).
     pub fn base_pixels(&self) -> u64 {
         self.meta.levels[0].layout.texels()
@@ -271,6 +296,7 @@ impl Database {
             heights,
             levels,
             columns,
+            c2: OnceLock::new(),
         };
         for i in 0..db.level_count() {
             db.check_level(i).map_err(fail)?;

@@ -6,8 +6,8 @@
 //! row stride and base of each virtual column are tabulated once per level
 //! (a few KiB: cached) and an index is `base[x] + y·stride[x] + x`.
 
+use crate::database::c2::Quad;
 use crate::database::{Database, Level, layout::MARGIN};
-use crate::level::c2::{self, Quad};
 
 /// Per-column addressing of one level.
 ///
@@ -33,8 +33,9 @@ pub struct AtlasLevel<'a> {
     pub seed_counts: Vec<u32>,
     /// C₂'s four diagonal texels for every texel u (the CPU correction
     /// scores C₂(u) from here rather than chasing `similar[u]` across the
-    /// atlas; 32 bytes per texel, 32 MiB for the embedded database).
-    pub c2: Vec<Quad>,
+    /// atlas; 32 bytes per texel, 32 MiB for the embedded database; built
+    /// once per database, [`Database::c2`]).
+    pub c2: &'a [Quad],
 }
 
 impl<'a> AtlasLevel<'a> {
@@ -52,11 +53,10 @@ impl<'a> AtlasLevel<'a> {
                 };
             }
         }
-        let c2 = c2::gather(&level, &columns);
         AtlasLevel {
             level,
             columns,
-            c2,
+            c2: db.c2(i),
             seed_counts: db.meta().levels[i].seed_counts.clone(),
         }
     }

@@ -7,6 +7,5 @@
 //! re-exports them under their old paths (`synth::fixed`, …).
 
 pub mod atlas;
-pub mod c2;
 pub mod fixed;
 pub mod state;

@@ -3,8 +3,8 @@
 use crate::{CliResult, args::Input, progress::Bar};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use terrasynth::database::c2;
 use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
-use terrasynth::level::c2;
 
 #[derive(clap::Subcommand)]
 pub enum Command {

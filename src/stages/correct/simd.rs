@@ -20,7 +20,7 @@
 //!   which at level 0 outgrows the L2 cache: reading `similar[u]`, then
 //!   the texels it names, were two cache misses in a row per candidate.
 //!   The span reads C₂'s four diagonal texels from `AtlasLevel::c2[u]`
-//!   instead (gathered once per database level, [`crate::level::c2`]),
+//!   instead (gathered once per database, [`crate::database::c2`]),
 //!   near `S(p)` like C₁, and looks up `similar[u]` only for a winner
 //!   (C₂ won under 0.5 % of the pixels of a 1024² synthesis; at 1024² the
 //!   correction ran ~8 % fewer instructions).
@@ -248,7 +248,7 @@ fn decide<const P: u32, const AVX2: bool>(
         let fixed = (!free).then_some(v);
         let t = diagonals(app, idx, col.stride as i32);
         let (sc, h_prev) = score_with::<P>(ns, &t, 1, fixed, vp);
-        let (cost, i, hh) = best_of::<P, AVX2>(app, &atlas.c2, ns, p, weigh(sc, w), vp);
+        let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, p, weigh(sc, w), vp);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -257,7 +257,7 @@ fn decide<const P: u32, const AVX2: bool>(
         }
         return finish(atlas, st, at, p, (cost, i, hh), g);
     }
-    let winner = best_of::<P, AVX2>(app, &atlas.c2, ns, p, u32::MAX, vp);
+    let winner = best_of::<P, AVX2>(app, atlas.c2, ns, p, u32::MAX, vp);
     finish(atlas, st, at, p, winner, g)
 }
 

@@ -126,7 +126,7 @@ fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending
     let app = atlas.level.appearance;
     prefetch(app, pair.idx - pair.stride - 1);
     prefetch(app, pair.idx + pair.stride - 1);
-    prefetch(&atlas.c2, u_idx);
+    prefetch(atlas.c2, u_idx);
     out.pairs[out.count / 2] = pair;
     out.count += 2;
 }

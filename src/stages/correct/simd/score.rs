@@ -5,7 +5,7 @@
 use super::super::{CLAMP, DIAGONALS, FLAT, Prior};
 use super::gather::Pending;
 use super::grid::{Grid, Window, at, window};
-use crate::level::c2::Quad;
+use crate::database::c2::Quad;
 use wide::{i16x8, i32x4, i32x8};
 
 #[cfg(target_arch = "x86_64")]

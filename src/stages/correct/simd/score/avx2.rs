@@ -21,7 +21,7 @@
 use super::super::super::{CLAMP, FLAT, Prior};
 use super::super::gather::Pair;
 use super::Neighbourhood;
-use crate::level::c2::Quad;
+use crate::database::c2::Quad;
 use core::arch::x86_64::*;
 
 /// N_S (×3, V on mode 1) in the lane order of a candidate's

@@ -1,4 +1,4 @@
-//! C₂'s diagonal texels, gathered once per database level.
+//! C₂'s diagonal texels, gathered once per opened database.
 //!
 //! Why: correction scores every pixel's C₂ candidates, `C₂(u)` of each
 //! distinct `u = S(p+Δ) − Δ`, by the four diagonal texels around them.
@@ -8,9 +8,13 @@
 //! entry holds those four texels themselves, 32-byte aligned: `u` is near
 //! `S(p)`, which neighbouring pixels share, so the entries are read in
 //! the order the level is walked and come from cache, one line each.
+//!
+//! Derived data of the CPU path (the WGSL kernel reads `similar`): built
+//! when the database's first `Synthesizer` is made ([`super::Database::c2`])
+//! and shared by every later one, so that short runs (a window, a Dask
+//! chunk, a getter that makes a `Synthesizer`) do not pay for it again.
 
-use crate::database::{Database, Level};
-use crate::level::atlas::Column;
+use super::{Database, Level};
 use crate::stages::isa::prefetch;
 use rayon::prelude::*;
 
@@ -27,14 +31,16 @@ pub struct Quad(pub [u64; 4]);
 ///
 /// Every similarity entry is an interior coordinate (the database checks
 /// them when it is opened), so its diagonals lie in its exemplar.
-pub fn gather(level: &Level<'_>, columns: &[Column]) -> Vec<Quad> {
+pub fn gather(level: &Level<'_>) -> Vec<Quad> {
     let app = level.appearance;
     let similar = level.similar;
-    // The texel index and row stride of a similarity entry.
+    // The texel index and row stride of a similarity entry (the database
+    // checked that every entry lies in an exemplar when it was opened).
     let at = |c: u32| {
         let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);
-        let col = &columns[x as usize];
-        (col.base + y * col.stride as i32 + x, col.stride as i32)
+        let r = &level.layout.rects[level.columns[x as usize] as usize];
+        let base = (r.offset as i64 - r.x0 as i64) as i32;
+        (base + y * r.width as i32 + x, r.width as i32)
     };
     // Entries point anywhere in the atlas: the rows of entry u + AHEAD are
     // asked for while entry u is read (this halved the build, which every
