@@ -14,7 +14,7 @@
 //! and shared by every later one, so that short runs (a window, a Dask
 //! chunk, a getter that makes a `Synthesizer`) do not pay for it again.
 
-use super::{Database, Level};
+use super::{Database, Level, layout};
 use crate::stages::isa::prefetch;
 use rayon::prelude::*;
 
@@ -27,6 +27,16 @@ const AHEAD: usize = 16;
 #[derive(Clone, Copy, Default, Debug, PartialEq)]
 pub struct Quad(pub [u64; 4]);
 
+impl Quad {
+    /// The diagonals of the texel with index `k` in an exemplar of row
+    /// stride `s` (the caller guarantees they lie in it).
+    #[inline(always)]
+    pub fn around(app: &[u64], k: i32, s: i32) -> Quad {
+        let t = |i: i32| app[i as usize];
+        Quad([t(k - s - 1), t(k + s - 1), t(k - s + 1), t(k + s + 1)])
+    }
+}
+
 /// The [`Quad`] of `C₂(u)` for every texel `u` of `level`, in texel order.
 ///
 /// Every similarity entry is an interior coordinate (the database checks
@@ -37,10 +47,9 @@ pub fn gather(level: &Level<'_>) -> Vec<Quad> {
     // The texel index and row stride of a similarity entry (the database
     // checked that every entry lies in an exemplar when it was opened).
     let at = |c: u32| {
-        let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);
+        let (x, y) = layout::unpack(c);
         let r = &level.layout.rects[level.columns[x as usize] as usize];
-        let base = (r.offset as i64 - r.x0 as i64) as i32;
-        (base + y * r.width as i32 + x, r.width as i32)
+        (r.index(x, y) as i32, r.width as i32)
     };
     // Entries point anywhere in the atlas: the rows of entry u + AHEAD are
     // asked for while entry u is read (this halved the build, which every
@@ -52,8 +61,7 @@ pub fn gather(level: &Level<'_>) -> Vec<Quad> {
             prefetch(app, k + s - 1);
         }
         let (k, s) = at(similar[u]);
-        let t = |i: i32| app[i as usize];
-        Quad([t(k - s - 1), t(k + s - 1), t(k - s + 1), t(k + s + 1)])
+        Quad::around(app, k, s)
     };
     // A pixel reads entries of three exemplar rows (16 KiB apart at 512
     // texels a row), and patches jump across the table (24 MiB at the

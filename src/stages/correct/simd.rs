@@ -46,12 +46,13 @@ mod score;
 use super::nudge::nudge;
 use super::scalar::reflect;
 use super::{ALL_TYPES, DELTAS, Guide, ParentRow, Prior, W_FREE, scalar, weigh};
+use crate::database::c2::Quad;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
 use gather::{Pending, gather};
 use grid::{CHUNK, GRID_COLS, Grid, Tap};
-use score::{Neighbourhood, best_of, column, diagonals, neighbourhood, score_with};
+use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
 /// cache misses of the (prefetched) candidate texels overlap useful work.
@@ -246,7 +247,7 @@ fn decide<const P: u32, const AVX2: bool>(
         // coherent: the previous result as is.
         let free = w >= W_FREE;
         let fixed = (!free).then_some(v);
-        let t = diagonals(app, idx, col.stride as i32);
+        let t = Quad::around(app, idx, col.stride as i32);
         let (sc, h_prev) = score_with::<P>(ns, &t, 1, fixed, vp);
         let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, p, weigh(sc, w), vp);
         if i == usize::MAX {

@@ -11,14 +11,6 @@ use wide::{i16x8, i32x4, i32x8};
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2;
 
-/// The four diagonal texels of the candidate whose texel index is `q` in
-/// an exemplar of row stride `s`, in [`Quad`]'s order.
-#[inline(always)]
-pub(super) fn diagonals(app: &[u64], q: i32, s: i32) -> Quad {
-    let t = |i: i32| app[i as usize];
-    Quad([t(q - s - 1), t(q + s - 1), t(q - s + 1), t(q + s + 1)])
-}
-
 /// The synthesis neighbourhood N_S (×3), two diagonals per vector, mode 1
 /// including the offsets V.
 #[derive(Clone, Copy)]
@@ -180,7 +172,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         return best;
     }
     for (j, pair) in pairs.iter().enumerate() {
-        let c1 = diagonals(app, pair.idx, pair.stride);
+        let c1 = Quad::around(app, pair.idx, pair.stride);
         let scored = [
             score_with::<P>(ns, &c1, 1, None, vp),
             score_with::<P>(ns, &c2[pair.u as usize], 2, None, vp),
