@@ -18,7 +18,7 @@
 //! after the saturating narrowing (as in [`super::score_with`]), and the
 //! squares summed by `madd` (16 terms ≤ 9459² each: no i32 overflow).
 
-use super::super::super::{CLAMP, FLAT};
+use super::super::super::{CLAMP, FLAT, Prior};
 use super::super::gather::Pair;
 use super::Neighbourhood;
 use crate::database::c2::Quad;
@@ -117,64 +117,25 @@ fn residuals_of<const P: u32>(ns: &Ns256, t: __m256i) -> Residuals {
     }
 }
 
-/// The optimal offsets of a pair's two candidates, `a` in lane 0 and `b`
-/// in lane 1, from their Σ d₁ (`sums`, the same lanes), and their priors'
-/// costs: [`Prior::optimal`](crate::stages::correct::Prior::optimal) and [`Prior::cost`](crate::stages::correct::Prior::cost) of each candidate's prior
-/// (the pixel's, or [`FLAT`] for a flat candidate), both lanes at once.
-///
-/// The floor division runs in f64 lanes, and it is exact: numerator and
-/// denominator are exact in f64, an integer quotient comes out exactly,
-/// and a non-integer one lies at least 1/den ≥ 1/36 from the next integer
-/// while the rounding error is below 2⁻⁵³·2³¹, so flooring the rounded
-/// quotient gives ⌊a/b⌋ for every i32 numerator (formed in wrapping i32
-/// lanes, as the scalar form forms it). The scalar closed forms took two
-/// constant divisions with sign fix-ups and two branches per pair.
+/// The optimal offset of a candidate with residuals `r` and Σ d₁ = `sum1`,
+/// its prior's cost, and its clamped residuals squared and summed in
+/// pairs (eight i32 lanes; their sum is the score before the prior).
 #[inline]
 #[target_feature(enable = "avx2")]
-fn offsets<const P: u32>(
-    a: &Residuals,
-    b: &Residuals,
-    sums: __m128i,
-    vp: i32,
-) -> (__m128i, __m128i) {
-    // Lanes 0 and 1: all ones where the candidate is flat.
-    let flat = _mm_set_epi32(0, 0, -(b.flat as i32), -(a.flat as i32));
-    let pick = |own: i32, flat_value: i32| {
-        _mm_blendv_epi8(_mm_set1_epi32(own), _mm_set1_epi32(flat_value), flat)
+fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
+    let (prior, h) = if r.flat {
+        (FLAT, FLAT.optimal(sum1))
+    } else {
+        let prior = Prior { weight: P, v: vp };
+        (prior, prior.optimal(sum1))
     };
-    let weight = pick(P as i32, FLAT.weight as i32);
-    let anchor = pick(vp, FLAT.v);
-    let den = pick(12 + 3 * P as i32, 12 + 3 * FLAT.weight as i32);
-    // Σ d₁ + 3P·V + ⌊den/2⌋, in wrapping i32 lanes.
-    let three_w = _mm_mullo_epi32(weight, _mm_set1_epi32(3));
-    let num = _mm_add_epi32(
-        _mm_add_epi32(sums, _mm_mullo_epi32(three_w, anchor)),
-        _mm_srai_epi32::<1>(den),
-    );
-    let q = _mm_div_pd(_mm_cvtepi32_pd(num), _mm_cvtepi32_pd(den));
-    let h = _mm_cvttpd_epi32(_mm_floor_pd(q));
-    // The prior's cost: P·(3(h − V))², the residual clamped to ±CLAMP.
-    let r = _mm_mullo_epi32(_mm_sub_epi32(h, anchor), _mm_set1_epi32(3));
-    let r = _mm_min_epi32(
-        _mm_max_epi32(r, _mm_set1_epi32(-CLAMP)),
-        _mm_set1_epi32(CLAMP),
-    );
-    let cost = _mm_mullo_epi32(weight, _mm_mullo_epi32(r, r));
-    (h, cost)
-}
-
-/// The clamped residuals of a candidate at offset `h`, squared and summed
-/// in pairs (eight i32 lanes; their sum is the score before the prior).
-#[inline]
-#[target_feature(enable = "avx2")]
-fn squares(r: &Residuals, h: i32) -> __m256i {
     let off = _mm256_blend_epi32::<0b0101_0101>(_mm256_setzero_si256(), _mm256_set1_epi32(3 * h));
     let d = _mm256_packs_epi32(_mm256_sub_epi32(r.even, off), r.odd);
     let d = _mm256_min_epi16(
         _mm256_max_epi16(d, _mm256_set1_epi16(-CLAMP as i16)),
         _mm256_set1_epi16(CLAMP as i16),
     );
-    _mm256_madd_epi16(d, d)
+    (h, prior.cost(h), _mm256_madd_epi16(d, d))
 }
 
 /// Scores and optimal offsets of a pair's C₁ (κ = 1) and C₂ (κ = 2), as
@@ -202,11 +163,9 @@ pub(super) unsafe fn score_pair<const P: u32>(
     // interleaved (a's in even lanes, b's in odd) and summed.
     let x = _mm256_blend_epi32::<0b1010_1010>(a.even, _mm256_slli_epi64::<32>(b.even));
     let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
-    let (h, costs) = offsets::<P>(&a, &b, _mm_add_epi32(x, _mm_unpackhi_epi64(x, x)), vp);
-    let (h, costs) = (_mm_cvtsi128_si64(h), _mm_cvtsi128_si64(costs));
-    let (ha, hb) = (h as i32, (h >> 32) as i32);
-    let (ca, cb) = (costs as u32, (costs >> 32) as u32);
-    let (sa, sb) = (squares(&a, ha), squares(&b, hb));
+    let sums = _mm_cvtsi128_si64(_mm_add_epi32(x, _mm_unpackhi_epi64(x, x)));
+    let (ha, ca, sa) = fit::<P>(&a, sums as i32, vp);
+    let (hb, cb, sb) = fit::<P>(&b, (sums >> 32) as i32, vp);
     // [a, a, b, b | a, a, b, b] → [a, a, b, b] → [a, b, a, b].
     let x = _mm256_hadd_epi32(sa, sb);
     let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
