@@ -3,7 +3,7 @@
 //! prefetched.
 
 use super::super::DELTAS;
-use super::grid::{Grid, Tap, at, window};
+use super::grid::{Grid, any_edge, at, window};
 use crate::level::atlas::AtlasLevel;
 use crate::stages::isa::prefetch;
 
@@ -20,11 +20,11 @@ pub(super) struct Pending {
 /// The two candidates of one u.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Pair {
-    /// C₁: texel index, row stride and atlas texel.
-    pub idx: i32,
+    /// C₁'s texel index: u's, unless u left its exemplar's interior and
+    /// was clamped back (the winner's coordinate is found by [`c1_texel`]).
+    pub c1: i32,
+    /// The row stride of C₁'s (and u's) exemplar.
     pub stride: i32,
-    pub x: i32,
-    pub y: i32,
     /// u's texel index: C₂ is `similar[u]`, its diagonal texels `c2[u]`
     /// (`AtlasLevel`). Only the winner's coordinate is ever looked up.
     pub u: i32,
@@ -43,20 +43,26 @@ pub(super) struct Pair {
 /// slower still).
 #[inline(always)]
 pub(super) fn gather(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, out: &mut Pending) {
-    let win = window(grid, c);
-    let taps: [&Tap; 9] = std::array::from_fn(|k| at(&win, DELTAS[k].0, DELTAS[k].1));
+    let (idx, stride) = (window(&grid.idx, c), window(&grid.stride, c));
     // u lies in the exemplar of S(n), one texel from its interior, so its
     // texel index identifies it.
+    let s: [i32; 9] = std::array::from_fn(|k| at(&stride, DELTAS[k].0, DELTAS[k].1));
     let u: [i32; 9] = std::array::from_fn(|k| {
         let (dx, dy) = DELTAS[k];
-        taps[k].idx - dx - dy * taps[k].stride
+        at(&idx, dx, dy) - dx - dy * s[k]
     });
     let mut first = firsts(&u);
     out.count = 0;
+    // C₁ is u itself unless a neighbour lies next to an edge (rare).
+    let edge = any_edge(grid, c);
     while first != 0 {
         let k = first.trailing_zeros() as usize;
         first &= first - 1;
-        list(atlas, taps[k], k, u[k], out);
+        let c1 = match edge {
+            true => clamped(atlas, grid, c, k, u[k], s[k]),
+            false => u[k],
+        };
+        list(atlas, k, c1, (u[k], s[k]), out);
     }
 }
 
@@ -104,31 +110,53 @@ fn firsts_scalar(u: &[i32; 9]) -> u32 {
     first
 }
 
-/// [`gather`]'s listing of C₁ and C₂ of Δ = `DELTAS[k]`, whose neighbour
-/// is `n` and u's texel index `u_idx`.
+/// [`gather`]'s listing of C₁ (texel index `c1`) and C₂ of Δ =
+/// `DELTAS[k]`, whose u has texel index `u_idx` in an exemplar of row
+/// stride `stride`.
 #[inline(always)]
-fn list(atlas: &AtlasLevel<'_>, n: &Tap, k: usize, u_idx: i32, out: &mut Pending) {
-    let (dx, dy) = DELTAS[k];
-    // C₁: u clamped into its exemplar's interior (same exemplar as S(n)).
-    let u = (n.sx - dx, n.sy - dy);
-    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
-    let pair = Pair {
-        idx: u_idx + (cx - u.0) + (cy - u.1) * n.stride,
-        stride: n.stride,
-        x: cx,
-        y: cy,
-        u: u_idx,
-        from: k as u8,
-    };
+fn list(atlas: &AtlasLevel<'_>, k: usize, c1: i32, (u_idx, stride): (i32, i32), out: &mut Pending) {
     // Scoring reads C₁'s texels q − s ± 1 and q + s ± 1 (the AVX2 scorer
     // the 32 bytes q ± s − 1 … q ± s + 2), near S(p), whose lines N_S
     // reads anyway; and C₂'s from `c2[u]`, one line.
     let app = atlas.level.appearance;
-    prefetch(app, pair.idx - pair.stride - 1);
-    prefetch(app, pair.idx + pair.stride - 1);
+    prefetch(app, c1 - stride - 1);
+    prefetch(app, c1 + stride - 1);
     prefetch(atlas.c2, u_idx);
-    out.pairs[out.count / 2] = pair;
+    out.pairs[out.count / 2] = Pair {
+        c1,
+        stride,
+        u: u_idx,
+        from: k as u8,
+    };
     out.count += 2;
+}
+
+/// C₁'s texel: u = t(n) − Δ of the neighbour at Δ = `DELTAS[k]` of the
+/// pixel in grid column `c`, clamped into its exemplar's interior (the
+/// same exemplar as t(n)).
+#[inline(always)]
+pub(super) fn c1_texel(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, k: usize) -> (i32, i32) {
+    let (dx, dy) = DELTAS[k];
+    let (r, j) = ((2 + dy) as usize, (c as i32 + dx) as usize);
+    atlas.clamp_interior(grid.sx[r][j] - dx, grid.sy[r][j] - dy)
+}
+
+/// C₁'s texel index: u clamped into its exemplar's interior (the pixel
+/// has a neighbour next to an edge).
+#[inline(never)]
+fn clamped(
+    atlas: &AtlasLevel<'_>,
+    grid: &Grid,
+    c: usize,
+    k: usize,
+    u_idx: i32,
+    stride: i32,
+) -> i32 {
+    let (dx, dy) = DELTAS[k];
+    let (r, j) = ((2 + dy) as usize, (c as i32 + dx) as usize);
+    let u = (grid.sx[r][j] - dx, grid.sy[r][j] - dy);
+    let (cx, cy) = c1_texel(atlas, grid, c, k);
+    u_idx + (cx - u.0) + (cy - u.1) * stride
 }
 
 #[cfg(test)]

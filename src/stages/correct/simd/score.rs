@@ -4,7 +4,7 @@
 
 use super::super::{CLAMP, DIAGONALS, FLAT, Prior};
 use super::gather::Pending;
-use super::grid::{Grid, Window, at, window};
+use super::grid::{Grid, at, window};
 use crate::database::c2::Quad;
 use wide::{i16x8, i32x4, i32x8};
 
@@ -88,12 +88,11 @@ pub(super) fn neighbourhood(
     left: &Column,
     right: &Column,
 ) -> Neighbourhood {
-    let win = window(grid, c);
     let [up_l, down_l] = *left;
     let [up_r, down_r] = *right;
     Neighbourhood {
-        ns01: wide::bytemuck::cast::<_, i32x8>([up_l, up_r]) + outer(app, &win, 0),
-        ns23: wide::bytemuck::cast::<_, i32x8>([down_l, down_r]) + outer(app, &win, 2),
+        ns01: wide::bytemuck::cast::<_, i32x8>([up_l, up_r]) + outer(app, grid, c, 0),
+        ns23: wide::bytemuck::cast::<_, i32x8>([down_l, down_r]) + outer(app, grid, c, 2),
     }
 }
 
@@ -108,14 +107,13 @@ pub(super) type Column = [i32x4; 2];
 #[inline(always)]
 pub(super) fn column(app: &[u64], grid: &Grid, j: usize) -> Column {
     // Rows 1 and 0 (δy = −1), rows 3 and 4 (δy = 1); the pixel's row is 2.
-    let (a_up, c_up) = (&grid[1][j], &grid[0][j]);
-    let (a_down, c_down) = (&grid[3][j], &grid[4][j]);
-    let near = [app[a_up.idx as usize], app[a_down.idx as usize]];
+    let (idx, stride, v) = (&grid.idx, &grid.stride, &grid.v);
+    let near = [app[idx[1][j] as usize], app[idx[3][j] as usize]];
     let far = [
-        app[(c_up.idx + c_up.stride) as usize],
-        app[(c_down.idx - c_down.stride) as usize],
+        app[(idx[0][j] + stride[0][j]) as usize],
+        app[(idx[4][j] - stride[4][j]) as usize],
     ];
-    let v = i32x8::new([a_up.v + c_up.v, 0, 0, 0, a_down.v + c_down.v, 0, 0, 0]);
+    let v = i32x8::new([v[1][j] + v[0][j], 0, 0, 0, v[3][j] + v[4][j], 0, 0, 0]);
     let sum = i32x8::from_i16x8(wide::bytemuck::cast(near))
         + i32x8::from_i16x8(wide::bytemuck::cast(far))
         + v;
@@ -125,11 +123,14 @@ pub(super) fn column(app: &[u64], grid: &Grid, j: usize) -> Column {
 /// The texels of N_S's diagonals k and k + 1 (δy alike) at v = (δx, 0),
 /// with their V on mode 1, as one vector.
 #[inline(always)]
-fn outer(app: &[u64], win: &Window<'_>, k: usize) -> i32x8 {
+fn outer(app: &[u64], grid: &Grid, c: usize, k: usize) -> i32x8 {
+    let (idx, v) = (window(&grid.idx, c), window(&grid.v, c));
     let texel = |k: usize| {
         let (dx, dy) = DIAGONALS[k];
-        let b = at(win, 2 * dx, dy);
-        (app[(b.idx - dx) as usize], b.v)
+        (
+            app[(at(&idx, 2 * dx, dy) - dx) as usize],
+            at(&v, 2 * dx, dy),
+        )
     };
     let ((t0, v0), (t1, v1)) = (texel(k), texel(k + 1));
     i32x8::from_i16x8(wide::bytemuck::cast([t0, t1])) + i32x8::new([v0, 0, 0, 0, v1, 0, 0, 0])
@@ -172,7 +173,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         return best;
     }
     for (j, pair) in pairs.iter().enumerate() {
-        let c1 = Quad::around(app, pair.idx, pair.stride);
+        let c1 = Quad::around(app, pair.c1, pair.stride);
         let scored = [
             score_with::<P>(ns, &c1, 1, None, vp),
             score_with::<P>(ns, &c2[pair.u as usize], 2, None, vp),

@@ -155,7 +155,7 @@ pub(super) unsafe fn score_pair<const P: u32>(
     vp: i32,
 ) -> [(u32, i32); 2] {
     // SAFETY: forwarded from the caller.
-    let a = unsafe { residuals::<P>(app, ns, pair.idx, pair.stride) };
+    let a = unsafe { residuals::<P>(app, ns, pair.c1, pair.stride) };
     let quad: *const Quad = &c2[pair.u as usize];
     // SAFETY: a `Quad` is 32 bytes, 32-byte aligned.
     let b = residuals_of::<P>(ns, unsafe { _mm256_load_si256(quad.cast()) });
