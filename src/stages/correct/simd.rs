@@ -50,8 +50,8 @@ use crate::database::c2::Quad;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use gather::{Pending, gather};
-use grid::{CHUNK, GRID_COLS, Grid, Tap};
+use gather::{Pending, c1_texel, gather};
+use grid::{CHUNK, Grid};
 use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
 
 /// Scoring runs this many pixels behind candidate gathering, so that the
@@ -141,7 +141,7 @@ fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
         x1,
         g,
     } = *span;
-    let mut grid: Grid = [[Tap::default(); GRID_COLS]; 5];
+    let mut grid = Grid::new();
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
@@ -175,7 +175,7 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
     // True by construction; stated so that the compiler knows every grid
     // column a pixel reads (≤ 2n + 2) is inside the grid.
     assert!(n <= CHUNK);
-    grid::fill(grid, atlas, st, y, x0, n, next);
+    grid::fill::<AVX2>(grid, atlas, st, y, x0, n, next);
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
     let parent = parent.map(|pa| ParentRow::new(pa, y));
@@ -207,8 +207,8 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
                     scalar::correct_pixel_guided(atlas, st, x, y, g, prior)
                 }
                 _ => {
-                    let at = (x0 + 2 * k, y);
-                    decide::<P, AVX2>(atlas, st, &ns, at, &ring[k % RING], g, prior.v)
+                    let at = ((x0 + 2 * k, y), 2 * k + 2);
+                    decide::<P, AVX2>(atlas, st, grid, &ns, at, &ring[k % RING], g, prior.v)
                 }
             };
             st.set(i, s, v);
@@ -218,19 +218,21 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
 
 /// Scores a gathered pixel's candidates against its synthesis
 /// neighbourhood `ns`; returns the winner's coordinate (with the fraction of
-/// the neighbour it came from) and optimal offset.
+/// the neighbour it came from) and optimal offset. `at`: the pixel's level
+/// position and grid column.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn decide<const P: u32, const AVX2: bool>(
     atlas: &AtlasLevel<'_>,
     st: &State,
+    grid: &Grid,
     ns: &Neighbourhood,
-    at: (usize, usize),
+    at: ((usize, usize), usize),
     p: &Pending,
     g: &Guide<'_>,
     vp: i32,
 ) -> (Coord, i32) {
-    let pixel = at.1 * st.width + at.0;
+    let pixel = at.0.1 * st.width + at.0.0;
     let app = atlas.level.appearance;
     // The coherence candidate first (a tie keeps the previous result), then
     // the rest in DELTAS order, C₁ before C₂ (ties keep the earlier).
@@ -256,10 +258,10 @@ fn decide<const P: u32, const AVX2: bool>(
                 false => (prev, v),
             };
         }
-        return finish(atlas, st, at, p, (cost, i, hh), g);
+        return finish(atlas, st, grid, at, p, (cost, i, hh), g);
     }
     let winner = best_of::<P, AVX2>(app, atlas.c2, ns, p, u32::MAX, vp);
-    finish(atlas, st, at, p, winner, g)
+    finish(atlas, st, grid, at, p, winner, g)
 }
 
 /// The winner's offset `v`, nudged towards the pixel's geometric target
@@ -281,7 +283,8 @@ fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>)
 fn finish(
     atlas: &AtlasLevel<'_>,
     st: &State,
-    (x, y): (usize, usize),
+    grid: &Grid,
+    ((x, y), c): ((usize, usize), usize),
     p: &Pending,
     best: (u32, usize, i32),
     g: &Guide<'_>,
@@ -289,7 +292,7 @@ fn finish(
     debug_assert!(best.1 < p.count);
     let pair = &p.pairs[best.1 / 2];
     let (q, idx) = match best.1 % 2 {
-        0 => ((pair.x, pair.y), pair.idx),
+        0 => (c1_texel(atlas, grid, c, pair.from as usize), pair.c1),
         _ => {
             let c = atlas.level.similar[pair.u as usize];
             let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);
