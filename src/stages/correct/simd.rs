@@ -16,6 +16,14 @@
 //!   small grid and the pixels take them from there. Likewise the two N_S
 //!   texels of a diagonal that lie in the grid column between two pixels
 //!   are summed once for both (8 texel reads per pixel instead of 12).
+//!   The grid is a structure of arrays, and the AVX2 copy fills its row
+//!   runs four neighbours at a time with one column lookup
+//!   ([`grid`]'s `avx2`).
+//! - **C₁ without the clamp.** C₁ = u clamped into u's exemplar's interior
+//!   is u itself unless a neighbour's texel lies on the interior's edge;
+//!   the fill flags those (1.3 % of the pixels at 1024²), so the rest
+//!   list and prefetch C₁ without a column lookup, and only the winner's
+//!   coordinate is ever formed.
 //! - **C₂ without chasing it.** C₂ entries point anywhere in the atlas,
 //!   which at level 0 outgrows the L2 cache: reading `similar[u]`, then
 //!   the texels it names, were two cache misses in a row per candidate.

@@ -131,18 +131,25 @@ fn list(atlas: &AtlasLevel<'_>, k: usize, c1: i32, (u_idx, stride): (i32, i32), 
     out.count += 2;
 }
 
-/// C₁'s texel: u = t(n) − Δ of the neighbour at Δ = `DELTAS[k]` of the
-/// pixel in grid column `c`, clamped into its exemplar's interior (the
-/// same exemplar as t(n)).
+/// The texel u = t(n) − Δ of the neighbour at Δ = `DELTAS[k]` of the
+/// pixel in grid column `c`.
 #[inline(always)]
-pub(super) fn c1_texel(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, k: usize) -> (i32, i32) {
+fn u_texel(grid: &Grid, c: usize, k: usize) -> (i32, i32) {
     let (dx, dy) = DELTAS[k];
     let (r, j) = ((2 + dy) as usize, (c as i32 + dx) as usize);
-    atlas.clamp_interior(grid.sx[r][j] - dx, grid.sy[r][j] - dy)
+    (grid.sx[r][j] - dx, grid.sy[r][j] - dy)
 }
 
-/// C₁'s texel index: u clamped into its exemplar's interior (the pixel
-/// has a neighbour next to an edge).
+/// C₁'s texel: [`u_texel`] clamped into its exemplar's interior (the same
+/// exemplar as t(n)).
+#[inline(always)]
+pub(super) fn c1_texel(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, k: usize) -> (i32, i32) {
+    let (ux, uy) = u_texel(grid, c, k);
+    atlas.clamp_interior(ux, uy)
+}
+
+/// C₁'s texel index, from u's (`u_idx`, in an exemplar of row stride
+/// `stride`), where the pixel has a neighbour next to an edge.
 #[inline(never)]
 fn clamped(
     atlas: &AtlasLevel<'_>,
@@ -152,10 +159,8 @@ fn clamped(
     u_idx: i32,
     stride: i32,
 ) -> i32 {
-    let (dx, dy) = DELTAS[k];
-    let (r, j) = ((2 + dy) as usize, (c as i32 + dx) as usize);
-    let u = (grid.sx[r][j] - dx, grid.sy[r][j] - dy);
-    let (cx, cy) = c1_texel(atlas, grid, c, k);
+    let u = u_texel(grid, c, k);
+    let (cx, cy) = atlas.clamp_interior(u.0, u.1);
     u_idx + (cx - u.0) + (cy - u.1) * stride
 }
 

@@ -242,3 +242,98 @@ pub(super) fn any_edge(grid: &Grid, c: usize) -> bool {
     };
     (row(1) | row(2) | row(3)) & 0x00FF_FFFF != 0
 }
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::{CHUNK, Field, Grid, fill};
+    use crate::database::default::build_default;
+    use crate::database::layout::MARGIN;
+    use crate::level::atlas::AtlasLevel;
+    use crate::level::fixed::{Coord, FRAC_BITS};
+    use crate::level::state::State;
+    use crate::progress::Silent;
+
+    /// A state of short coherent runs (four in a row usually share an
+    /// exemplar: the vector path) that jump between exemplars (its
+    /// fallback) and often sit on an interior edge (the `edge` flags),
+    /// with random fractions and offsets.
+    fn runs_state(atlas: &AtlasLevel<'_>, w: usize, h: usize, seed: u64) -> State {
+        let mut x = seed | 1;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let rects = &atlas.level.layout.rects;
+        let st = State::new(w, h);
+        let (mut left, mut at) = (0, (0i32, 0i32, 0i32, 0i32));
+        for i in 0..w * h {
+            if left == 0 {
+                let r = rects[next() as usize % rects.len()];
+                let (lo, hi) = ((r.x0 + MARGIN) as i32, (r.x0 + r.width - 1 - MARGIN) as i32);
+                let (top, bottom) = (MARGIN as i32, (r.height - 1 - MARGIN) as i32);
+                let pick = |b: u64, lo: i32, hi: i32| match b % 4 {
+                    0 => lo,
+                    1 => hi,
+                    _ => lo + (b / 4 % (hi - lo + 1) as u64) as i32,
+                };
+                at = (pick(next(), lo, hi), pick(next(), top, bottom), lo, hi);
+                left = 1 + next() % 12;
+            }
+            left -= 1;
+            let b = next();
+            let fx = (b & 0xFF) as i32 - 128;
+            let fy = ((b >> 8) & 0xFF) as i32 - 128;
+            let v = ((b >> 16) % 801) as i32 - 400;
+            let s = Coord {
+                x: (at.0 << FRAC_BITS) + fx,
+                y: (at.1 << FRAC_BITS) + fy,
+            };
+            st.set(i, s, v);
+            at.0 = (at.0 + 1).min(at.3);
+        }
+        st
+    }
+
+    fn same<T: PartialEq + std::fmt::Debug>(a: &Field<T>, b: &Field<T>, what: &str) {
+        assert_eq!(a, b, "{what} differs between the AVX2 and the scalar fill");
+    }
+
+    /// `fill::<true>` (row runs four at a time in AVX2) leaves every field
+    /// of the grid as `fill::<false>` does, chunk after chunk, first rows
+    /// and continued ones, at the level's borders too.
+    #[test]
+    fn avx2_fill_matches_the_scalar_fill() {
+        if !(std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("bmi2")) {
+            eprintln!("skipped: this CPU has no AVX2/BMI2");
+            return;
+        }
+        let db = build_default(&Silent).expect("the default database builds");
+        for level in [0, 1, 3] {
+            let atlas = AtlasLevel::new(&db, level);
+            for (w, h, seed) in [(2 * CHUNK + 9, 11, 7u64), (37, 6, 11), (5, 5, 13)] {
+                let st = runs_state(&atlas, w, h, seed);
+                let (mut a, mut b) = (Grid::new(), Grid::new());
+                for px in 0..2 {
+                    let mut x0 = px;
+                    while x0 < w {
+                        let n = (w - x0).div_ceil(2).min(CHUNK);
+                        for (j, y) in (px..h).step_by(2).enumerate() {
+                            fill::<true>(&mut a, &atlas, &st, y, x0, n, j > 0);
+                            fill::<false>(&mut b, &atlas, &st, y, x0, n, j > 0);
+                            let at = format!("level {level} {w}x{h} row {y} from {x0}");
+                            same(&a.idx, &b.idx, &format!("idx ({at})"));
+                            same(&a.stride, &b.stride, &format!("stride ({at})"));
+                            same(&a.v, &b.v, &format!("v ({at})"));
+                            same(&a.edge, &b.edge, &format!("edge ({at})"));
+                            same(&a.sx, &b.sx, &format!("sx ({at})"));
+                            same(&a.sy, &b.sy, &format!("sy ({at})"));
+                        }
+                        x0 += 2 * n;
+                    }
+                }
+            }
+        }
+    }
+}
