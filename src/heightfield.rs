@@ -22,6 +22,15 @@ pub struct Stats {
     pub nodata: usize,
 }
 
+/// [`Heightfield::extent`]: the range of the valid samples and how many
+/// are nodata.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extent {
+    /// (min, max) of the valid samples; `None` when there are none.
+    pub range: Option<(f32, f32)>,
+    pub nodata: usize,
+}
+
 pub use crate::georef::Georef;
 
 /// A row-major grid of heights in metres; row 0 is north, column 0 is west.
@@ -169,6 +178,36 @@ impl Heightfield {
         mask.iter().any(|&m| m).then_some(mask)
     }
 
+    /// The smallest and largest valid heights (`None` when every sample is
+    /// nodata) and the nodata count, in one parallel pass. What writers
+    /// need before they quantize: [`Heightfield::stats`]' mean is a serial
+    /// sum (its rounding depends on the order), and at 1024² its pass,
+    /// run on one core after a synthesis that used all of them, was a
+    /// visible part of a `synth` process. Min and max do not depend on the
+    /// order, so these equal `stats()`'s.
+    pub fn extent(&self) -> Extent {
+        use rayon::prelude::*;
+        let fold = |(mut lo, mut hi, mut nodata): (f32, f32, usize), &v: &f32| {
+            if v.is_nan() {
+                nodata += 1;
+            } else {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            (lo, hi, nodata)
+        };
+        let empty = (f32::INFINITY, f32::NEG_INFINITY, 0);
+        let (lo, hi, nodata) = self
+            .data
+            .par_chunks(1 << 16)
+            .map(|c| c.iter().fold(empty, fold))
+            .reduce(|| empty, |a, b| (a.0.min(b.0), a.1.max(b.1), a.2 + b.2));
+        Extent {
+            range: (nodata < self.data.len()).then_some((lo, hi)),
+            nodata,
+        }
+    }
+
     /// Min, max and mean over valid samples; `None` when every sample is nodata.
     pub fn stats(&self) -> Option<Stats> {
         let (mut min, mut max, mut sum, mut valid) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f64, 0);
@@ -271,6 +310,35 @@ mod tests {
         assert_eq!((s.min, s.max, s.valid, s.nodata), (1.0, 5.0, 3, 1));
         assert!((s.mean - 3.0).abs() < 1e-12);
         assert_eq!(hf.nodata_mask().unwrap(), vec![false, true, false, false]);
+    }
+
+    #[test]
+    fn extent_is_the_range_and_nodata_count_of_stats() {
+        // Several parallel chunks (2^16 samples each), nodata in some, the
+        // extremes in the last: a chunk left out or misfolded changes it.
+        let (w, h) = (700, 300);
+        let mut hf = Heightfield::from_fn(w, h, 1.0, |x, y| {
+            ((x * 7919 + y * 104_729) % 1000) as f32 * 0.5 - 100.0
+        })
+        .unwrap();
+        for (x, y) in [(3, 0), (699, 150), (10, 299)] {
+            hf.set(x, y, f32::NAN);
+        }
+        hf.set(650, 299, -1234.5);
+        hf.set(651, 299, 4321.25);
+        let s = hf.stats().unwrap();
+        let e = hf.extent();
+        assert_eq!(e.range, Some((s.min, s.max)));
+        assert_eq!(e.range, Some((-1234.5, 4321.25)));
+        assert_eq!(e.nodata, 3);
+        let none = Heightfield::from_vec(1, 2, 1.0, vec![f32::NAN; 2]).unwrap();
+        assert_eq!(
+            none.extent(),
+            Extent {
+                range: None,
+                nodata: 2
+            }
+        );
     }
 
     #[test]

@@ -145,8 +145,9 @@ pub(super) fn encode32(hf: &Heightfield) -> Result<Encoded, FormatError> {
         south_up: false,
     };
     let (min, max) = hf
-        .stats()
-        .map_or((0.0, 0.0), |s| (s.min as f64, s.max as f64));
+        .extent()
+        .range
+        .map_or((0.0, 0.0), |(lo, hi)| (lo as f64, hi as f64));
     Ok(Encoded {
         bytes: hf.data().iter().flat_map(|v| v.to_le_bytes()).collect(),
         sidecar: Some(sidecar.to_json(min, max)),

@@ -61,7 +61,11 @@ pub fn synth_scene(
     let mut session = scene_session(&db, &scene, backend)?;
     let frame = session.apply(first)?;
     write_output(&frame.heightfield, output, None, engine, &inputs)?;
-    let s = frame.heightfield.stats().expect("synthesis has no nodata");
+    let (lo, hi) = frame
+        .heightfield
+        .extent()
+        .range
+        .expect("synthesis has no nodata");
     eprintln!(
         "wrote {} ({} x {}, seed {}, {} points, {} curves, {} junctions): heights {:.1} .. {:.1} m in {:.0} ms",
         output.display(),
@@ -71,8 +75,8 @@ pub fn synth_scene(
         scene.points.len(),
         scene.curves.len(),
         edits.junctions().len(),
-        s.min,
-        s.max,
+        lo,
+        hi,
         frame.time.as_secs_f64() * 1e3
     );
     if let Some(p) = preview {
