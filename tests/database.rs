@@ -3,7 +3,7 @@
 use proptest::prelude::*;
 use std::sync::OnceLock;
 use terrasynth::database::{
-    self, BuildOptions, Database, ExemplarInput, TypeMask, appearance, layout, types,
+    self, BuildOptions, Database, ExemplarInput, TypeMask, appearance, c2, c2_cache, layout, types,
 };
 use terrasynth::{Heightfield, progress::Silent};
 
@@ -285,6 +285,33 @@ fn fuzz_seeds_load_and_their_prefixes_fail_cleanly() {
             let err = Database::from_bytes(&bytes[..cut], &p).unwrap_err();
             assert!(err.to_string().contains(&*p.to_string_lossy()), "{err}");
         }
+    }
+    // C₂ table files: the seed keeps the tables of the tsdb seed (a
+    // golden file: `TERRASYNTH_BLESS=1` rewrites it, for review).
+    let tiny =
+        Database::from_bytes(&std::fs::read(root.join("tsdb/tiny.tsdb")).unwrap(), &root).unwrap();
+    let tables: Vec<Vec<c2::Quad>> = (0..tiny.level_count())
+        .map(|i| c2::gather(&tiny.level(i)))
+        .collect();
+    let views: Vec<&[c2::Quad]> = tables.iter().map(|t| t.as_slice()).collect();
+    let expected = c2_cache::encode(tiny.fingerprint(), &views);
+    let seed = root.join("c2_cache/tiny.c2");
+    if std::env::var_os("TERRASYNTH_BLESS").is_some() {
+        std::fs::create_dir_all(seed.parent().unwrap()).unwrap();
+        std::fs::write(&seed, &expected).unwrap();
+    }
+    assert_eq!(files("c2_cache"), std::slice::from_ref(&seed));
+    let bytes = std::fs::read(&seed).unwrap();
+    assert!(
+        bytes == expected,
+        "{} is not tiny.tsdb's tables",
+        seed.display()
+    );
+    let counts: Vec<usize> = tables.iter().map(|t| t.len()).collect();
+    let ranges = c2_cache::decode(&bytes, tiny.fingerprint(), &counts).unwrap();
+    assert_eq!(ranges.len(), tiny.level_count());
+    for cut in 0..bytes.len() {
+        assert!(c2_cache::decode(&bytes[..cut], tiny.fingerprint(), &counts).is_err());
     }
     for p in files("type_mask") {
         let bytes = std::fs::read(&p).unwrap();

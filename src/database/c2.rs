@@ -14,9 +14,11 @@
 //! and shared by every later one, so that short runs (a window, a Dask
 //! chunk, a getter that makes a `Synthesizer`) do not pay for it again.
 
+use super::file::Bytes;
 use super::{Database, Level, layout};
 use crate::stages::isa::prefetch;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// How many entries ahead [`gather`] prefetches.
 const AHEAD: usize = 16;
@@ -24,7 +26,7 @@ const AHEAD: usize = 16;
 /// The four diagonal texels of one C₂, in the AVX2 scorer's order:
 /// (−1,−1), (−1,1), (1,−1), (1,1) (the `u64` appearance texels).
 #[repr(C, align(32))]
-#[derive(Clone, Copy, Default, Debug, PartialEq)]
+#[derive(Clone, Copy, Default, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Quad(pub [u64; 4]);
 
 impl Quad {
@@ -74,6 +76,25 @@ pub fn gather(level: &Level<'_>) -> Vec<Quad> {
         .map(quad)
         .collect_into_vec(&mut out);
     out
+}
+
+/// The tables of every level of a database: gathered in this process, or
+/// mapped from the file that keeps them ([`super::c2_cache`]).
+pub enum Tables {
+    Gathered(Vec<Vec<Quad>>),
+    /// The file and each level's byte range in it (checked to be 32-byte
+    /// aligned when the file was opened).
+    Mapped(Bytes, Vec<Range<usize>>),
+}
+
+impl Tables {
+    /// Level `i`'s table.
+    pub fn level(&self, i: usize) -> &[Quad] {
+        match self {
+            Tables::Gathered(t) => &t[i],
+            Tables::Mapped(b, r) => bytemuck::cast_slice(&b.as_slice()[r[i].clone()]),
+        }
+    }
 }
 
 /// Bytes of the tables of every level of `db` (what CPU synthesis keeps

@@ -107,14 +107,19 @@ pub fn cache_dir() -> PathBuf {
 
 /// Loads the default database cached in `dir` (normally [`cache_dir`]),
 /// building and caching it if needed. Returns the database and whether it
-/// was just built.
+/// was just built. C₂'s tables ([`Database::c2`]) are kept beside it.
 pub fn load_or_build(dir: &Path, progress: &dyn Progress) -> Result<(Database, bool), DbError> {
-    cache::load_or_build(&cache_path(dir), || build_default(progress))
+    let path = cache_path(dir);
+    let (mut db, built) = cache::load_or_build(&path, || build_default(progress))?;
+    db.keep_c2_at(path.with_extension("c2"));
+    Ok((db, built))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::database::c2::{self, Quad};
+    use crate::database::c2_cache;
 
     #[test]
     fn embedded_exemplars_decode_with_types() {
@@ -141,5 +146,33 @@ mod tests {
         std::fs::write(cache_path(&dir), b"junk").unwrap();
         let (c, built) = load_or_build(&dir, silent).unwrap();
         assert!(built && c.file_bytes() == a.file_bytes());
+        // C₂'s tables: the first use gathers them and keeps them beside
+        // the database.
+        let c2_path = cache_path(&dir).with_extension("c2");
+        assert!(!c2_path.exists());
+        let gathered: Vec<Vec<Quad>> = (0..a.level_count())
+            .map(|i| c2::gather(&a.level(i)))
+            .collect();
+        assert_eq!(a.c2(0), gathered[0].as_slice());
+        let kept = std::fs::read(&c2_path).unwrap();
+        // A process that finds them uses the file as it is: here a valid
+        // file whose level-0 entries were changed (a gathering would undo it).
+        let mut changed = gathered.clone();
+        changed[0][7].0[2] ^= 1;
+        let views: Vec<&[Quad]> = changed.iter().map(|t| t.as_slice()).collect();
+        std::fs::write(&c2_path, c2_cache::encode(a.fingerprint(), &views)).unwrap();
+        let (d, _) = load_or_build(&dir, silent).unwrap();
+        for (i, t) in changed.iter().enumerate() {
+            assert_eq!(d.c2(i), t.as_slice(), "level {i}");
+        }
+        // A damaged file is refused: the tables are gathered and kept again.
+        let mut damaged = kept.clone();
+        damaged[kept.len() / 2] ^= 0x40;
+        std::fs::write(&c2_path, &damaged).unwrap();
+        let (e, _) = load_or_build(&dir, silent).unwrap();
+        for (i, t) in gathered.iter().enumerate() {
+            assert_eq!(e.c2(i), t.as_slice(), "level {i}");
+        }
+        assert!(std::fs::read(&c2_path).unwrap() == kept);
     }
 }

@@ -17,6 +17,7 @@
 pub mod appearance;
 mod build;
 pub mod c2;
+pub mod c2_cache;
 pub mod cache;
 pub mod default;
 pub mod error;
@@ -37,7 +38,7 @@ use file::{Bytes, Kind};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// Metadata stored as JSON in the file's first section.
@@ -130,7 +131,10 @@ pub struct Database {
     levels: Vec<LevelRanges>,
     columns: Vec<Vec<u8>>,
     /// C₂'s diagonal texels per level, built on first use ([`c2`]).
-    c2: OnceLock<Vec<Vec<c2::Quad>>>,
+    c2: OnceLock<c2::Tables>,
+    /// Where they are kept across processes, if anywhere
+    /// ([`Database::keep_c2_at`]).
+    c2_file: Option<PathBuf>,
 }
 
 impl std::fmt::Debug for Database {
@@ -200,7 +204,8 @@ impl Database {
         }
     }
     /// C₂'s diagonal texels of level `i` (the CPU correction's table,
-    /// [`c2`]), gathered for every level on first use.
+    /// [`c2`]), gathered for every level on first use, or mapped from the
+    /// file that keeps them ([`Database::keep_c2_at`]).
     ///
     /// Built without a lock: a caller that finds the tables missing builds
     /// them, and where two race one result is kept. No thread ever waits
@@ -210,14 +215,41 @@ impl Database {
         let tables = match self.c2.get() {
             Some(t) => t,
             None => {
-                let built = (0..self.level_count())
-                    .map(|i| c2::gather(&self.level(i)))
-                    .collect();
-                let _ = self.c2.set(built);
+                let file = self.c2_file.as_deref();
+                let tables = file
+                    .and_then(|p| c2_cache::load(p, self))
+                    .unwrap_or_else(|| {
+                        let built: Vec<_> = (0..self.level_count())
+                            .map(|i| c2::gather(&self.level(i)))
+                            .collect();
+                        if let Some(p) = file {
+                            c2_cache::save(p, self, &built);
+                        }
+                        c2::Tables::Gathered(built)
+                    });
+                let _ = self.c2.set(tables);
                 self.c2.get().expect("set just above")
             }
         };
-        &tables[i]
+        tables.level(i)
+    }
+
+    /// Keeps C₂'s tables ([`Database::c2`]) in the file `path` across
+    /// processes: they are mapped from it when it holds this database's
+    /// tables, else gathered and written there. For databases in the
+    /// cache directory ([`c2_cache`]); has no effect once the tables exist.
+    pub fn keep_c2_at(&mut self, path: PathBuf) {
+        self.c2_file = Some(path);
+    }
+
+    /// Which database this is, for files derived from it: the CRC-32 of
+    /// the file's header (which covers every section's CRC) and its length.
+    pub fn fingerprint(&self) -> c2_cache::Fingerprint {
+        let b = self.file_bytes();
+        c2_cache::Fingerprint {
+            crc: u32::from_le_bytes(b[24..28].try_into().expect("a checked header")),
+            len: b.len() as u64,
+        }
     }
 
     /// Exemplar base pixels (level 0).
@@ -297,6 +329,7 @@ impl Database {
             levels,
             columns,
             c2: OnceLock::new(),
+            c2_file: None,
         };
         for i in 0..db.level_count() {
             db.check_level(i).map_err(fail)?;
