@@ -24,7 +24,9 @@ use std::ops::Range;
 const AHEAD: usize = 16;
 
 /// The four diagonal texels of one C₂, in the AVX2 scorer's order:
-/// (−1,−1), (−1,1), (1,−1), (1,1) (the `u64` appearance texels).
+/// (−1,−1), (−1,1), (1,−1), (1,1) (the `u64` appearance texels). Files
+/// keep them in this order ([`super::c2_cache`]): a change of it is a new
+/// `FORMAT` there.
 #[repr(C, align(32))]
 #[derive(Clone, Copy, Default, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Quad(pub [u64; 4]);
