@@ -13,6 +13,7 @@ use super::tint::{self, pack};
 use super::types::TypeOverlay;
 use super::{Grid, Lighting, RenderError, RenderOptions, Sea, preview_size};
 use crate::heightfield::Heightfield;
+use rayon::prelude::*;
 
 /// Kernel height units per metre (millimetres).
 pub const UNITS_PER_M: f64 = 1000.0;
@@ -81,12 +82,16 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
     let (w, h) = (hf.width(), hf.height());
     // The minimum is a wish and yields to the maximum.
     let (ow, oh) = preview_size::fit(w, h, o.min_size.min(o.max_size), o.max_size);
-    let resized = preview_size::heights(hf.data(), w, h, ow, oh);
-    let heights: Vec<i32> = resized.iter().map(|&v| quantize(v as f64)).collect();
+    // In parallel, and without a copy where the preview has the terrain's
+    // size: after a synthesis this ran on one core while the other idled.
+    let heights: Vec<i32> = preview_size::heights(hf.data(), w, h, ow, oh)
+        .par_iter()
+        .map(|&v| quantize(v as f64))
+        .collect();
     let (sx, sy) = (ow as f64 / w as f64, oh as f64 / h as f64);
     let cell_x = hf.cell_size() / sx;
     let cell_y = hf.cell_size() / sy;
-    let range = hf.stats().map(|s| (s.min as f64, s.max as f64));
+    let range = hf.extent().range.map(|(lo, hi)| (lo as f64, hi as f64));
 
     let mut p = ShadeParams::zeroed_with_size(ow as u32, oh as u32);
     set_lights(&mut p, &o.lighting);

@@ -8,6 +8,7 @@
 //! alias the light and break contour lines).
 
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// The preview's size for a `width × height` grid: the long side is brought
 /// to at most `max_size` (uniform scale, rounded, each side ≥ 1), or, when it
@@ -36,10 +37,11 @@ pub fn fit(width: usize, height: usize, min_size: usize, max_size: usize) -> (us
 /// input samples under its filter, or nodata when they carry less than half
 /// of the filter's weight — so holes neither grow nor shrink noticeably.
 /// (The cubic's negative lobes make this approximate next to holes; the
-/// result stays a weighted mean of nearby valid samples.)
-pub fn heights(data: &[f32], w: usize, h: usize, ow: usize, oh: usize) -> Vec<f32> {
+/// result stays a weighted mean of nearby valid samples.) At the same size,
+/// the samples themselves.
+pub fn heights(data: &[f32], w: usize, h: usize, ow: usize, oh: usize) -> Cow<'_, [f32]> {
     if (w, h) == (ow, oh) {
-        return data.to_vec();
+        return Cow::Borrowed(data);
     }
     let tx = taps(w, ow);
     let ty = taps(h, oh);
@@ -58,7 +60,7 @@ pub fn heights(data: &[f32], w: usize, h: usize, ow: usize, oh: usize) -> Vec<f3
             *o = apply(t, |i| mid[i * ow + x]);
         }
     });
-    out
+    Cow::Owned(out)
 }
 
 /// Nearest-neighbour resampling of an index map (type masks: indices must

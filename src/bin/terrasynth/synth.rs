@@ -152,7 +152,17 @@ pub fn run(a: Args) -> CliResult {
             (synth.run_window((w, h), win, a.seed)?, what)
         }
     };
-    write_output(&result.heightfield, &a.output, None, a.engine, &inputs)?;
+    // The heightfield's encoder runs on one core: the preview is drawn
+    // meanwhile.
+    let (written, drawn) = rayon::join(
+        || write_output(&result.heightfield, &a.output, None, a.engine, &inputs),
+        || {
+            a.preview
+                .as_ref()
+                .map(|_| preview(&synth, &result.heightfield))
+        },
+    );
+    written?;
     let (lo, hi) = result
         .heightfield
         .extent()
@@ -166,9 +176,8 @@ pub fn run(a: Args) -> CliResult {
         hi,
         result.timings.total.as_secs_f64() * 1e3
     );
-    if let Some(p) = &a.preview {
-        let preview = preview(&synth, &result.heightfield)?;
-        render::write_png(p, &preview.image)?;
+    if let (Some(p), Some(drawn)) = (&a.preview, drawn) {
+        render::write_png(p, &drawn?.image)?;
         eprintln!("wrote {}", p.display());
     }
     if let Some(l0) = result.levels.first() {

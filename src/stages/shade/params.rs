@@ -4,6 +4,7 @@
 
 use super::{FULL, LIGHT_ONE, MAX_ABS_HEIGHT, MAX_LIGHTS, NODATA, flags};
 use bytemuck::{Pod, Zeroable};
+use rayon::prelude::*;
 
 /// Everything the kernel needs besides the buffers. `#[repr(C)]`, only
 /// 32-bit integer fields, 16-byte aligned blocks, so the same bytes can be a
@@ -117,10 +118,11 @@ impl ShadeParams {
         if b.heights.len() as u64 != n {
             return err(format!("{} heights for {n} pixels", b.heights.len()));
         }
+        // In parallel (the first offender, so the message is the same).
         if let Some(i) = b
             .heights
-            .iter()
-            .position(|&h| h != NODATA && !(-MAX_ABS_HEIGHT..=MAX_ABS_HEIGHT).contains(&h))
+            .par_iter()
+            .position_first(|&h| h != NODATA && !(-MAX_ABS_HEIGHT..=MAX_ABS_HEIGHT).contains(&h))
         {
             return err(format!(
                 "height {} at pixel {i} outside ±{MAX_ABS_HEIGHT}",

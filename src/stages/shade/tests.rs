@@ -34,3 +34,27 @@ fn blend_ends_are_exact() {
     assert_eq!(apply_shade(a, FULL), a);
     assert_eq!(apply_shade(a, 2 * FULL), 0x00ff_ffff);
 }
+
+#[test]
+fn an_out_of_range_height_is_named_by_its_first_pixel() {
+    // Many offenders far apart (the scan is parallel): the first is named.
+    let n = 300_000usize;
+    let mut heights = vec![0i32; n];
+    for i in (123_457..n).step_by(40_000) {
+        heights[i] = MAX_ABS_HEIGHT + 1;
+    }
+    heights[123_456] = NODATA;
+    let p = ShadeParams {
+        width: 600,
+        height: 500,
+        ..bytemuck::Zeroable::zeroed()
+    };
+    let b = ShadeBuffers {
+        heights: &heights,
+        types: &[],
+        tint: &[0],
+        type_colours: &[],
+    };
+    let err = p.validate(&b).unwrap_err();
+    assert!(err.0.contains("at pixel 123457 "), "{err}");
+}
