@@ -6,7 +6,14 @@ use super::*;
 
 #[test]
 fn isqrt_is_floor_sqrt() {
-    for n in (0..70_000u32).chain([u32::MAX, u32::MAX - 1, 1 << 30, (1 << 30) - 1]) {
+    // Where floor(√n) changes (every k² and its neighbours), the small
+    // values, the top of the range and a stride through the rest.
+    let squares = (0..=65_535u32).flat_map(|k| {
+        let s = k * k;
+        [s, s.saturating_sub(1), s + 1, s + 2 * k]
+    });
+    let rest = (0..70_000u32).chain((0..u32::MAX - 9_999).step_by(9_973));
+    for n in squares.chain(rest).chain([u32::MAX, u32::MAX - 1]) {
         let r = isqrt(n) as u64;
         assert!(r * r <= n as u64 && (r + 1) * (r + 1) > n as u64, "{n}");
     }
