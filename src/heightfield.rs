@@ -170,7 +170,7 @@ impl Heightfield {
         self.get(x, y).is_nan()
     }
     pub fn nodata_count(&self) -> usize {
-        self.data.iter().filter(|v| v.is_nan()).count()
+        self.extent().nodata
     }
     /// `Some(mask)` (true = nodata) when any sample is missing, else `None`.
     pub fn nodata_mask(&self) -> Option<Vec<bool>> {
@@ -209,22 +209,24 @@ impl Heightfield {
     }
 
     /// Min, max and mean over valid samples; `None` when every sample is nodata.
+    /// The range and count come from [`Heightfield::extent`]; the mean is
+    /// summed in sample order, so its rounding is the same on every run.
     pub fn stats(&self) -> Option<Stats> {
-        let (mut min, mut max, mut sum, mut valid) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f64, 0);
-        for &v in &self.data {
-            if !v.is_nan() {
-                min = min.min(v);
-                max = max.max(v);
-                sum += v as f64;
-                valid += 1;
-            }
-        }
-        (valid > 0).then(|| Stats {
+        let Extent { range, nodata } = self.extent();
+        let (min, max) = range?;
+        let sum: f64 = self
+            .data
+            .iter()
+            .filter(|v| !v.is_nan())
+            .map(|&v| v as f64)
+            .sum();
+        let valid = self.data.len() - nodata;
+        Some(Stats {
             min,
             max,
             mean: sum / valid as f64,
             valid,
-            nodata: self.data.len() - valid,
+            nodata,
         })
     }
 

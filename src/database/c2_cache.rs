@@ -30,7 +30,7 @@
 
 use super::Database;
 use super::c2::{Quad, Tables};
-use super::file::Bytes;
+use super::file::{self, Bytes};
 use std::ops::Range;
 use std::path::Path;
 
@@ -84,8 +84,8 @@ pub fn decode(
     db: Fingerprint,
     counts: &[usize],
 ) -> Result<Vec<Range<usize>>, String> {
-    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().expect("4 bytes"));
-    let u64_at = |i: usize| u64::from_le_bytes(bytes[i..i + 8].try_into().expect("8 bytes"));
+    let u32_at = |i: usize| file::u32_at(bytes, i);
+    let u64_at = |i: usize| file::u64_at(bytes, i);
     if bytes.len() < 32 || &bytes[..4] != MAGIC {
         return Err("not a C2 table file".into());
     }

@@ -114,11 +114,16 @@ pub fn encode(sections: &[Section<'_>]) -> Vec<u64> {
     words
 }
 
-fn u32_at(b: &[u8], at: usize) -> u32 {
+pub(super) fn u32_at(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(b[at..at + 4].try_into().expect("4 bytes"))
 }
-fn u64_at(b: &[u8], at: usize) -> u64 {
+pub(super) fn u64_at(b: &[u8], at: usize) -> u64 {
     u64::from_le_bytes(b[at..at + 8].try_into().expect("8 bytes"))
+}
+
+/// The header's CRC-32 of a checked file (it covers every section's CRC).
+pub(super) fn header_crc(bytes: &[u8]) -> u32 {
+    u32_at(bytes, 24)
 }
 
 /// Checks the container (magic, version, lengths, checksums, padding) and

@@ -247,7 +247,7 @@ impl Database {
     pub fn fingerprint(&self) -> c2_cache::Fingerprint {
         let b = self.file_bytes();
         c2_cache::Fingerprint {
-            crc: u32::from_le_bytes(b[24..28].try_into().expect("a checked header")),
+            crc: file::header_crc(b),
             len: b.len() as u64,
         }
     }

@@ -12,7 +12,6 @@ use super::sidecar::Sidecar;
 use super::{Encoded, FormatError};
 use crate::heightfield::Heightfield;
 use crate::size::check_dims;
-use rayon::prelude::*;
 use std::io::Cursor;
 
 /// The bit depth of a greyscale PNG, to choose between 8- and 16-bit decoding.
@@ -87,15 +86,7 @@ pub(super) fn encode16(
     south_up: bool,
 ) -> Result<Encoded, FormatError> {
     let q = quantize16(hf, range, south_up)?;
-    let mut bytes = vec![0u8; q.codes.len() * 2];
-    bytes
-        .par_chunks_mut(1 << 16)
-        .zip(q.codes.par_chunks(1 << 15))
-        .for_each(|(out, codes)| {
-            for (o, c) in out.chunks_exact_mut(2).zip(codes) {
-                o.copy_from_slice(&c.to_be_bytes());
-            }
-        });
+    let bytes = q.bytes(u16::to_be_bytes);
     let mut out = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut out, hf.width() as u32, hf.height() as u32);

@@ -17,6 +17,23 @@ pub(super) struct Quantized {
     pub sidecar: Vec<u8>,
 }
 
+impl Quantized {
+    /// The codes as bytes, each by `order` (`u16::to_be_bytes` for PNG,
+    /// `to_le_bytes` for R16), converted in parallel like the codes.
+    pub fn bytes(&self, order: fn(u16) -> [u8; 2]) -> Vec<u8> {
+        let mut bytes = vec![0u8; self.codes.len() * 2];
+        bytes
+            .par_chunks_mut(1 << 16)
+            .zip(self.codes.par_chunks(1 << 15))
+            .for_each(|(out, codes)| {
+                for (o, &c) in out.chunks_exact_mut(2).zip(codes) {
+                    o.copy_from_slice(&order(c));
+                }
+            });
+        bytes
+    }
+}
+
 pub(super) fn quantize16(
     hf: &Heightfield,
     range: Option<(f64, f64)>,

@@ -126,7 +126,7 @@ pub(super) fn encode16(
     FormatError::check_no_nodata(hf, Format::R16)?;
     let q = quantize16(hf, range, south_up)?;
     Ok(Encoded {
-        bytes: q.codes.iter().flat_map(|c| c.to_le_bytes()).collect(),
+        bytes: q.bytes(u16::to_le_bytes),
         sidecar: Some(q.sidecar),
     })
 }
