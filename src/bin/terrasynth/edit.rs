@@ -60,7 +60,17 @@ pub fn synth_scene(
     let first = edits.edits(&scene, &db)?;
     let mut session = scene_session(&db, &scene, backend)?;
     let frame = session.apply(first)?;
-    write_output(&frame.heightfield, output, None, engine, &inputs)?;
+    // The heightfield's encoder runs on one core: the preview is drawn
+    // meanwhile (and written only once the heightfield is).
+    let (written, drawn) = rayon::join(
+        || write_output(&frame.heightfield, output, None, engine, &inputs),
+        || {
+            preview.map(|_| {
+                overlay::preview(&frame.heightfield, &scene, &edits, db.type_names(), overlay)
+            })
+        },
+    );
+    written?;
     let (lo, hi) = frame
         .heightfield
         .extent()
@@ -79,9 +89,8 @@ pub fn synth_scene(
         hi,
         frame.time.as_secs_f64() * 1e3
     );
-    if let Some(p) = preview {
-        let img = overlay::preview(&frame.heightfield, &scene, &edits, db.type_names(), overlay)?;
-        terrasynth::render::write_png(p, &img)?;
+    if let (Some(p), Some(drawn)) = (preview, drawn) {
+        terrasynth::render::write_png(p, &drawn?)?;
         eprintln!("wrote {}", p.display());
     }
     if coords.0.is_some() || coords.1.is_some() {
@@ -142,8 +151,13 @@ pub fn run(a: Args) -> CliResult {
         let frame = session.apply(list)?;
         let hf = &frame.heightfield;
         let out = a.out_dir.join(format!("frame_{k:03}.{ext}"));
-        io::write(hf, &out, &WriteOptions::default())?;
-        let img = overlay::preview(hf, &scene, &edits, db.type_names(), !a.no_overlay)?;
+        // The frame is encoded while its preview is drawn.
+        let (written, drawn) = rayon::join(
+            || io::write(hf, &out, &WriteOptions::default()),
+            || overlay::preview(hf, &scene, &edits, db.type_names(), !a.no_overlay),
+        );
+        written?;
+        let img = drawn?;
         let pv = a.out_dir.join(format!("frame_{k:03}.preview.png"));
         terrasynth::render::write_png(&pv, &img)?;
         // Where the terrain changed, and by how much.
