@@ -9,23 +9,20 @@
 //! region that can change is re-synthesized (exactly, see
 //! [`crate::synth::Guides::restrict`]).
 
-use super::control::Target;
 use super::control::{
     Blend, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED, inside,
 };
 use super::fixed::Coord;
-use super::stages::correct::ALL_TYPES;
-use super::stages::reduce_types::reduce_types;
-use super::stages::reduce_weights::reduce_weights;
 use super::state::{level_size, top_level};
-use super::{Frames, Guides, LevelGuide, Params, SynthError, Synthesizer, union};
+use super::{Frames, Guides, Params, SynthError, Synthesizer, union};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use rayon::prelude::*;
-use std::ops::Range;
 use std::sync::Arc;
 use std::time::Duration;
 use thiserror::Error;
+
+mod guides;
 
 /// Weights in quarters (paper §5.3).
 pub const W_FROZEN: u8 = 0;
@@ -196,7 +193,12 @@ impl<'db> Session<'db> {
             frame.time = t.elapsed();
             return Ok(frame);
         }
-        self.fresh = self.pasted.iter().map(|p| vec![false; p.len()]).collect();
+        // Pixels pasted in this step (none without a paste: then nothing
+        // is allocated or scanned for them).
+        self.fresh = match edits.iter().any(|e| matches!(e, Edit::Paste(_))) {
+            true => self.pasted.iter().map(|p| vec![false; p.len()]).collect(),
+            false => Vec::new(),
+        };
         let (w0, h0) = level_size(self.width, self.height, 0);
         let mut weights = vec![W_COHERENT; w0 * h0];
         let mark = |c: &dyn super::control::Constraint, weights: &mut Vec<u8>| {
@@ -247,9 +249,11 @@ impl<'db> Session<'db> {
                 }
             }
         }
-        for (i, p) in self.pasted[0].iter().enumerate() {
-            if *p {
-                weights[i] = W_FROZEN;
+        if !self.controls.pastes.is_empty() {
+            for (i, p) in self.pasted[0].iter().enumerate() {
+                if *p {
+                    weights[i] = W_FROZEN;
+                }
             }
         }
         let guides = self.guides(weights);
@@ -258,9 +262,18 @@ impl<'db> Session<'db> {
         } else {
             None
         };
-        let (out, frames) =
-            self.synth
-                .run_with(self.width, self.height, self.seed, &guides, prev, true)?;
+        let run = self
+            .synth
+            .run_with(self.width, self.height, self.seed, &guides, prev, true);
+        let (out, frames) = match run {
+            Ok(r) => r,
+            Err(e) => {
+                // `guides` took the previous frame's targets: without them
+                // (and its results) the next frame is synthesized whole.
+                (self.frames, self.guides) = (None, None);
+                return Err(e.into());
+            }
+        };
         let mut hf = out.heightfield;
         if let (Some(f), Some(old)) = (&self.controls.freeze, &self.last) {
             // Frozen pixels keep the heights the user froze. Their S and V
@@ -342,63 +355,6 @@ impl<'db> Session<'db> {
                 }
                 Ok(())
             }
-        }
-    }
-
-    /// Per-level rasters of this frame, with the pixels whose inputs differ
-    /// from the previous frame's marked dirty.
-    fn guides(&self, w0: Vec<u8>) -> Guides {
-        let db = self.synth.database();
-        let last = self.pasted.len() - 1;
-        let cell = self.synth.cell_size_m();
-        let full = ((1u64 << db.type_names().len()) - 1) as u32;
-        let (lw, lh) = level_size(self.width, self.height, 0);
-        let mut allowed = self.controls.types.as_ref().map(|m| {
-            let mut r = vec![ALL_TYPES; lw * lh];
-            for y in 0..self.height {
-                for x in 0..self.width {
-                    let t = m[y * self.width + x];
-                    if t != UNCONSTRAINED {
-                        r[y * lw + x] = 1 << t;
-                    }
-                }
-            }
-            r
-        });
-        let mut weights = w0;
-        let mut levels = Vec::with_capacity(last + 1);
-        for i in 0..=last {
-            let (w, h) = level_size(self.width, self.height, i);
-            if i > 0 {
-                let (cw, ch) = level_size(self.width, self.height, i - 1);
-                allowed = allowed.map(|a| reduce_types(&a, cw, ch, w, h, full));
-                weights = reduce_weights(&weights, cw, ch, w, h);
-                for (k, p) in self.pasted[i].iter().enumerate() {
-                    if *p {
-                        weights[k] = W_FROZEN;
-                    }
-                }
-            }
-            levels.push(LevelGuide {
-                targets: self.blend.targets(i, cell).map(|t| t.cells),
-                allowed: allowed.clone().filter(|_| i >= FIRST_LEVEL),
-                weights: Some(weights.clone()),
-                dirty: None,
-            });
-        }
-        // Dirty: inputs that differ from the previous frame's, or changed
-        // weights (a weight that changes switches how the previous result
-        // competes; only freezing is safe, as it keeps the previous result).
-        let prev = self.guides.as_ref();
-        let none = LevelGuide::default();
-        for (i, g) in levels.iter_mut().enumerate() {
-            let (w, h) = level_size(self.width, self.height, i);
-            let p = prev.and_then(|p| p.levels.get(i)).unwrap_or(&none);
-            g.dirty = dirty_bounds(g, p, self.fresh.get(i).map(|f| &f[..]), w, h);
-        }
-        Guides {
-            levels,
-            restrict: self.restrict && self.coherence,
         }
     }
 }
@@ -506,54 +462,6 @@ impl Session<'_> {
     }
 }
 
-/// Bounds of the pixels of a `w × h` level whose inputs in `g` differ from
-/// the previous frame's `p`, or that received pasted values in this step
-/// (`fresh`: their previous results were overwritten). Most rows of an
-/// edit are unchanged: a row whose rasters compare equal as slices is
-/// skipped without looking at its pixels.
-fn dirty_bounds(
-    g: &LevelGuide,
-    p: &LevelGuide,
-    fresh: Option<&[bool]>,
-    w: usize,
-    h: usize,
-) -> Option<[usize; 4]> {
-    fn same<T: PartialEq>(a: &Option<Vec<T>>, b: &Option<Vec<T>>, r: Range<usize>) -> bool {
-        match (a, b) {
-            (Some(a), Some(b)) => a[r.clone()] == b[r],
-            (None, None) => true,
-            _ => false,
-        }
-    }
-    let t = |g: &LevelGuide, k: usize| g.targets.as_ref().map_or(Target::NONE, |t| t[k]);
-    let a = |g: &LevelGuide, k: usize| g.allowed.as_ref().map_or(ALL_TYPES, |a| a[k]);
-    let wt = |g: &LevelGuide, k: usize| g.weights.as_ref().map_or(W_FREE, |w| w[k]);
-    let fresh_at = |k: usize| fresh.is_some_and(|f| f[k]);
-    let row = |y: usize| {
-        let r = y * w..(y + 1) * w;
-        if same(&g.targets, &p.targets, r.clone())
-            && same(&g.allowed, &p.allowed, r.clone())
-            && same(&g.weights, &p.weights, r.clone())
-            && !fresh.is_some_and(|f| f[r.clone()].contains(&true))
-        {
-            return None;
-        }
-        let mut b = None;
-        for k in r {
-            if t(g, k) != t(p, k)
-                || a(g, k) != a(p, k)
-                || (wt(g, k) != wt(p, k) && wt(g, k) != W_FROZEN)
-                || fresh_at(k)
-            {
-                let x = k - y * w;
-                b = union(b, Some([x, y, x + 1, y + 1]));
-            }
-        }
-        b
-    };
-    (0..h).into_par_iter().map(row).reduce(|| None, union)
-}
-
 /// Marks level-0 pixels within a constraint's reach unweighted.
 fn free_within(c: &dyn super::control::Constraint, weights: &mut [u8], w: usize, h: usize) {
     let [x0, y0, x1, y1] = c.bounds();
@@ -568,25 +476,63 @@ fn free_within(c: &dyn super::control::Constraint, weights: &mut [u8], w: usize,
     }
 }
 
-/// Where `new` differs from `old` (same size), bit for bit.
+/// Where `new` differs from `old` (same size), bit for bit; in parallel
+/// (it runs on every edit, over every output pixel).
 fn change(old: &Heightfield, new: &Heightfield) -> Change {
     let w = new.width();
     let mask: Vec<bool> = old
         .data()
-        .iter()
+        .par_iter()
         .zip(new.data())
         .map(|(a, b)| a.to_bits() != b.to_bits())
         .collect();
-    let mut bounds: Option<[usize; 4]> = None;
-    for (k, _) in mask.iter().enumerate().filter(|(_, c)| **c) {
-        let (x, y) = (k % w, k / w);
-        bounds = Some(bounds.map_or([x, y, x + 1, y + 1], |b| {
-            [b[0].min(x), b[1].min(y), b[2].max(x + 1), b[3].max(y + 1)]
-        }));
-    }
+    let (pixels, bounds) = mask
+        .par_chunks(w)
+        .enumerate()
+        .map(|(y, row)| {
+            let n = row.iter().filter(|c| **c).count();
+            let x0 = row.iter().position(|c| *c);
+            let x1 = row.iter().rposition(|c| *c);
+            (n, x0.zip(x1).map(|(a, b)| [a, y, b + 1, y + 1]))
+        })
+        .reduce(|| (0, None), |(n, a), (m, b)| (n + m, union(a, b)));
     Change {
-        pixels: mask.iter().filter(|c| **c).count(),
+        pixels,
         mask,
         bounds,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn change_counts_and_bounds_the_differing_pixels() {
+        let (w, h) = (37, 23);
+        let old = Heightfield::from_fn(w, h, 1.0, |x, y| (x * 3 + y) as f32).unwrap();
+        let diffs: [&[(usize, usize)]; 4] = [
+            &[],
+            &[(5, 7)],
+            &[(36, 0), (0, 22), (12, 9)],
+            // -0.0 against 0.0: equal as floats, not as bits.
+            &[(0, 0), (3, 4), (4, 3)],
+        ];
+        for d in diffs {
+            let mut new = old.clone();
+            for &(x, y) in d {
+                let v = &mut new.data_mut()[y * w + x];
+                *v = if *v == 0.0 { -0.0 } else { *v + 0.5 };
+            }
+            let c = change(&old, &new);
+            assert_eq!(c.pixels, d.len());
+            let want = d
+                .iter()
+                .fold(None, |b, &(x, y)| union(b, Some([x, y, x + 1, y + 1])));
+            assert_eq!(c.bounds, want);
+            for (k, m) in c.mask.iter().enumerate() {
+                assert_eq!(*m, d.contains(&(k % w, k / w)), "pixel {k}");
+            }
+        }
     }
 }
