@@ -358,7 +358,9 @@ fn guided_correct_agrees_on_real_guides() {
     let synth = Synthesizer::new(db, params).unwrap();
     let (_, f1) = synth.run_with(w, h, 9, &guides, None, true).unwrap();
     let f1 = f1.unwrap();
-    let (out, _) = synth.run_with(w, h, 9, &guides, Some(&f1), false).unwrap();
+    let (out, _) = synth
+        .run_with(w, h, 9, &guides, Some(f1.clone()), false)
+        .unwrap();
     let mut checked = 0;
     for maps in out
         .levels

@@ -39,6 +39,7 @@ use stages::correct::{CorrectParams, SUBPASSES};
 use stages::reconstruct::{self, HEIGHT_FRAC_BITS};
 use stages::upsample_jitter::{Step, UpsampleParams};
 use state::{State, level_size, top_level};
+use std::cell::RefCell;
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 use window::{REACH_PER_SUBPASS, widen};
@@ -54,7 +55,10 @@ pub use windowed::{Paint, WindowControls, WindowError, check_window};
 /// whether to record this one.
 struct Control<'a> {
     guides: &'a Guides,
-    prev: Option<&'a Frames>,
+    /// The previous frame's results. Owned: restricted re-synthesis patches
+    /// each level's results in place as the level is corrected (the window
+    /// replaced), instead of copying every pass of the whole level.
+    prev: Option<RefCell<Frames>>,
     record: bool,
 }
 
@@ -203,15 +207,15 @@ impl<'db> Synthesizer<'db> {
     /// Synthesis under control inputs (paper §5), on the backend chosen by
     /// [`Synthesizer::use_backend`]. `prev` is the previous frame's per-pass
     /// results (the coherence candidates, and what pixels outside a level's
-    /// window keep); with `record`, this frame's are returned for the next
-    /// one.
+    /// window keep), consumed: its buffers become this frame's; with
+    /// `record`, this frame's are returned for the next one.
     pub fn run_with(
         &self,
         width: usize,
         height: usize,
         seed: u32,
         guides: &Guides,
-        prev: Option<&Frames>,
+        prev: Option<Frames>,
         record: bool,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         let cone = self.whole(width, height)?;
@@ -225,12 +229,12 @@ impl<'db> Synthesizer<'db> {
         cone: &Cone,
         seed: u32,
         guides: &Guides,
-        prev: Option<&Frames>,
+        prev: Option<Frames>,
         record: bool,
     ) -> Result<(Synthesis, Option<Frames>), SynthError> {
         let control = Control {
             guides,
-            prev,
+            prev: prev.map(RefCell::new),
             record,
         };
         self.dispatch(cone, seed, Some(&control))
@@ -392,8 +396,9 @@ impl<'db> Synthesizer<'db> {
         }
         kept.reverse();
         let t = Instant::now();
-        let prev_heights = control
-            .and_then(|c| c.prev)
+        let prev = control.and_then(|c| c.prev.as_ref()).map(|p| p.borrow());
+        let prev_heights = prev
+            .as_ref()
             .map(|f| &f.heights)
             .filter(|h| h.len() == cone.region(0).width() * cone.region(0).height());
         // The fixed-point heights are kept only for the next frame.

@@ -29,6 +29,7 @@
 //! [`correct::keep_outside`]: crate::stages::correct::keep_outside
 
 use super::cone::{Rect, crop, parent_view};
+use super::fixed::Coord;
 use super::window::{REACH_PER_SUBPASS, changed_bounds, double, union, widen};
 use super::{Control, Frames, PassResult, SynthError, Synthesizer};
 use crate::backend::Backend;
@@ -57,8 +58,8 @@ impl Synthesizer<'_> {
         (w, h): (usize, usize),
         changed_parent: Option<[usize; 4]>,
     ) -> Option<[usize; 4]> {
-        let before = c.prev.and_then(|f| f.levels.get(level))?;
-        if !c.guides.restrict || before.is_empty() {
+        let prev = c.prev.as_ref()?.borrow();
+        if !c.guides.restrict || prev.levels.get(level)?.is_empty() {
             return None;
         }
         let dirty = c.guides.levels.get(level).and_then(|g| g.dirty);
@@ -74,8 +75,9 @@ impl Synthesizer<'_> {
         let passes = self.params.passes as usize;
         passes > 0
             && c.prev
-                .and_then(|f| f.levels.get(level))
-                .is_some_and(|r| r.len() >= passes)
+                .as_ref()
+                .and_then(|f| f.borrow().levels.get(level).map(Vec::len))
+                .is_some_and(|n| n >= passes)
             && c.guides
                 .levels
                 .get(level)
@@ -99,7 +101,8 @@ impl Synthesizer<'_> {
     ) -> Result<Option<[usize; 4]>, SynthError> {
         let (w, h) = (region.width(), region.height());
         let lg = c.guides.levels.get(level);
-        let before = c.prev.and_then(|f| f.levels.get(level));
+        let prev = c.prev.as_ref().map(|f| f.borrow());
+        let before = prev.as_ref().and_then(|f| f.levels.get(level));
         let mut last_result = None;
         for pass in 0..self.params.passes as usize {
             let last = before.and_then(|b| b.get(pass));
@@ -160,7 +163,12 @@ impl Synthesizer<'_> {
         } = buf;
         let (w, h) = (region.width(), region.height());
         let level_rect = Rect::new(0, 0, w, h);
-        let before = &c.prev.expect("checked by can_crop").levels[level];
+        // This level's previous results, taken: each pass's becomes this
+        // frame's, with the window's pixels replaced.
+        let before = {
+            let mut prev = c.prev.as_ref().expect("checked by can_crop").borrow_mut();
+            std::mem::take(&mut prev.levels[level])
+        };
         let lg = &c.guides.levels[level];
         let [wx0, wy0, wx1, wy1] = widen(window, REACH_PER_SUBPASS, w, h);
         let cr = Rect {
@@ -183,8 +191,9 @@ impl Synthesizer<'_> {
         let weights = crop(lg.weights.as_ref().expect("checked"), level_rect, cr);
         let (a, z) = (window[0] - cr.x0, window[2] - cr.x0);
         let local = [a, window[1] - cr.y0, z, window[3] - cr.y0];
-        let mut last = None;
-        for (pass, prev) in before.iter().enumerate().take(self.params.passes as usize) {
+        let (mut last, mut changed) = (None, None);
+        let passes = self.params.passes as usize;
+        for (pass, mut prev) in before.into_iter().enumerate().take(passes) {
             let (coords, offsets) = (
                 crop(&prev.coords, level_rect, cr),
                 crop(&prev.offsets, level_rect, cr),
@@ -203,20 +212,19 @@ impl Synthesizer<'_> {
             };
             let g = b.upload_guide(&guide, cr.width(), cr.height())?;
             self.subpasses(b, (&sub, parent_sub.as_ref()), level, &g);
-            let is_last = pass + 1 == self.params.passes as usize;
+            let is_last = pass + 1 == passes;
             if frames.is_some() || is_last {
                 // The pass's result: the previous frame's with the
-                // window's pixels replaced.
+                // window's pixels replaced (the last pass's changes bound
+                // what the level below re-synthesizes).
                 let (sc, so) = b.download(&sub)?;
-                let mut r = prev.clone();
-                for y in window[1]..window[3] {
-                    let (to, from) = (y * w + window[0], (y - cr.y0) * cr.width() + a);
-                    r.coords[to..to + z - a].copy_from_slice(&sc[from..from + z - a]);
-                    r.offsets[to..to + z - a].copy_from_slice(&so[from..from + z - a]);
+                let c = replace_window(&mut prev, w, window, (&sc, &so), cr.width(), [a, cr.y0]);
+                if is_last {
+                    changed = c;
                 }
                 match frames.as_deref_mut() {
-                    Some(f) => f.levels[level].push(r),
-                    None => last = Some(r),
+                    Some(f) => f.levels[level].push(prev),
+                    None => last = Some(prev),
                 }
             }
         }
@@ -224,8 +232,6 @@ impl Synthesizer<'_> {
             .as_ref()
             .or_else(|| frames.and_then(|f| f.levels[level].last()))
             .expect("passes > 0 (checked by can_crop)");
-        let prev_last = before.last().expect("checked by can_crop");
-        let changed = changed_bounds(&last.coords, &last.offsets, w, prev_last, window);
         let st = State::from_parts(w, h, &last.coords, &last.offsets);
         Ok((changed, b.upload(st)?))
     }
@@ -247,4 +253,35 @@ impl Synthesizer<'_> {
             b.correct_guided(state, parent, level, &p, g);
         }
     }
+}
+
+/// Writes a crop's `window` (level coordinates; the crop is `stride` wide,
+/// `window[0]` is its column `x`, level row `y` its row `y − y0`) into a
+/// whole level's result `r` (`w` wide); returns the bounds of the pixels
+/// that changed.
+fn replace_window(
+    r: &mut PassResult,
+    w: usize,
+    window: [usize; 4],
+    (coords, offsets): (&[Coord], &[i32]),
+    stride: usize,
+    [x, y0]: [usize; 2],
+) -> Option<[usize; 4]> {
+    let n = window[2] - window[0];
+    let mut changed = None;
+    for y in window[1]..window[3] {
+        let (to, from) = (y * w + window[0]..y * w + window[2], (y - y0) * stride + x);
+        let (c, o) = (&coords[from..from + n], &offsets[from..from + n]);
+        let mut differ = (r.coords[to.clone()].iter().zip(c))
+            .zip(r.offsets[to.clone()].iter().zip(o))
+            .map(|((a, b), (p, q))| a != b || p != q);
+        let (first, last) = (differ.clone().position(|d| d), differ.rposition(|d| d));
+        if let (Some(f), Some(l)) = (first, last) {
+            let b = [window[0] + f, y, window[0] + l + 1, y + 1];
+            changed = union(changed, Some(b));
+        }
+        r.coords[to.clone()].copy_from_slice(c);
+        r.offsets[to].copy_from_slice(o);
+    }
+    changed
 }

@@ -257,20 +257,18 @@ impl<'db> Session<'db> {
             }
         }
         let guides = self.guides(weights);
-        let prev = if self.coherence {
-            self.frames.as_ref()
-        } else {
-            None
-        };
+        // The run takes the previous frame's results (and reuses their
+        // buffers): they are replaced by this frame's.
+        let prev = self.frames.take().filter(|_| self.coherence);
         let run = self
             .synth
             .run_with(self.width, self.height, self.seed, &guides, prev, true);
         let (out, frames) = match run {
             Ok(r) => r,
             Err(e) => {
-                // `guides` took the previous frame's targets: without them
-                // (and its results) the next frame is synthesized whole.
-                (self.frames, self.guides) = (None, None);
+                // The run took the previous frame's results, and `guides`
+                // its targets: the next frame is synthesized whole.
+                self.guides = None;
                 return Err(e.into());
             }
         };

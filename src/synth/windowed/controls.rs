@@ -104,7 +104,7 @@ impl Synthesizer<'_> {
                 heights: Vec::new(),
             };
             let guides = self.window_guides(&cone, last, c, Some(&pastes))?;
-            let two = self.run_cone(&cone, seed, &guides, Some(&prev), false)?.0;
+            let two = self.run_cone(&cone, seed, &guides, Some(prev), false)?.0;
             let frozen = paint(c.freeze, window, "freeze mask")?;
             let old = std::mem::replace(&mut hf, two.heightfield);
             if let Some(f) = frozen {
