@@ -30,7 +30,7 @@
 
 use super::cone::{Rect, crop, parent_view};
 use super::fixed::Coord;
-use super::window::{REACH_PER_SUBPASS, changed_bounds, double, union, widen};
+use super::window::{REACH_PER_SUBPASS, changed_bounds, double, row_bounds, union, widen};
 use super::{Control, Frames, PassResult, SynthError, Synthesizer};
 use crate::backend::Backend;
 use crate::level::state::State;
@@ -272,14 +272,10 @@ fn replace_window(
     for y in window[1]..window[3] {
         let (to, from) = (y * w + window[0]..y * w + window[2], (y - y0) * stride + x);
         let (c, o) = (&coords[from..from + n], &offsets[from..from + n]);
-        let mut differ = (r.coords[to.clone()].iter().zip(c))
+        let differ = (r.coords[to.clone()].iter().zip(c))
             .zip(r.offsets[to.clone()].iter().zip(o))
             .map(|((a, b), (p, q))| a != b || p != q);
-        let (first, last) = (differ.clone().position(|d| d), differ.rposition(|d| d));
-        if let (Some(f), Some(l)) = (first, last) {
-            let b = [window[0] + f, y, window[0] + l + 1, y + 1];
-            changed = union(changed, Some(b));
-        }
+        changed = union(changed, row_bounds(y, window[0], differ));
         r.coords[to.clone()].copy_from_slice(c);
         r.offsets[to].copy_from_slice(o);
     }

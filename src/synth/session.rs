@@ -14,6 +14,7 @@ use super::control::{
 };
 use super::fixed::Coord;
 use super::state::{level_size, top_level};
+use super::window::row_bounds;
 use super::{Frames, Guides, Params, SynthError, Synthesizer, union};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
@@ -489,9 +490,7 @@ fn change(old: &Heightfield, new: &Heightfield) -> Change {
         .enumerate()
         .map(|(y, row)| {
             let n = row.iter().filter(|c| **c).count();
-            let x0 = row.iter().position(|c| *c);
-            let x1 = row.iter().rposition(|c| *c);
-            (n, x0.zip(x1).map(|(a, b)| [a, y, b + 1, y + 1]))
+            (n, row_bounds(y, 0, row.iter().copied()))
         })
         .reduce(|| (0, None), |(n, a), (m, b)| (n + m, union(a, b)));
     Change {

@@ -43,6 +43,23 @@ pub(crate) fn union(a: Option<[usize; 4]>, b: Option<[usize; 4]>) -> Option<[usi
     }
 }
 
+/// Bounds of the set entries of one row: `row` holds, for columns
+/// `x0, x0 + 1, …` of row `y`, whether the pixel is in the set. The one
+/// rule behind every "where did this change" of the engine and sessions.
+pub(crate) fn row_bounds(
+    y: usize,
+    x0: usize,
+    row: impl IntoIterator<Item = bool>,
+) -> Option<[usize; 4]> {
+    let mut span: Option<(usize, usize)> = None;
+    for (i, set) in row.into_iter().enumerate() {
+        if set {
+            span = Some(span.map_or((i, i), |(a, _)| (a, i)));
+        }
+    }
+    span.map(|(a, b)| [x0 + a, y, x0 + b + 1, y + 1])
+}
+
 /// The children of a parent level's bounds.
 pub(super) fn double(b: [usize; 4]) -> [usize; 4] {
     b.map(|v| 2 * v)
@@ -68,14 +85,25 @@ pub(super) fn changed_bounds(
     r: &PassResult,
     [x0, y0, x1, y1]: [usize; 4],
 ) -> Option<[usize; 4]> {
-    let mut b: Option<[usize; 4]> = None;
-    for y in y0..y1 {
-        for i in y * width + x0..y * width + x1 {
-            if coords[i] != r.coords[i] || offsets[i] != r.offsets[i] {
-                let x = i % width;
-                b = union(b, Some([x, y, x + 1, y + 1]));
-            }
-        }
+    (y0..y1)
+        .map(|y| {
+            let k = y * width + x0..y * width + x1;
+            let differs = |i: usize| coords[i] != r.coords[i] || offsets[i] != r.offsets[i];
+            row_bounds(y, x0, k.map(differs))
+        })
+        .fold(None, union)
+}
+
+#[cfg(test)]
+mod row_bounds_tests {
+    use super::row_bounds;
+
+    #[test]
+    fn row_bounds_span_the_first_and_last_set_entries() {
+        let row = |bits: &str| bits.chars().map(|c| c == '1').collect::<Vec<_>>();
+        assert_eq!(row_bounds(3, 10, row("0000")), None);
+        assert_eq!(row_bounds(3, 10, row("0100")), Some([11, 3, 12, 4]));
+        assert_eq!(row_bounds(0, 0, row("1001")), Some([0, 0, 4, 1]));
+        assert_eq!(row_bounds(7, 2, row("0110100")), Some([3, 7, 7, 8]));
     }
-    b
 }

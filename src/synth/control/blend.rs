@@ -86,6 +86,7 @@ use super::Constraint;
 use crate::database::Quantization;
 use crate::synth::cone::Rect;
 use crate::synth::union;
+use crate::synth::window::row_bounds;
 use rayon::prelude::*;
 
 pub use crate::stages::correct::nudge::{MAX_TOL, Target};
@@ -325,18 +326,19 @@ impl Blend {
         let (l, [x0, y0, x1, y1]) = (&self.levels[level], rect?);
         assert_eq!(cells.len(), l.sums.len(), "targets of another level");
         let px_to_units = cell_size_m / self.q.scale_m;
-        let mut changed = None;
-        for y in y0..y1 {
-            for x in x0..x1 {
-                let k = y * l.width + x;
-                let t = target(&l.sums[k], px_to_units);
-                if cells[k] != t {
-                    cells[k] = t;
-                    changed = union(changed, Some([x, y, x + 1, y + 1]));
-                }
-            }
-        }
-        changed
+        let mut retarget = |k: usize| {
+            let t = target(&l.sums[k], px_to_units);
+            std::mem::replace(&mut cells[k], t) != t
+        };
+        (y0..y1)
+            .map(|y| {
+                row_bounds(
+                    y,
+                    x0,
+                    (y * l.width + x0..y * l.width + x1).map(&mut retarget),
+                )
+            })
+            .fold(None, union)
     }
 }
 

@@ -13,6 +13,7 @@ use super::super::stages::correct::ALL_TYPES;
 use super::super::stages::reduce_types::reduce_types;
 use super::super::stages::reduce_weights::reduce_weights;
 use super::super::state::level_size;
+use super::super::window::row_bounds;
 use super::super::{Guides, LevelGuide, union};
 use super::{FIRST_LEVEL, Session, W_FREE, W_FROZEN};
 use rayon::prelude::*;
@@ -105,13 +106,7 @@ impl Session<'_> {
 /// differ (None: no targets, i.e. [`Target::NONE`] everywhere).
 fn differ(a: Option<&[Target]>, b: Option<&[Target]>, w: usize, h: usize) -> Option<[usize; 4]> {
     let at = |t: Option<&[Target]>, k: usize| t.map_or(Target::NONE, |t| t[k]);
-    let row = |y: usize| {
-        (y * w..(y + 1) * w)
-            .filter(|&k| at(a, k) != at(b, k))
-            .map(|k| Some([k - y * w, y, k - y * w + 1, y + 1]))
-            .reduce(union)
-            .flatten()
-    };
+    let row = |y: usize| row_bounds(y, 0, (y * w..(y + 1) * w).map(|k| at(a, k) != at(b, k)));
     match (a, b) {
         (None, None) => None,
         _ => (0..h).into_par_iter().map(row).reduce(|| None, union),
@@ -149,14 +144,10 @@ fn dirty_bounds(
         {
             return None;
         }
-        let mut b = None;
-        for k in r {
-            if a(g, k) != a(p, k) || (wt(g, k) != wt(p, k) && wt(g, k) != W_FROZEN) || fresh_at(k) {
-                let x = k - y * w;
-                b = union(b, Some([x, y, x + 1, y + 1]));
-            }
-        }
-        b
+        let differs = |k: usize| {
+            a(g, k) != a(p, k) || (wt(g, k) != wt(p, k) && wt(g, k) != W_FROZEN) || fresh_at(k)
+        };
+        row_bounds(y, 0, r.map(differs))
     };
     (0..h).into_par_iter().map(row).reduce(|| None, union)
 }
