@@ -178,6 +178,7 @@ fn bench(c: &mut Criterion) {
         px: 0,
         py: 0,
         prior: correct::DEFAULT_PRIOR,
+        similar: true,
     };
     let mut g = group(c, "correct");
     g.bench_function(format!("scalar/{N}"), |b| {

@@ -41,7 +41,8 @@ struct CorrectParams {
     // seeding hashes absolute coordinates.
     origin_x: u32,
     origin_y: u32,
-    pad0: u32,
+    // Whether each source's C₂ competes (CorrectParams::similar; 0: C₁ only).
+    similar: u32,
     pad1: u32,
     pad2: u32,
 }
@@ -292,8 +293,8 @@ fn shifted(x: i32, y: i32, dl: vec2<i32>) -> Neighbour {
 }
 
 // The two candidates of one source u (its own texel, clamped inside, and
-// its most similar texel C₂), each scored if `admit` admits it; whether any
-// was.
+// its most similar texel C₂ if p.similar), each scored if `admit` admits
+// it; whether any was.
 fn try_source(ns: Hood, n: Neighbour, admit: u32, best: ptr<function, Best>) -> bool {
     var admitted = false;
     let u = n.t;
@@ -304,6 +305,9 @@ fn try_source(ns: Hood, n: Neighbour, admit: u32, best: ptr<function, Best>) -> 
         if (r1.score < (*best).score) {
             *best = Best(r1.score, (c1 << vec2<u32>(FRAC_BITS)) + n.frac, r1.h, true, c1);
         }
+    }
+    if (p.similar == 0u) {
+        return admitted;
     }
     let e = similar[atlas_index(u.x, u.y)];
     let c2 = vec2<i32>(i32(e & 0xFFFFu), i32(e >> 16u));

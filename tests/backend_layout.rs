@@ -179,7 +179,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
             has_parent,
             origin_x,
             origin_y,
-            pad0,
+            similar,
             pad1,
             pad2
         })

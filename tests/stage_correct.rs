@@ -43,7 +43,7 @@ proptest! {
     fn correct_agrees_on_random_states(
         w in 2usize..48, h in 2usize..48, level_pick in 0usize..8, sub in 0usize..4,
         prior in prop::sample::select(PRIORS.to_vec()), with_parent in any::<bool>(),
-        bits in prop::collection::vec(any::<u32>(), 64),
+        similar in any::<bool>(), bits in prop::collection::vec(any::<u32>(), 64),
     ) {
         let rig = rig(default_db());
         let level = level_pick % rig.atlas.len();
@@ -51,9 +51,9 @@ proptest! {
         let rev: Vec<u32> = bits.iter().rev().copied().collect();
         let parent = random_state(&rig.atlas[level], w.div_ceil(2), h.div_ceil(2), &rev, 0);
         let (px, py) = SUBPASSES[sub];
-        let p = CorrectParams { px, py, prior };
+        let p = CorrectParams { px, py, prior, similar };
         let runs = rig.correct(level, (&st, with_parent.then_some(&parent)), &p, None);
-        assert_agree(&runs, &format!("random {w}x{h} level {level} prior {prior}"));
+        assert_agree(&runs, &format!("random {w}x{h} level {level} prior {prior} C₂ {similar}"));
     }
 
     /// Coherent patches of coordinates (so candidate de-duplication is
@@ -114,14 +114,17 @@ fn correct_agrees_on_real_states() {
         let l = db.level_count() - 1;
         for r in real_levels(db, size, seed).iter().filter(|r| r.level <= l) {
             for (k, &(px, py)) in SUBPASSES.iter().enumerate() {
-                let p = CorrectParams {
-                    px,
-                    py,
-                    prior: DEFAULT_PRIOR,
-                };
-                let runs = rig.correct(r.level, (&r.state, r.parent.as_ref()), &p, None);
-                let what = format!("real state, level {}, subpass {k}", r.level);
-                assert_agree(&runs, &what);
+                for similar in [true, false] {
+                    let p = CorrectParams {
+                        px,
+                        py,
+                        prior: DEFAULT_PRIOR,
+                        similar,
+                    };
+                    let runs = rig.correct(r.level, (&r.state, r.parent.as_ref()), &p, None);
+                    let what = format!("real state, level {}, subpass {k}, C₂ {similar}", r.level);
+                    assert_agree(&runs, &what);
+                }
             }
         }
     }
@@ -277,9 +280,11 @@ proptest! {
         let (px, py) = SUBPASSES[sub];
         let parent = random_state(a, w.div_ceil(2), h.div_ceil(2), &bits, 0x5EED);
         let prior = PRIORS[bits[5] as usize % PRIORS.len()];
-        let p = CorrectParams { px, py, prior };
+        let similar = bits[5] >> 16 & 1 == 1;
+        let p = CorrectParams { px, py, prior, similar };
         let runs = rig.correct(level, (&st, Some(&parent)), &p, Some(&g));
-        assert_agree(&runs, &format!("random {w}×{h} level {level} flags {flags} prior {prior}"));
+        let what = format!("random {w}×{h} level {level} flags {flags} prior {prior} C₂ {similar}");
+        assert_agree(&runs, &what);
     }
 }
 
@@ -396,10 +401,12 @@ fn guided_correct_agrees_on_real_guides() {
         };
         for (s, &(px, py)) in SUBPASSES.iter().enumerate() {
             for (g, frame) in [(&g, 2), (&first, 1)] {
+                // As the synthesizer sets it (random states try both).
                 let p = CorrectParams {
                     px,
                     py,
                     prior: DEFAULT_PRIOR,
+                    similar: i >= Params::default().similar_from,
                 };
                 let runs = rig.correct(i, (&st, parent.as_ref()), &p, Some(g));
                 let what = format!("real guide, frame {frame}, level {i}, subpass {s}");
@@ -422,6 +429,7 @@ fn controls_change_the_result_as_intended() {
         px: 0,
         py: 0,
         prior: DEFAULT_PRIOR,
+        similar: true,
     };
     let plain = copy(&st);
     correct::correct(&atlas, &plain, None, &p);

@@ -102,6 +102,40 @@ fn without_jitter_the_exemplar_is_reproduced() {
     }
 }
 
+/// `Params::similar_from`: levels from it on score C₂ too, finer ones C₁
+/// alone. Moving it from 0 (the paper's k = 2 everywhere) to 1 leaves
+/// every level above 0 as it was and changes level 0 (C₂ wins there
+/// rarely, but somewhere in 256²); moving it above level 1 changes level 1.
+#[test]
+fn similar_from_sets_where_c2_competes() {
+    let levels = |from: usize| {
+        let params = Params {
+            keep_levels: true,
+            similar_from: from,
+            ..Params::default()
+        };
+        let out = Synthesizer::new(db(), params)
+            .unwrap()
+            .run(256, 256, 3)
+            .unwrap();
+        out.levels
+    };
+    let (paper, default, coarse) = (levels(0), levels(1), levels(2));
+    let same =
+        |a: &[terrasynth::synth::LevelMaps], b: &[terrasynth::synth::LevelMaps], l: usize| {
+            a[l].coords == b[l].coords && a[l].offsets == b[l].offsets
+        };
+    for l in 1..paper.len() {
+        assert!(
+            same(&paper, &default, l),
+            "level {l} changed without C₂ at level 0"
+        );
+    }
+    assert!(!same(&paper, &default, 0), "level 0 ignored similar_from");
+    assert!(!same(&default, &coarse, 1), "level 1 ignored similar_from");
+    assert!(same(&default, &coarse, 2), "level 2 changed");
+}
+
 /// At every jitter up to the `--jitter` limit of 4 texels — which carries
 /// a child past the 2-texel margin, into the gap or off the atlas, unless
 /// the clamp picks the parent's exemplar (`--jitter 4` crashed before).

@@ -210,7 +210,7 @@ fn synthesize<'py>(
         passes,
         start_exemplar,
         prior: height_prior.unwrap_or(Params::default().prior),
-        keep_levels: false,
+        ..Params::default()
     };
     let db = db.db.clone();
     let hf = py

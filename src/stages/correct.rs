@@ -4,8 +4,9 @@
 //! 1. the synthesis neighbourhood N_S (eq. 5–6): for each diagonal δ, the sum
 //!    over v ∈ {0, (δx,0), (0,δy)} of `A(S(p+δ+v) − v) + V(p+δ+v)·a`;
 //! 2. the candidates Q (eq. 3): for Δ ∈ {−1,0,1}², u = S(p+Δ) − Δ and its
-//!    k = 2 similarity entries C₁(u) = u, C₂(u); identical u are evaluated
-//!    once (in coherent patches most of the nine coincide);
+//!    k = 2 similarity entries C₁(u) = u, C₂(u) (k = 1, C₁ alone, where
+//!    [`CorrectParams::similar`] is off); identical u are evaluated once
+//!    (in coherent patches most of the nine coincide);
 //! 3. the score of each candidate q (eq. 7): `κ·min_h ‖N_S − N_E(q, h)‖²`
 //!    with N_E the four diagonal appearance texels of q plus `h` on mode 1,
 //!    κ = 1 for C₁ and 2 for C₂ (the "κ = 1/2");
@@ -230,6 +231,9 @@ pub struct CorrectParams {
     /// Height prior weight P, one of [`PRIORS`] (0: the paper's relative
     /// matching).
     pub prior: u32,
+    /// Whether each source u also offers its most similar texel C₂ (the
+    /// paper's k = 2); without, C₁ alone (k = 1). See [`crate::synth::Params::similar_from`].
+    pub similar: bool,
 }
 
 /// Subpass order within a pass (the four parity classes).
@@ -360,7 +364,7 @@ fn guided<const P: u32>(
             let first = b * ROWS_PER_TASK;
             let ys: [usize; ROWS_PER_TASK] = std::array::from_fn(|j| y_first + 2 * (first + j));
             let ys = &ys[..ROWS_PER_TASK.min(rows - first)];
-            simd::correct_span::<P>(atlas, st, parent, ys, x_first, x_end, g);
+            simd::correct_span::<P>(atlas, st, parent, (ys, x_first, x_end), p.similar, g);
         });
 }
 

@@ -341,12 +341,8 @@ impl<'db> Synthesizer<'db> {
                 match control {
                     None => {
                         for _pass in 0..self.params.passes {
-                            for &(px, py) in &SUBPASSES {
-                                let p = CorrectParams {
-                                    px,
-                                    py,
-                                    prior: self.params.prior,
-                                };
+                            for &sub in &SUBPASSES {
+                                let p = self.correct_params(level, sub);
                                 b.correct(&state, parent.as_ref(), level, &p);
                             }
                         }
@@ -500,6 +496,16 @@ impl<'db> Synthesizer<'db> {
             jitter: if level > l { 0 } else { self.jitter },
             step: self.step(level, l),
             origin: [region.x0 as u32, region.y0 as u32],
+        }
+    }
+
+    /// The settings of subpass `(px, py)` of a correction at `level`.
+    fn correct_params(&self, level: usize, (px, py): (u32, u32)) -> CorrectParams {
+        CorrectParams {
+            px,
+            py,
+            prior: self.params.prior,
+            similar: level >= self.params.similar_from,
         }
     }
 

@@ -34,7 +34,7 @@ use super::window::{REACH_PER_SUBPASS, changed_bounds, double, row_bounds, union
 use super::{Control, Frames, PassResult, SynthError, Synthesizer};
 use crate::backend::Backend;
 use crate::level::state::State;
-use crate::stages::correct::{Coherence, CorrectParams, Guide, SUBPASSES};
+use crate::stages::correct::{Coherence, Guide, SUBPASSES};
 
 /// One level's buffers for [`Synthesizer::correct_cropped`]: the state,
 /// the level above and its size, and where the level lies.
@@ -244,12 +244,8 @@ impl Synthesizer<'_> {
         level: usize,
         g: &B::Guide<'_>,
     ) {
-        for &(px, py) in &SUBPASSES {
-            let p = CorrectParams {
-                px,
-                py,
-                prior: self.params.prior,
-            };
+        for &sub in &SUBPASSES {
+            let p = self.correct_params(level, sub);
             b.correct_guided(state, parent, level, &p, g);
         }
     }

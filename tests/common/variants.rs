@@ -166,7 +166,8 @@ impl<'db> Rig<'db> {
     }
 
     /// [`Rig::correct`] for every subpass at every height prior weight,
-    /// each from copies of `st`; every variant must agree.
+    /// with and without C₂, each from copies of `st`; every variant must
+    /// agree.
     pub fn correct_at_every_prior(
         &self,
         level: usize,
@@ -176,10 +177,17 @@ impl<'db> Rig<'db> {
     ) {
         for &(px, py) in &SUBPASSES {
             for &prior in &PRIORS {
-                let p = CorrectParams { px, py, prior };
-                let runs = self.correct(level, (st, parent), &p, g);
-                let what = format!("{what}, subpass ({px},{py}), prior {prior}");
-                assert_agree(&runs, &what);
+                for similar in [true, false] {
+                    let p = CorrectParams {
+                        px,
+                        py,
+                        prior,
+                        similar,
+                    };
+                    let runs = self.correct(level, (st, parent), &p, g);
+                    let what = format!("{what}, subpass ({px},{py}), prior {prior}, C₂ {similar}");
+                    assert_agree(&runs, &what);
+                }
             }
         }
     }

@@ -96,6 +96,7 @@ impl Gpu {
             level: g.level,
             type_count: self.levels[level].type_count,
             prior: p.prior,
+            similar: p.similar as u32,
             x0: x0 as u32,
             y0: y0 as u32,
             x1: x1.min(st.width) as u32,

@@ -145,6 +145,12 @@ pub struct SynthesisArgs {
     /// altitude the coarser level chose (more relief, less drift).
     #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
     pub height_prior: u32,
+    /// The finest level whose correction also scores each source's most
+    /// similar texel C₂ (k = 2); finer levels score C₁ alone. 0 is the
+    /// paper's k = 2 at every level; the default leaves out level 0, where
+    /// C₂ almost never wins.
+    #[arg(long, default_value_t = 1)]
+    pub similar_from: usize,
 }
 
 impl SynthesisArgs {
@@ -155,6 +161,7 @@ impl SynthesisArgs {
             passes: self.passes,
             start_exemplar: self.start_exemplar,
             prior: self.height_prior,
+            similar_from: self.similar_from,
             keep_levels,
         }
     }

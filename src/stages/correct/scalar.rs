@@ -139,18 +139,6 @@ pub(super) fn neighbour(atlas: &AtlasLevel<'_>, st: &State, x: i32, y: i32) -> N
     }
 }
 
-/// Corrects one pixel; returns its new coordinate and offset.
-#[inline(always)]
-pub fn correct_pixel(
-    atlas: &AtlasLevel<'_>,
-    st: &State,
-    x: i32,
-    y: i32,
-    prior: Prior,
-) -> (Coord, i32) {
-    correct_pixel_guided(atlas, st, x, y, &Guide::NONE, prior)
-}
-
 /// The best candidate so far: cost, coordinate, offset, and its texel
 /// (None for a frozen previous result, which is taken as is).
 type Best = (u32, Coord, i32, Option<(i32, i32)>);
@@ -161,7 +149,8 @@ type Best = (u32, Coord, i32, Option<(i32, i32)>);
 ///    its optimal offset; where coherent (0 < W < 1) the previous S and V
 ///    as they are, scored with that offset; where frozen (W = 0) the
 ///    previous S and V at cost 0;
-/// 2. the k-coherence candidates, those of a type outside R^i(p) rejected;
+/// 2. the k-coherence candidates (C₂ only if `similar`), those of a type
+///    outside R^i(p) rejected;
 /// 3. if a type constraint rejected them all, 9 hash-chosen seeds per
 ///    allowed type, scored like C₁;
 /// 4. the winner's offset nudged by φ_d towards the blended target
@@ -177,8 +166,8 @@ type Best = (u32, Coord, i32, Option<(i32, i32)>);
 pub fn correct_pixel_guided(
     atlas: &AtlasLevel<'_>,
     st: &State,
-    x: i32,
-    y: i32,
+    (x, y): (i32, i32),
+    similar: bool,
     g: &Guide<'_>,
     prior: Prior,
 ) -> (Coord, i32) {
@@ -243,6 +232,9 @@ pub fn correct_pixel_guided(
                 if sc < best.0 {
                     *best = (sc, place(c1), hh, Some(c1));
                 }
+            }
+            if !similar {
+                continue;
             }
             let c2 = atlas.level.similar[atlas.index(u.0, u.1)];
             let c2 = ((c2 & 0xFFFF) as i32, (c2 >> 16) as i32);
@@ -315,7 +307,8 @@ pub fn correct_guided(
         .for_each(|y| {
             for x in (p.px as usize..x1.min(w)).step_by(2).filter(|&x| x >= x0) {
                 let prior = Prior::at(p.prior, parent, x, y);
-                let (s, v) = correct_pixel_guided(atlas, st, x as i32, y as i32, g, prior);
+                let at = (x as i32, y as i32);
+                let (s, v) = correct_pixel_guided(atlas, st, at, p.similar, g, prior);
                 st.set(y * w + x, s, v);
             }
         });

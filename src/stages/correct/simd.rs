@@ -90,9 +90,8 @@ pub fn correct_span<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
     parent: Option<&State>,
-    ys: &[usize],
-    x0: usize,
-    x1: usize,
+    (ys, x0, x1): (&[usize], usize, usize),
+    similar: bool,
     g: &Guide<'_>,
 ) {
     let span = Span {
@@ -102,6 +101,7 @@ pub fn correct_span<const P: u32>(
         ys,
         x0,
         x1,
+        similar,
         g,
     };
     #[cfg(target_arch = "x86_64")]
@@ -123,6 +123,8 @@ struct Span<'s> {
     ys: &'s [usize],
     x0: usize,
     x1: usize,
+    /// `CorrectParams::similar`: C₂ candidates compete.
+    similar: bool,
     g: &'s Guide<'s>,
 }
 
@@ -140,22 +142,14 @@ fn span_avx2<const P: u32>(span: &Span<'_>) {
 /// ([`best_of`]).
 #[inline(always)]
 fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
-    let Span {
-        atlas,
-        st,
-        parent,
-        ys,
-        x0,
-        x1,
-        g,
-    } = *span;
+    let (ys, x0, x1) = (span.ys, span.x0, span.x1);
     let mut grid = Grid::new();
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
         for (j, &y) in ys.iter().enumerate() {
             debug_assert!(j == 0 || y == ys[j - 1] + 2);
-            correct_chunk::<P, AVX2>(atlas, st, parent, y, a, b, j > 0, &mut grid, g);
+            correct_chunk::<P, AVX2>(span, (y, a, b), j > 0, &mut grid);
         }
         a = b;
     }
@@ -166,18 +160,20 @@ fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
 /// writes), and each pixel's own coordinate before the pixel is written.
 /// `next`: `grid` holds this chunk of class row y − 2.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn correct_chunk<const P: u32, const AVX2: bool>(
-    atlas: &AtlasLevel<'_>,
-    st: &State,
-    parent: Option<&State>,
-    y: usize,
-    x0: usize,
-    x1: usize,
+    span: &Span<'_>,
+    (y, x0, x1): (usize, usize, usize),
     next: bool,
     grid: &mut Grid,
-    g: &Guide<'_>,
 ) {
+    let Span {
+        atlas,
+        st,
+        parent,
+        similar,
+        g,
+        ..
+    } = *span;
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
     // True by construction; stated so that the compiler knows every grid
@@ -192,7 +188,7 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
     let mut left = column(app, grid, 1);
     for i in 0..n + LOOKAHEAD {
         if i < n {
-            gather(atlas, grid, 2 * i + 2, &mut ring[i % RING]);
+            gather(atlas, grid, 2 * i + 2, similar, &mut ring[i % RING]);
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
@@ -212,11 +208,12 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
             let (s, v) = match g.allowed {
                 Some(a) if a[i] != ALL_TYPES => {
                     let (x, y) = ((x0 + 2 * k) as i32, y as i32);
-                    scalar::correct_pixel_guided(atlas, st, x, y, g, prior)
+                    scalar::correct_pixel_guided(atlas, st, (x, y), similar, g, prior)
                 }
                 _ => {
                     let at = ((x0 + 2 * k, y), 2 * k + 2);
-                    decide::<P, AVX2>(atlas, st, grid, &ns, at, &ring[k % RING], g, prior.v)
+                    let p = &ring[k % RING];
+                    decide::<P, AVX2>(atlas, st, grid, &ns, at, p, similar, g, prior.v)
                 }
             };
             st.set(i, s, v);
@@ -237,6 +234,7 @@ fn decide<const P: u32, const AVX2: bool>(
     ns: &Neighbourhood,
     at: ((usize, usize), usize),
     p: &Pending,
+    similar: bool,
     g: &Guide<'_>,
     vp: i32,
 ) -> (Coord, i32) {
@@ -259,7 +257,8 @@ fn decide<const P: u32, const AVX2: bool>(
         let fixed = (!free).then_some(v);
         let t = Quad::around(app, idx, col.stride as i32);
         let (sc, h_prev) = score_with::<P>(ns, &t, 1, fixed, vp);
-        let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, p, weigh(sc, w), vp);
+        let bar = weigh(sc, w);
+        let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), bar, vp);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -268,7 +267,7 @@ fn decide<const P: u32, const AVX2: bool>(
         }
         return finish(atlas, st, grid, at, p, (cost, i, hh), g);
     }
-    let winner = best_of::<P, AVX2>(app, atlas.c2, ns, p, u32::MAX, vp);
+    let winner = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), u32::MAX, vp);
     finish(atlas, st, grid, at, p, winner, g)
 }
 

@@ -33,7 +33,8 @@ pub struct CorrectUniform {
     /// `Guide::origin` (the type-seeding hash reads absolute coordinates).
     pub origin_x: u32,
     pub origin_y: u32,
-    pub pad0: u32,
+    /// `CorrectParams::similar` (1: C₂ candidates compete).
+    pub similar: u32,
     pub pad1: u32,
     pub pad2: u32,
 }

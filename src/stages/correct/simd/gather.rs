@@ -34,7 +34,8 @@ pub(super) struct Pair {
 
 /// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
 /// distinct `u = S(p+Δ) − Δ`, in DELTAS order) and prefetches the texels
-/// scoring will read (at level 0 the atlas is larger than the L2 cache).
+/// scoring will read (at level 0 the atlas is larger than the L2 cache):
+/// C₂'s only when they compete (`similar`).
 ///
 /// The distinct u are found first, as a bit mask, with a fixed number of
 /// compares; then only they are listed, in one loop. Deciding per Δ
@@ -42,7 +43,13 @@ pub(super) struct Pair {
 /// mispredicted often (listing every Δ instead, repeats included, was
 /// slower still).
 #[inline(always)]
-pub(super) fn gather(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, out: &mut Pending) {
+pub(super) fn gather(
+    atlas: &AtlasLevel<'_>,
+    grid: &Grid,
+    c: usize,
+    similar: bool,
+    out: &mut Pending,
+) {
     let (idx, stride) = (window(&grid.idx, c), window(&grid.stride, c));
     // u lies in the exemplar of S(n), one texel from its interior, so its
     // texel index identifies it.
@@ -62,7 +69,7 @@ pub(super) fn gather(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, out: &mut Pe
             true => clamped(atlas, grid, c, k, u[k], s[k]),
             false => u[k],
         };
-        list(atlas, k, c1, (u[k], s[k]), out);
+        list(atlas, k, c1, (u[k], s[k]), similar, out);
     }
 }
 
@@ -112,16 +119,26 @@ fn firsts_scalar(u: &[i32; 9]) -> u32 {
 
 /// [`gather`]'s listing of C₁ (texel index `c1`) and C₂ of Δ =
 /// `DELTAS[k]`, whose u has texel index `u_idx` in an exemplar of row
-/// stride `stride`.
+/// stride `stride` (C₂ listed but not prefetched unless `similar`: the
+/// scorer then skips it).
 #[inline(always)]
-fn list(atlas: &AtlasLevel<'_>, k: usize, c1: i32, (u_idx, stride): (i32, i32), out: &mut Pending) {
+fn list(
+    atlas: &AtlasLevel<'_>,
+    k: usize,
+    c1: i32,
+    (u_idx, stride): (i32, i32),
+    similar: bool,
+    out: &mut Pending,
+) {
     // Scoring reads C₁'s texels q − s ± 1 and q + s ± 1 (the AVX2 scorer
     // the 32 bytes q ± s − 1 … q ± s + 2), near S(p), whose lines N_S
     // reads anyway; and C₂'s from `c2[u]`, one line.
     let app = atlas.level.appearance;
     prefetch(app, c1 - stride - 1);
     prefetch(app, c1 + stride - 1);
-    prefetch(atlas.c2, u_idx);
+    if similar {
+        prefetch(atlas.c2, u_idx);
+    }
     out.pairs[out.count / 2] = Pair {
         c1,
         stride,

@@ -137,9 +137,10 @@ fn outer(app: &[u64], grid: &Grid, c: usize, k: usize) -> i32x8 {
 }
 
 /// The best gathered candidate whose cost is below `bar`:
-/// (cost, index, optimal offset), index `usize::MAX` if none is. `AVX2`:
-/// in the span's AVX2 copy, by [`avx2`]'s scorer (the same candidates in
-/// the same order, the same strict `<`: ties keep the earlier).
+/// (cost, index, optimal offset), index `usize::MAX` if none is; C₂
+/// candidates only if `similar`. `AVX2`: in the span's AVX2 copy, by
+/// [`avx2`]'s scorer (the same candidates in the same order, the same
+/// strict `<`: ties keep the earlier).
 ///
 /// The dispatch is a constant, not a `#[target_feature]` function: those
 /// cannot be `#[inline(always)]`, and left to itself the compiler called
@@ -149,7 +150,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
     app: &[u64],
     c2: &[Quad],
     ns: &Neighbourhood,
-    p: &Pending,
+    (p, similar): (&Pending, bool),
     bar: u32,
     vp: i32,
 ) -> (u32, usize, i32) {
@@ -160,6 +161,16 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         // SAFETY: `AVX2` is set only in the span's AVX2 copy, which runs
         // only where the CPU has AVX2.
         let ns = unsafe { avx2::ns256(ns) };
+        if !similar {
+            for (j, pair) in pairs.iter().enumerate() {
+                // SAFETY: as below.
+                let (sc, hh) = unsafe { avx2::score_c1::<P>(app, &ns, pair, vp) };
+                if sc < best.0 {
+                    best = (sc, 2 * j, hh);
+                }
+            }
+            return best;
+        }
         for (j, pair) in pairs.iter().enumerate() {
             // SAFETY: the CPU has AVX2 (as above), C₁ is an interior
             // coordinate (see `avx2::score_pair`) and u a texel.
@@ -174,13 +185,14 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
     }
     for (j, pair) in pairs.iter().enumerate() {
         let c1 = Quad::around(app, pair.c1, pair.stride);
-        let scored = [
-            score_with::<P>(ns, &c1, 1, None, vp),
-            score_with::<P>(ns, &c2[pair.u as usize], 2, None, vp),
-        ];
-        for (i, (sc, hh)) in scored.into_iter().enumerate() {
+        let (sc, hh) = score_with::<P>(ns, &c1, 1, None, vp);
+        if sc < best.0 {
+            best = (sc, 2 * j, hh);
+        }
+        if similar {
+            let (sc, hh) = score_with::<P>(ns, &c2[pair.u as usize], 2, None, vp);
             if sc < best.0 {
-                best = (sc, 2 * j + i, hh);
+                best = (sc, 2 * j + 1, hh);
             }
         }
     }

@@ -138,6 +138,37 @@ fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
     (h, prior.cost(h), _mm256_madd_epi16(d, d))
 }
 
+/// Score and optimal offset of a pair's C₁ alone (κ = 1), where C₂ does
+/// not compete; as [`score_pair`]'s first.
+///
+/// # Safety
+/// As [`candidate_texels`].
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn score_c1<const P: u32>(
+    app: &[u64],
+    ns: &Ns256,
+    pair: &Pair,
+    vp: i32,
+) -> (u32, i32) {
+    // SAFETY: forwarded from the caller.
+    let a = unsafe { residuals::<P>(app, ns, pair.c1, pair.stride) };
+    // Σ d₁: the mode-0 lanes 0, 2, 4, 6 of `even`.
+    let (h, cost, squares) = fit::<P>(&a, lane_sum(a.even), vp);
+    // The squares sum to at most 16·9459² < 2³¹; with the prior < 2³².
+    let odd = _mm256_srli_epi64::<32>(squares);
+    let total = lane_sum(squares).wrapping_add(lane_sum(odd)) as u32;
+    (total.wrapping_add(cost), h)
+}
+
+/// The sum of lanes 0, 2, 4 and 6 of `x` (i32, wrapping).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn lane_sum(x: __m256i) -> i32 {
+    let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+    _mm_cvtsi128_si32(_mm_add_epi32(x, _mm_unpackhi_epi64(x, x)))
+}
+
 /// Scores and optimal offsets of a pair's C₁ (κ = 1) and C₂ (κ = 2), as
 /// the scalar `score`. Two at a time so that their horizontal sums share
 /// shuffles. C₂'s texels are one aligned load from `c2` (its entry is
