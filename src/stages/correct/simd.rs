@@ -101,17 +101,27 @@ pub fn correct_span<const P: u32>(
         ys,
         x0,
         x1,
-        similar,
         g,
     };
+    // A copy of the span per setting: with both scorers in one, the
+    // compiler stopped inlining the pair scorer (a call per pair cost
+    // level 1 ~8 %).
     #[cfg(target_arch = "x86_64")]
     if crate::stages::isa::avx2() {
         // SAFETY: the CPU supports AVX2, BMI1, BMI2, LZCNT and POPCNT
         // (`isa::avx2` checks them), the features the function enables.
-        unsafe { span_avx2::<P>(&span) };
+        unsafe {
+            match similar {
+                true => span_avx2::<P, true>(&span),
+                false => span_avx2::<P, false>(&span),
+            }
+        };
         return;
     }
-    run_span::<P, false>(&span);
+    match similar {
+        true => run_span::<P, false, true>(&span),
+        false => run_span::<P, false, false>(&span),
+    }
 }
 
 /// The arguments of [`correct_span`].
@@ -123,8 +133,6 @@ struct Span<'s> {
     ys: &'s [usize],
     x0: usize,
     x1: usize,
-    /// `CorrectParams::similar`: C₂ candidates compete.
-    similar: bool,
     g: &'s Guide<'s>,
 }
 
@@ -133,15 +141,15 @@ struct Span<'s> {
 /// kernel (candidate listing, the closed-form offset, the prior).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,bmi2,lzcnt,popcnt")]
-fn span_avx2<const P: u32>(span: &Span<'_>) {
-    run_span::<P, true>(span);
+fn span_avx2<const P: u32, const C2: bool>(span: &Span<'_>) {
+    run_span::<P, true, C2>(span);
 }
 
 /// [`correct_span`] for any instruction set; `AVX2`: compiled into
 /// [`span_avx2`], where the candidates are scored by [`score::avx2`]
-/// ([`best_of`]).
+/// ([`best_of`]); `C2`: `CorrectParams::similar`.
 #[inline(always)]
-fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
+fn run_span<const P: u32, const AVX2: bool, const C2: bool>(span: &Span<'_>) {
     let (ys, x0, x1) = (span.ys, span.x0, span.x1);
     let mut grid = Grid::new();
     let mut a = x0;
@@ -149,7 +157,7 @@ fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
         let b = x1.min(a + 2 * CHUNK);
         for (j, &y) in ys.iter().enumerate() {
             debug_assert!(j == 0 || y == ys[j - 1] + 2);
-            correct_chunk::<P, AVX2>(span, (y, a, b), j > 0, &mut grid);
+            correct_chunk::<P, AVX2, C2>(span, (y, a, b), j > 0, &mut grid);
         }
         a = b;
     }
@@ -160,7 +168,7 @@ fn run_span<const P: u32, const AVX2: bool>(span: &Span<'_>) {
 /// writes), and each pixel's own coordinate before the pixel is written.
 /// `next`: `grid` holds this chunk of class row y − 2.
 #[inline(always)]
-fn correct_chunk<const P: u32, const AVX2: bool>(
+fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     span: &Span<'_>,
     (y, x0, x1): (usize, usize, usize),
     next: bool,
@@ -170,10 +178,10 @@ fn correct_chunk<const P: u32, const AVX2: bool>(
         atlas,
         st,
         parent,
-        similar,
         g,
         ..
     } = *span;
+    let similar = C2;
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
     // True by construction; stated so that the compiler knows every grid
