@@ -89,10 +89,10 @@ impl Backend for Cpu<'_, '_> {
     fn reconstruct_rect(
         &self,
         st: &State,
-        prev: &[i32],
+        prev: Vec<i32>,
         rect: [usize; 4],
     ) -> Result<Vec<i32>, BackendError> {
-        let mut out = prev.to_vec();
+        let mut out = prev;
         reconstruct::reconstruct_rect(&self.atlas[0], self.heights, st, &mut out, rect);
         Ok(out)
     }

@@ -142,11 +142,13 @@ pub trait Backend {
     }
     /// [`Backend::reconstruct`] where the heights can differ from `prev`
     /// (the previous frame's, level-sized) only in `rect`: an edit's
-    /// re-synthesis. Default: the whole level.
+    /// re-synthesis. `prev` is taken so that a backend may patch it in
+    /// place (a level-sized copy per edit was a fresh 4 MB at 1024²).
+    /// Default: the whole level.
     fn reconstruct_rect(
         &self,
         st: &Self::State,
-        prev: &[i32],
+        prev: Vec<i32>,
         rect: [usize; 4],
     ) -> Result<Vec<i32>, BackendError> {
         let _ = (prev, rect);

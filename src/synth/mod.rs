@@ -392,10 +392,11 @@ impl<'db> Synthesizer<'db> {
         }
         kept.reverse();
         let t = Instant::now();
-        let prev = control.and_then(|c| c.prev.as_ref()).map(|p| p.borrow());
-        let prev_heights = prev
-            .as_ref()
-            .map(|f| &f.heights)
+        // The previous frame's heights are taken: patched, they become
+        // this frame's.
+        let prev_heights = control
+            .and_then(|c| c.prev.as_ref())
+            .map(|p| std::mem::take(&mut p.borrow_mut().heights))
             .filter(|h| h.len() == cone.region(0).width() * cone.region(0).height());
         // The fixed-point heights are kept only for the next frame.
         let keep = frames.is_some();

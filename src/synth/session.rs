@@ -479,16 +479,24 @@ fn free_within(c: &dyn super::control::Constraint, weights: &mut [u8], w: usize,
 /// (it runs on every edit, over every output pixel).
 fn change(old: &Heightfield, new: &Heightfield) -> Change {
     let w = new.width();
-    let mask: Vec<bool> = old
-        .data()
-        .par_iter()
-        .zip(new.data())
-        .map(|(a, b)| a.to_bits() != b.to_bits())
-        .collect();
+    // Zeroed by the allocator: the pages of rows that compare equal (most
+    // of an edit's) are never written. Rows compare as bytes first, one
+    // `memcmp` each; only differing rows are looked at pixel by pixel.
+    let mut mask = vec![false; old.data().len()];
+    fn bits(h: &Heightfield, y: usize) -> &[u32] {
+        bytemuck::cast_slice(h.row(y))
+    }
     let (pixels, bounds) = mask
-        .par_chunks(w)
+        .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
+            let (a, b) = (bits(old, y), bits(new, y));
+            if a == b {
+                return (0, None);
+            }
+            for ((m, a), b) in row.iter_mut().zip(a).zip(b) {
+                *m = a != b;
+            }
             let n = row.iter().filter(|c| **c).count();
             (n, row_bounds(y, 0, row.iter().copied()))
         })

@@ -43,23 +43,30 @@ impl Session<'_> {
         });
         let pasted = !self.controls.pastes.is_empty();
         let touched = self.blend.take_touched();
-        let mut weights = w0;
-        let mut levels = Vec::with_capacity(last + 1);
+        let mut w0 = Some(w0);
+        let mut levels: Vec<LevelGuide> = Vec::with_capacity(last + 1);
         let mut moved = Vec::with_capacity(last + 1);
         for (i, touched) in touched.into_iter().enumerate().take(last + 1) {
             let (w, h) = level_size(self.width, self.height, i);
-            if i > 0 {
-                let (cw, ch) = level_size(self.width, self.height, i - 1);
-                allowed = allowed.map(|a| reduce_types(&a, cw, ch, w, h, full));
-                weights = reduce_weights(&weights, cw, ch, w, h);
-                if pasted {
-                    for (k, p) in self.pasted[i].iter().enumerate() {
-                        if *p {
-                            weights[k] = W_FROZEN;
+            // Each level's weights are reduced from the level below's,
+            // which its guide already holds (no copy of either).
+            let weights = match levels.last() {
+                None => w0.take().expect("level 0 comes first"),
+                Some(below) => {
+                    let (cw, ch) = level_size(self.width, self.height, i - 1);
+                    allowed = allowed.map(|a| reduce_types(&a, cw, ch, w, h, full));
+                    let child = below.weights.as_deref().expect("every level has weights");
+                    let mut weights = reduce_weights(child, cw, ch, w, h);
+                    if pasted {
+                        for (k, p) in self.pasted[i].iter().enumerate() {
+                            if *p {
+                                weights[k] = W_FROZEN;
+                            }
                         }
                     }
+                    weights
                 }
-            }
+            };
             let before = self
                 .guides
                 .as_mut()
@@ -80,7 +87,7 @@ impl Session<'_> {
             levels.push(LevelGuide {
                 targets,
                 allowed: allowed.clone().filter(|_| i >= FIRST_LEVEL),
-                weights: Some(weights.clone()),
+                weights: Some(weights),
                 dirty: None,
             });
         }
