@@ -163,7 +163,8 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         let ns = unsafe { avx2::ns256(ns) };
         if !similar {
             for (j, pair) in pairs.iter().enumerate() {
-                // SAFETY: as below.
+                // SAFETY: the CPU has AVX2 (as above) and C₁ is an
+                // interior coordinate (see `avx2::score_pair`).
                 let (sc, hh) = unsafe { avx2::score_c1::<P>(app, &ns, pair, vp) };
                 if sc < best.0 {
                     best = (sc, 2 * j, hh);
