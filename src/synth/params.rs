@@ -31,12 +31,13 @@ pub struct Params {
     ///
     /// Why 1: at level 0, C₂ won 0.17 % of the pixels of a 1024²
     /// synthesis (0.15–0.22 % at every level: κ = 2 and the height prior
-    /// rarely let it), yet scoring it was a third of the candidates'
-    /// work and its texels the level's farthest reads. Without it at
-    /// level 0 the realism protocol (8 DEMs × 9 seeds) gave the same mean
-    /// ratio, 0.520; without it at levels 0–1 too, 0.522 (olympic 0.244 →
-    /// 0.262), and at every level 0.532, so the coarse levels keep it: a
-    /// C₂ there starts a patch from elsewhere in the exemplars.
+    /// rarely let it), yet scoring it took ~16 % of level 0's
+    /// instructions and its texels were the level's farthest reads.
+    /// Without it at level 0 the realism protocol (8 DEMs × 9 seeds) gave
+    /// the same mean ratio, 0.520; without it at levels 0–1 too, 0.522
+    /// (olympic 0.244 → 0.262), and at every level 0.532, so the coarse
+    /// levels keep it: a C₂ there starts a patch from elsewhere in the
+    /// exemplars.
     pub similar_from: usize,
     /// Keep every level's S and V in the result, for inspection.
     pub keep_levels: bool,
