@@ -181,7 +181,6 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
         g,
         ..
     } = *span;
-    let similar = C2;
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
     // True by construction; stated so that the compiler knows every grid
@@ -196,7 +195,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     let mut left = column(app, grid, 1);
     for i in 0..n + LOOKAHEAD {
         if i < n {
-            gather(atlas, grid, 2 * i + 2, similar, &mut ring[i % RING]);
+            gather(atlas, grid, 2 * i + 2, C2, &mut ring[i % RING]);
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
@@ -216,12 +215,12 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
             let (s, v) = match g.allowed {
                 Some(a) if a[i] != ALL_TYPES => {
                     let (x, y) = ((x0 + 2 * k) as i32, y as i32);
-                    scalar::correct_pixel_guided(atlas, st, (x, y), similar, g, prior)
+                    scalar::correct_pixel_guided(atlas, st, (x, y), C2, g, prior)
                 }
                 _ => {
                     let at = ((x0 + 2 * k, y), 2 * k + 2);
                     let p = &ring[k % RING];
-                    decide::<P, AVX2>(atlas, st, grid, &ns, at, p, similar, g, prior.v)
+                    decide::<P, AVX2>(atlas, st, grid, &ns, at, p, C2, g, prior.v)
                 }
             };
             st.set(i, s, v);

@@ -23,7 +23,7 @@ impl Session<'_> {
     /// Per-level rasters of this frame, with the pixels whose inputs differ
     /// from the previous frame's marked dirty. Takes the previous frame's
     /// targets (they become this frame's).
-    pub(super) fn guides(&mut self, w0: Vec<u8>) -> Guides {
+    pub(super) fn guides(&mut self, mut w0: Vec<u8>) -> Guides {
         let db = self.synth.database();
         let last = self.pasted.len() - 1;
         let cell = self.synth.cell_size_m();
@@ -43,7 +43,6 @@ impl Session<'_> {
         });
         let pasted = !self.controls.pastes.is_empty();
         let touched = self.blend.take_touched();
-        let mut w0 = Some(w0);
         let mut levels: Vec<LevelGuide> = Vec::with_capacity(last + 1);
         let mut moved = Vec::with_capacity(last + 1);
         for (i, touched) in touched.into_iter().enumerate().take(last + 1) {
@@ -51,7 +50,7 @@ impl Session<'_> {
             // Each level's weights are reduced from the level below's,
             // which its guide already holds (no copy of either).
             let weights = match levels.last() {
-                None => w0.take().expect("level 0 comes first"),
+                None => std::mem::take(&mut w0),
                 Some(below) => {
                     let (cw, ch) = level_size(self.width, self.height, i - 1);
                     allowed = allowed.map(|a| reduce_types(&a, cw, ch, w, h, full));
