@@ -97,15 +97,33 @@ impl Heightfield {
         cell_size: f64,
         f: impl Fn(usize, usize) -> f32 + Sync,
     ) -> Result<Self, SizeError> {
+        Self::from_rows(width, height, cell_size, |y, row| {
+            for (x, v) in row.iter_mut().enumerate() {
+                *v = f(x, y);
+            }
+        })
+    }
+
+    /// Builds a grid row by row, in parallel: `f(y, row)` fills row `y`.
+    /// Non-finite values become NaN (no data). For callers that can fill a
+    /// row as a slice map, which the compiler vectorizes where a call per
+    /// pixel with its own index arithmetic was not (an edit converts the
+    /// whole level to metres: ~6 % of its CPU time at 1024² before).
+    pub fn from_rows(
+        width: usize,
+        height: usize,
+        cell_size: f64,
+        f: impl Fn(usize, &mut [f32]) + Sync,
+    ) -> Result<Self, SizeError> {
         use rayon::prelude::*;
         let mut hf = Self::new(width, height, cell_size)?;
         hf.data
             .par_chunks_mut(width)
             .enumerate()
             .for_each(|(y, row)| {
-                for (x, v) in row.iter_mut().enumerate() {
-                    let h = f(x, y);
-                    *v = if h.is_finite() { h } else { f32::NAN };
+                f(y, row);
+                for v in row.iter_mut() {
+                    *v = if v.is_finite() { *v } else { f32::NAN };
                 }
             });
         Ok(hf)

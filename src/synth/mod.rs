@@ -569,11 +569,16 @@ impl<'db> Synthesizer<'db> {
         let scale = q.scale_m / (1 << HEIGHT_FRAC_BITS) as f64;
         let (r, win) = (cone.region(0), cone.window());
         let (dx, dy, stride) = (win.x0 - r.x0, win.y0 - r.y0, r.width());
-        Ok(Heightfield::from_fn(
+        Ok(Heightfield::from_rows(
             win.width(),
             win.height(),
             cell,
-            |x, y| (q.offset_m + scale * fixed[(y + dy) * stride + x + dx] as f64) as f32,
+            |y, row| {
+                let from = &fixed[(y + dy) * stride + dx..][..row.len()];
+                for (h, &v) in row.iter_mut().zip(from) {
+                    *h = (q.offset_m + scale * v as f64) as f32;
+                }
+            },
         )?)
     }
 
