@@ -32,6 +32,10 @@ impl Backend for Cpu<'_, '_> {
         Ok(st)
     }
 
+    fn host_state(&self, st: State) -> Option<State> {
+        Some(st)
+    }
+
     fn alloc(&self, width: usize, height: usize) -> Result<State, BackendError> {
         Ok(State::new(width, height))
     }

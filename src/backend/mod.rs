@@ -68,6 +68,15 @@ pub trait Backend {
     fn name(&self) -> &'static str;
     /// Moves a host state (the coarse start) to the backend.
     fn upload(&self, st: State) -> Result<Self::State, BackendError>;
+    /// The host state a backend state is, if this backend keeps its states
+    /// on the host (the CPU's: `Some`, without a copy); `None` otherwise.
+    /// A session keeps each level's final state this way, so that an
+    /// edit patches the next frame's level in place instead of rebuilding
+    /// it from the recorded results.
+    fn host_state(&self, st: Self::State) -> Option<State> {
+        let _ = st;
+        None
+    }
     /// A `width × height` state whose contents the next stage overwrites.
     fn alloc(&self, width: usize, height: usize) -> Result<Self::State, BackendError>;
     /// A copy of the pixels `[x0, x1) × [y0, y1)` of a state: windowed

@@ -125,6 +125,22 @@ impl State {
             .for_each(|(v, o)| v.iter().zip(o).for_each(|(v, &o)| v.store(o, Relaxed)));
         st
     }
+    /// Overwrites the pixels `[x0, x1) × [y0, y1)` with those of
+    /// `coords` and `offsets`, row-major rasters of this state's size.
+    pub fn write_rect(&self, [x0, y0, x1, y1]: [usize; 4], coords: &[Coord], offsets: &[i32]) {
+        let n = self.width * self.height;
+        assert_eq!((coords.len(), offsets.len()), (n, n));
+        for y in y0..y1 {
+            let row = y * self.width + x0..y * self.width + x1;
+            let (s, v) = self.run(row.start, row.len());
+            s.iter()
+                .zip(&coords[row.clone()])
+                .for_each(|(s, c)| s.store(c.pack(), Relaxed));
+            v.iter()
+                .zip(&offsets[row])
+                .for_each(|(v, &o)| v.store(o, Relaxed));
+        }
+    }
     /// A copy of the pixels `[x0, x1) × [y0, y1)`.
     pub fn crop(&self, [x0, y0, x1, y1]: [usize; 4]) -> State {
         let out = State::new(x1 - x0, y1 - y0);

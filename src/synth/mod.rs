@@ -278,8 +278,16 @@ impl<'db> Synthesizer<'db> {
         let mut kept = Vec::new();
         let mut frames = control.filter(|c| c.record).map(|_| Frames {
             levels: vec![Vec::new(); l.min(top_level(width, height)) + 1],
-            heights: Vec::new(),
+            ..Frames::default()
         });
+        // A level's whole state, once nothing reads it any more: kept in the
+        // recorded frame (`Frames::states`) where the backend has it on the
+        // host, else dropped.
+        let keep_state = |frames: &mut Option<Frames>, level: usize, st: B::State| {
+            if let Some(f) = frames.as_mut() {
+                f.keep_state(level, b.host_state(st));
+            }
+        };
         // Without a device clock, the loop waits after each stage so that
         // wall clock measures it; with one, stages queue back to back.
         let device_clock = b.has_device_clock();
@@ -289,6 +297,8 @@ impl<'db> Synthesizer<'db> {
         // offsets anchor the height prior (`correct` module docs).
         let mut parent: Option<B::State> = None;
         let mut parent_size = (0, 0);
+        // Whether `parent` is its level's whole state (not a crop of it).
+        let mut parent_whole = false;
         // Bounds of the pixels of the level above that differ from the
         // previous frame (restricted re-synthesis only).
         let mut changed_parent: Option<[usize; 4]> = None;
@@ -306,7 +316,9 @@ impl<'db> Synthesizer<'db> {
                 let above = match cone.parent_crop(level) {
                     Some(c) => {
                         parent_size = (c.width(), c.height());
-                        b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?
+                        let crop = b.crop(&state, [c.x0, c.y0, c.x1, c.y1])?;
+                        keep_state(&mut frames, level + 1, state);
+                        crop
                     }
                     None => {
                         let r = cone.region(level + 1);
@@ -314,6 +326,7 @@ impl<'db> Synthesizer<'db> {
                         state
                     }
                 };
+                let whole = cone.parent_crop(level).is_none();
                 let child = b.alloc(w, h)?;
                 let p = self.upsample_params(seed, level, region);
                 // Correcting a window with coherence reads the upsampled
@@ -332,7 +345,10 @@ impl<'db> Synthesizer<'db> {
                 if !device_clock {
                     b.finish()?;
                 }
-                parent = Some(above);
+                if let (Some(old), true) = (parent.replace(above), parent_whole) {
+                    keep_state(&mut frames, level + 2, old);
+                }
+                parent_whole = whole;
                 state = child;
                 timings.levels[level].upsample = t.elapsed();
             }
@@ -417,6 +433,10 @@ impl<'db> Synthesizer<'db> {
         if let (Some(f), Some(fixed)) = (frames.as_mut(), fixed) {
             f.heights = fixed;
         }
+        if let (Some(p), true) = (parent, parent_whole) {
+            keep_state(&mut frames, 1, p);
+        }
+        keep_state(&mut frames, 0, state);
         timings.reconstruct = t.elapsed();
         timings.total = t0.elapsed();
         if let Some(times) = b.device_times()? {

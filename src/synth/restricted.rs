@@ -164,10 +164,12 @@ impl Synthesizer<'_> {
         let (w, h) = (region.width(), region.height());
         let level_rect = Rect::new(0, 0, w, h);
         // This level's previous results, taken: each pass's becomes this
-        // frame's, with the window's pixels replaced.
-        let before = {
+        // frame's, with the window's pixels replaced; so does its final
+        // state where one was kept.
+        let (before, kept) = {
             let mut prev = c.prev.as_ref().expect("checked by can_crop").borrow_mut();
-            std::mem::take(&mut prev.levels[level])
+            let kept = prev.states.get_mut(level).and_then(Option::take);
+            (std::mem::take(&mut prev.levels[level]), kept)
         };
         let lg = &c.guides.levels[level];
         let [wx0, wy0, wx1, wy1] = widen(window, REACH_PER_SUBPASS, w, h);
@@ -232,7 +234,15 @@ impl Synthesizer<'_> {
             .as_ref()
             .or_else(|| frames.and_then(|f| f.levels[level].last()))
             .expect("passes > 0 (checked by can_crop)");
-        let st = State::from_parts(w, h, &last.coords, &last.offsets);
+        // The level's state holds the last pass's result: the previous
+        // frame's state with the window written, or (none kept) a new one.
+        let st = match kept.filter(|s| (s.width, s.height) == (w, h)) {
+            Some(st) => {
+                st.write_rect(window, &last.coords, &last.offsets);
+                st
+            }
+            None => State::from_parts(w, h, &last.coords, &last.offsets),
+        };
         Ok((changed, b.upload(st)?))
     }
 

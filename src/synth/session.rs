@@ -365,6 +365,8 @@ impl Session<'_> {
     fn paste(&mut self, p: &Paste, weights0: &mut [u8]) {
         let db = self.synth.database();
         let frames = self.frames.as_mut().expect("a frame exists before a paste");
+        // The kept final states no longer match the results written here.
+        frames.states.clear();
         let delta = (p.delta_m / db.quantization().scale_m).round() as i32;
         // Source mask at level 0, then dilated upwards (any child inside).
         let (mut sw, mut sh) = match p.source {

@@ -3,6 +3,7 @@
 //! bounds, widened by how far subpasses carry a change, can reach.
 
 use super::fixed::Coord;
+use crate::level::state::State;
 
 /// Subpass reads reach two pixels (DESIGN §5), so within one level a change
 /// spreads at most this far per subpass.
@@ -13,13 +14,65 @@ pub(super) const REACH_PER_SUBPASS: usize = 2;
 /// each pixel once, in its parity class's subpass, so the state after the
 /// pass holds every subpass's result (paper §5.3: "the results for all
 /// sub-passes are needed").
-#[derive(Debug, Clone, Default, PartialEq)]
+///
+/// Equality and clones compare and copy the recorded results; the kept
+/// [`Frames::states`] are a cache of them and are neither compared nor
+/// cloned.
+#[derive(Default)]
 pub struct Frames {
     pub levels: Vec<Vec<PassResult>>,
     /// Level 0's fixed-point heights (stage `reconstruct`'s output), which
     /// an edit's re-synthesis recomputes only where S and V can change;
     /// empty where not recorded.
     pub heights: Vec<i32>,
+    /// Each level's final state, where the backend keeps states on the
+    /// host (index = level; `None` where not kept): the same S and V as
+    /// the level's last [`PassResult`]. A restricted re-synthesis writes
+    /// its window into it instead of building the level's state afresh
+    /// from that result (at 1024² a 12 MB copy into new pages per edit,
+    /// ~14 % of an edit's CPU time). Code that changes [`Frames::levels`]
+    /// clears it.
+    pub(crate) states: Vec<Option<State>>,
+}
+
+impl Clone for Frames {
+    fn clone(&self) -> Frames {
+        Frames {
+            levels: self.levels.clone(),
+            heights: self.heights.clone(),
+            states: Vec::new(),
+        }
+    }
+}
+
+impl PartialEq for Frames {
+    fn eq(&self, other: &Frames) -> bool {
+        self.levels == other.levels && self.heights == other.heights
+    }
+}
+
+impl std::fmt::Debug for Frames {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Frames")
+            .field("levels", &self.levels)
+            .field("heights", &self.heights)
+            .field(
+                "states",
+                &self.states.iter().map(Option::is_some).collect::<Vec<_>>(),
+            )
+            .finish()
+    }
+}
+
+impl Frames {
+    /// Keeps `st` as level `level`'s final state (a level the frame
+    /// records).
+    pub(super) fn keep_state(&mut self, level: usize, st: Option<State>) {
+        if level < self.levels.len() {
+            self.states.resize_with(self.levels.len(), || None);
+            self.states[level] = st;
+        }
+    }
 }
 
 /// One level's S and V after one pass.

@@ -101,7 +101,7 @@ impl Synthesizer<'_> {
                             .collect()
                     })
                     .collect(),
-                heights: Vec::new(),
+                ..Frames::default()
             };
             let guides = self.window_guides(&cone, last, c, Some(&pastes))?;
             let two = self.run_cone(&cone, seed, &guides, Some(prev), false)?.0;

@@ -219,6 +219,8 @@ pub(super) fn pasted(pastes: &[PasteGeometry], i: usize, rect: Rect) -> Vec<bool
 /// any write of that paste and level). Targets whose source lies outside
 /// the region are left alone: they lie outside what [`needs`] asked for.
 pub(super) fn write(pastes: &[PasteGeometry], frames: &mut Frames, regions: &[Rect]) {
+    // The kept final states no longer match the results written here.
+    frames.states.clear();
     for p in pastes {
         for (i, passes) in frames.levels.iter_mut().enumerate() {
             let r = regions[i];
