@@ -306,7 +306,7 @@ fn finish(
     debug_assert!(best.1 < p.count);
     let pair = &p.pairs[best.1 / 2];
     let (q, idx) = match best.1 % 2 {
-        0 => (c1_texel(atlas, grid, c, pair.from as usize), pair.c1),
+        0 => (c1_texel(atlas, grid, c, (p, pair.from as usize)), pair.c1),
         _ => {
             let c = atlas.level.similar[pair.u as usize];
             let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);

@@ -15,6 +15,9 @@ pub(super) struct Pending {
     pub pairs: [Pair; 9],
     /// Candidates (twice the pairs).
     pub count: usize,
+    /// Whether a neighbour lies next to an edge, so that C₁ may differ
+    /// from u (else the winner's coordinate is u's, unclamped).
+    pub edge: bool,
 }
 
 /// The two candidates of one u.
@@ -62,6 +65,7 @@ pub(super) fn gather(
     out.count = 0;
     // C₁ is u itself unless a neighbour lies next to an edge (rare).
     let edge = any_edge(grid, c);
+    out.edge = edge;
     while first != 0 {
         let k = first.trailing_zeros() as usize;
         first &= first - 1;
@@ -158,11 +162,20 @@ fn u_texel(grid: &Grid, c: usize, k: usize) -> (i32, i32) {
 }
 
 /// C₁'s texel: [`u_texel`] clamped into its exemplar's interior (the same
-/// exemplar as t(n)).
+/// exemplar as t(n)); u itself unless the pixel `p` has a neighbour next
+/// to an edge.
 #[inline(always)]
-pub(super) fn c1_texel(atlas: &AtlasLevel<'_>, grid: &Grid, c: usize, k: usize) -> (i32, i32) {
+pub(super) fn c1_texel(
+    atlas: &AtlasLevel<'_>,
+    grid: &Grid,
+    c: usize,
+    (p, k): (&Pending, usize),
+) -> (i32, i32) {
     let (ux, uy) = u_texel(grid, c, k);
-    atlas.clamp_interior(ux, uy)
+    match p.edge {
+        true => atlas.clamp_interior(ux, uy),
+        false => (ux, uy),
+    }
 }
 
 /// C₁'s texel index, from u's (`u_idx`, in an exemplar of row stride
