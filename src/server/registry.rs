@@ -17,7 +17,9 @@ use std::time::Duration;
 /// previous frame's per-pass results, guides, constraint sums, curve fields,
 /// the heightfield and the preview. Measured as the server's resident size
 /// at 1024²: +57 MiB for a new session, +117 MiB more once it has a point,
-/// a curve and painted types (≈ 166 B/px); rounded up.
+/// a curve and painted types (≈ 166 B/px); since then a session also keeps
+/// each level's final state (`Frames::states`, 12 B/px at level 0, 16 with
+/// the coarser levels: ≈ 182 B/px). Rounded up.
 pub const SESSION_BYTES_PER_PIXEL: u64 = 200;
 
 pub struct Registry {
