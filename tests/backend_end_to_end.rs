@@ -125,7 +125,7 @@ fn scene_session_matches_end_to_end() {
         if let Some(i) = (0..a.len()).find(|&i| a[i].to_bits() != b[i].to_bits()) {
             panic!("frame {k}: pixel {i}: GPU {} m vs CPU {} m", b[i], a[i]);
         }
-        for (level, (cl, gl)) in cf.levels.iter().zip(&gf.levels).enumerate() {
+        for (level, (cl, gl)) in cf.levels().iter().zip(gf.levels()).enumerate() {
             assert!(
                 cl == gl,
                 "frame {k}: level {level}: per-pass results differ"

@@ -380,7 +380,7 @@ fn guided_correct_agrees_on_real_guides() {
             .filter(|m| !m.coords.is_empty())
             .map(from_maps);
         let lg = &guides.levels[i];
-        let r = &f1.levels[i][0];
+        let r = &f1.levels()[i][0];
         let g = Guide {
             level: i as u32,
             targets: lg.targets.as_deref(),

@@ -183,7 +183,7 @@ fn painted_types_take_their_coordinates_from_that_type() {
         let f = s.frames().unwrap();
         let lvl = db.level(2);
         let atlas = terrasynth::synth::atlas::AtlasLevel::new(db, 2);
-        let last = f.levels[2].last().unwrap();
+        let last = f.levels()[2].last().unwrap();
         let w = N / 4;
         let (mut inside, mut ok) = (0, 0);
         for (k, co) in last.coords.iter().enumerate() {

@@ -16,11 +16,14 @@ pub(super) const REACH_PER_SUBPASS: usize = 2;
 /// sub-passes are needed").
 ///
 /// Equality and clones compare and copy the recorded results; the kept
-/// [`Frames::states`] are a cache of them and are neither compared nor
+/// `states` are a cache of them and are neither compared nor
 /// cloned.
 #[derive(Default)]
 pub struct Frames {
-    pub levels: Vec<Vec<PassResult>>,
+    /// Per level, per pass (read with [`Frames::levels`]: crate code that
+    /// changes them also clears [`Frames::states`], which outside code
+    /// could not).
+    pub(crate) levels: Vec<Vec<PassResult>>,
     /// Level 0's fixed-point heights (stage `reconstruct`'s output), which
     /// an edit's re-synthesis recomputes only where S and V can change;
     /// empty where not recorded.
@@ -65,6 +68,12 @@ impl std::fmt::Debug for Frames {
 }
 
 impl Frames {
+    /// Every corrected level's results after each pass (index = level,
+    /// then pass).
+    pub fn levels(&self) -> &[Vec<PassResult>] {
+        &self.levels
+    }
+
     /// Keeps `st` as level `level`'s final state (a level the frame
     /// records).
     pub(super) fn keep_state(&mut self, level: usize, st: Option<State>) {

@@ -97,7 +97,7 @@ pub fn synth_scene(
         // The last pass of level 0 is what reconstruction read.
         let l0 = session
             .frames()
-            .and_then(|f| f.levels.first())
+            .and_then(|f| f.levels().first())
             .and_then(|l| l.last())
             .ok_or("no level-0 coordinates: the scene runs 0 correction passes")?;
         let stride = terrasynth::synth::state::level_size(scene.width, scene.height, 0).0;
