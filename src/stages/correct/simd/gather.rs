@@ -62,18 +62,23 @@ pub(super) fn gather(
         at(&idx, dx, dy) - dx - dy * s[k]
     });
     let mut first = firsts(&u);
-    out.count = 0;
+    out.count = 2 * first.count_ones() as usize;
     // C₁ is u itself unless a neighbour lies next to an edge (rare).
     let edge = any_edge(grid, c);
     out.edge = edge;
-    while first != 0 {
+    // One slot per distinct u, in order (a slot per iteration, not an
+    // index: no bounds check, and the count is known up front).
+    for slot in &mut out.pairs {
+        if first == 0 {
+            break;
+        }
         let k = first.trailing_zeros() as usize;
         first &= first - 1;
         let c1 = match edge {
             true => clamped(atlas, grid, c, k, u[k], s[k]),
             false => u[k],
         };
-        list(atlas, k, c1, (u[k], s[k]), similar, out);
+        *slot = list(atlas, k, c1, (u[k], s[k]), similar);
     }
 }
 
@@ -132,8 +137,7 @@ fn list(
     c1: i32,
     (u_idx, stride): (i32, i32),
     similar: bool,
-    out: &mut Pending,
-) {
+) -> Pair {
     // Scoring reads C₁'s texels q − s ± 1 and q + s ± 1 (the AVX2 scorer
     // the 32 bytes q ± s − 1 … q ± s + 2), near S(p), whose lines N_S
     // reads anyway; and C₂'s from `c2[u]`, one line.
@@ -143,13 +147,12 @@ fn list(
     if similar {
         prefetch(atlas.c2, u_idx);
     }
-    out.pairs[out.count / 2] = Pair {
+    Pair {
         c1,
         stride,
         u: u_idx,
         from: k as u8,
-    };
-    out.count += 2;
+    }
 }
 
 /// The texel u = t(n) − Δ of the neighbour at Δ = `DELTAS[k]` of the
