@@ -82,12 +82,13 @@
 //! unconstrained terrain's (within 6 px, 99 %). Type constraints stay off
 //! on the finest two levels ([`super::FIRST_LEVEL`]).
 
-use super::Constraint;
+use super::{Constraint, Hold};
 use crate::database::Quantization;
 use crate::synth::cone::Rect;
 use crate::synth::union;
 use crate::synth::window::row_bounds;
 use rayon::prelude::*;
+use std::ops::Range;
 
 pub use crate::stages::correct::nudge::{MAX_TOL, Target};
 
@@ -230,8 +231,6 @@ impl Blend {
         for (i, level) in self.levels.iter_mut().enumerate() {
             let scale = (1u64 << i) as f64;
             let cap = hold.level_cap.map_or(f64::INFINITY, |k| k * scale);
-            // Radius of the disc inscribed in a pixel's footprint.
-            let half = scale / 2.0;
             // Level pixels of the region whose centre lies in the bounds.
             let range = |a: f64, b: f64, from: usize, n: usize| {
                 let lo = ((a / scale - 0.5).ceil().max(0.0) as usize).clamp(from, from + n);
@@ -243,60 +242,28 @@ impl Blend {
                 level.sums = vec![Sums::default(); w * h];
             }
             let (ys, xs) = (range(y0, y1, level.y0, h), range(x0, x1, level.x0, w));
-            let (lx0, ly0) = (level.x0, level.y0);
+            let stamp = Stamp {
+                c,
+                sign,
+                q: &q,
+                hold: &hold,
+                scale,
+                cap,
+                xs,
+                origin: (level.x0, level.y0),
+                width: w,
+            };
             // Tile rows in parallel, each owning its rows of sums (integer
             // sums: the order of the additions changes nothing). Moving a
             // point samples its footprint twice at every level; serially
             // that was ~8 % of an edit's CPU time, with the other core idle.
-            let rows = &mut level.sums[(ys.start - ly0) * w..(ys.end - ly0) * w];
+            let rows = &mut level.sums[(ys.start - level.y0) * w..(ys.end - level.y0) * w];
             let (reached, touched) = rows
                 .par_chunks_mut(TILE * w)
                 .enumerate()
                 .map(|(k, rows)| {
                     let ty = ys.start + k * TILE;
-                    let ty1 = (ty + TILE).min(ys.end);
-                    let (mut reached, mut touched) = (0i64, None);
-                    for tx in xs.clone().step_by(TILE) {
-                        let tx1 = (tx + TILE).min(xs.end);
-                        // Skip a tile whose every pixel centre is beyond the
-                        // cap (exact: see `Constraint::distance_bound`).
-                        let centre = |a: usize, b: usize| (a + b) as f64 / 2.0 * scale;
-                        let spread = ((tx1 - 1 - tx) as f64).hypot((ty1 - 1 - ty) as f64);
-                        let bound = c.distance_bound(centre(tx, tx1), centre(ty, ty1));
-                        if bound - spread * scale / 2.0 > cap.min(hold.max_reach) {
-                            continue;
-                        }
-                        for y in ty..ty1 {
-                            let row = &mut rows[(y - ty) * w..][..w];
-                            let oy = (y as f64 + 0.5) * scale;
-                            let mut hit = None;
-                            for x in tx..tx1 {
-                                let Some(s) = c.sample((x as f64 + 0.5) * scale, oy) else {
-                                    continue;
-                                };
-                                // NaN distances (a broken constraint) never count.
-                                let inside = s.distance <= s.reach.min(cap);
-                                if !inside {
-                                    continue;
-                                }
-                                let d_tol = (s.distance - half).max(0.0);
-                                let t_px = hold.tolerance_slope * d_tol;
-                                let (b, bh, bd) = contribution(&q, s.target_m, s.distance, t_px);
-                                let cell = &mut row[x - lx0];
-                                let was = cell.b != 0;
-                                cell.b += sign * b;
-                                cell.bh += sign * bh;
-                                cell.bd += sign * bd;
-                                reached += (cell.b != 0) as i64 - was as i64;
-                                hit = Some((hit.map_or(x, |(a, _)| a), x + 1));
-                            }
-                            if let Some((a, b)) = hit {
-                                let (a, b, y) = (a - lx0, b - lx0, y - ly0);
-                                touched = union(touched, Some([a, y, b, y + 1]));
-                            }
-                        }
-                    }
-                    (reached, touched)
+                    stamp.tile_row(ty..(ty + TILE).min(ys.end), rows)
                 })
                 .reduce(|| (0, None), |a, b| (a.0 + b.0, union(a.1, b.1)));
             level.reached = level.reached.wrapping_add_signed(reached as isize);
@@ -376,6 +343,83 @@ fn target(s: &Sums, px_to_units: f64) -> Target {
     Target {
         height: height.clamp(i32::MIN as i64 / 2, i32::MAX as i64 / 2) as i32,
         tol,
+    }
+}
+
+/// One constraint's contribution to one level's sums ([`Blend`]'s apply),
+/// added tile row by tile row.
+struct Stamp<'a> {
+    c: &'a dyn Constraint,
+    /// +1 to add the constraint, −1 to take it away.
+    sign: i64,
+    q: &'a Quantization,
+    hold: &'a Hold,
+    /// Output pixels per level pixel.
+    scale: f64,
+    /// The level's reach cap, output pixels.
+    cap: f64,
+    /// Level columns whose centre lies in the constraint's bounds.
+    xs: Range<usize>,
+    /// The level region's corner and width (sums are region-relative).
+    origin: (usize, usize),
+    width: usize,
+}
+
+impl Stamp<'_> {
+    /// Adds the constraint to level rows `ys` (at most one tile high),
+    /// whose sums are `rows`; returns the change in reached pixels and the
+    /// bounds of the sums it changed.
+    fn tile_row(&self, ys: Range<usize>, rows: &mut [Sums]) -> (i64, Option<[usize; 4]>) {
+        let (mut reached, mut touched) = (0, None);
+        let (x0, y0) = self.origin;
+        for tx in self.xs.clone().step_by(TILE) {
+            let tx1 = (tx + TILE).min(self.xs.end);
+            // Skip a tile whose every pixel centre is beyond the cap
+            // (exact: see `Constraint::distance_bound`).
+            let centre = |a: usize, b: usize| (a + b) as f64 / 2.0 * self.scale;
+            let spread = ((tx1 - 1 - tx) as f64).hypot((ys.end - 1 - ys.start) as f64);
+            let bound = self
+                .c
+                .distance_bound(centre(tx, tx1), centre(ys.start, ys.end));
+            if bound - spread * self.scale / 2.0 > self.cap.min(self.hold.max_reach) {
+                continue;
+            }
+            for y in ys.clone() {
+                let row = &mut rows[(y - ys.start) * self.width..][..self.width];
+                let mut hit = None;
+                for x in tx..tx1 {
+                    if let Some(change) = self.pixel(&mut row[x - x0], x, y) {
+                        reached += change;
+                        hit = Some((hit.map_or(x, |(a, _)| a), x + 1));
+                    }
+                }
+                if let Some((a, b)) = hit {
+                    touched = union(touched, Some([a - x0, y - y0, b - x0, y - y0 + 1]));
+                }
+            }
+        }
+        (reached, touched)
+    }
+
+    /// Adds the constraint to level pixel (x, y)'s sums `cell`; `None` where
+    /// it does not reach the pixel, else the change in reached pixels.
+    fn pixel(&self, cell: &mut Sums, x: usize, y: usize) -> Option<i64> {
+        let at = |v: usize| (v as f64 + 0.5) * self.scale;
+        let s = self.c.sample(at(x), at(y))?;
+        // NaN distances (a broken constraint) never count.
+        let inside = s.distance <= s.reach.min(self.cap);
+        if !inside {
+            return None;
+        }
+        // Radius of the disc inscribed in a pixel's footprint.
+        let d_tol = (s.distance - self.scale / 2.0).max(0.0);
+        let t_px = self.hold.tolerance_slope * d_tol;
+        let (b, bh, bd) = contribution(self.q, s.target_m, s.distance, t_px);
+        let was = cell.b != 0;
+        cell.b += self.sign * b;
+        cell.bh += self.sign * bh;
+        cell.bd += self.sign * bd;
+        Some((cell.b != 0) as i64 - was as i64)
     }
 }
 
