@@ -78,10 +78,11 @@ const _: () = assert!(RING > LOOKAHEAD && RING.is_power_of_two());
 /// (consecutive: y, y + 2, …), writing each result as it is found.
 ///
 /// The rows are walked one column chunk at a time, top to bottom, so that
-/// each chunk's next row reuses two of the grid rows of the one before
-/// (level rows y and y + 1 are rows 2–3 of row y's grid and rows 0–1 of
-/// row y + 2's; neither holds a pixel the subpass writes at the columns
-/// read): a fill reads 2½ rows of taps instead of 4.
+/// each chunk's next row reuses three of the grid rows of the one before
+/// (level rows y, y + 1 and y + 2 are rows 2–4 of row y's grid and rows
+/// 0–2 of row y + 2's; see [`grid::fill`] for why they are unchanged):
+/// a fill reads two rows of taps instead of 4, each level row once per
+/// subpass.
 ///
 /// On x86-64 CPUs with AVX2 the same code runs compiled for AVX2 (picked at
 /// run time; the baseline build targets SSE2): the `wide` vectors and the
@@ -157,7 +158,8 @@ fn run_span<const P: u32, const AVX2: bool, const C2: bool>(span: &Span<'_>) {
         let b = x1.min(a + 2 * CHUNK);
         for (j, &y) in ys.iter().enumerate() {
             debug_assert!(j == 0 || y == ys[j - 1] + 2);
-            correct_chunk::<P, AVX2, C2>(span, (y, a, b), j > 0, &mut grid);
+            let at = (j > 0, j + 1 < ys.len());
+            correct_chunk::<P, AVX2, C2>(span, (y, a, b), at, &mut grid);
         }
         a = b;
     }
@@ -166,12 +168,13 @@ fn run_span<const P: u32, const AVX2: bool, const C2: bool>(span: &Span<'_>) {
 /// One chunk `[x0, x1)` of a span. Reading the neighbours up front is safe:
 /// a subpass reads only pixels of other parity classes (which it never
 /// writes), and each pixel's own coordinate before the pixel is written.
-/// `next`: `grid` holds this chunk of class row y − 2.
+/// `rows`: whether `grid` holds this chunk of class row y − 2, and whether
+/// class row y + 2 follows (see [`grid::fill`]).
 #[inline(always)]
 fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     span: &Span<'_>,
     (y, x0, x1): (usize, usize, usize),
-    next: bool,
+    rows: (bool, bool),
     grid: &mut Grid,
 ) {
     let Span {
@@ -186,7 +189,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     // True by construction; stated so that the compiler knows every grid
     // column a pixel reads (≤ 2n + 2) is inside the grid.
     assert!(n <= CHUNK);
-    grid::fill::<AVX2>(grid, atlas, st, y, x0, n, next);
+    grid::fill::<AVX2>(grid, atlas, st, y, x0, n, rows);
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
     let parent = parent.map(|pa| ParentRow::new(pa, y));

@@ -37,12 +37,13 @@ pub(super) struct Grid {
     /// interior, so that C₁ = u needs the clamp: t(n) is not strictly
     /// inside the interior, or the neighbour lies outside the level (its
     /// texel is extrapolated). Elsewhere C₁ is u itself.
-    pub edge: Field<bool>,
+    /// (1 or 0: bytes, so that the AVX2 fill stores four flags at once.)
+    pub edge: Field<u8>,
     /// Per column, whether rows 1–3 (the pixel's 3×3) hold an
     /// [`Grid::edge`] neighbour: formed once per fill, so that a pixel's
     /// test ([`any_edge`]) is one read instead of three rows' (~20
     /// instructions per pixel).
-    pub edge3: [bool; GRID_COLS],
+    pub edge3: [u8; GRID_COLS],
     /// The rounded coordinate t(n), read only to clamp C₁ at an edge and
     /// for the winner's coordinate.
     pub sx: Field<i32>,
@@ -56,8 +57,8 @@ impl Grid {
             idx: [[0; GRID_COLS]; 5],
             stride: [[0; GRID_COLS]; 5],
             v: [[0; GRID_COLS]; 5],
-            edge: [[true; GRID_COLS]; 5],
-            edge3: [true; GRID_COLS],
+            edge: [[1; GRID_COLS]; 5],
+            edge3: [1; GRID_COLS],
             sx: [[0; GRID_COLS]; 5],
             sy: [[0; GRID_COLS]; 5],
         }
@@ -82,7 +83,7 @@ impl Grid {
         self.v[r][j] = v;
         self.sx[r][j] = sx;
         self.sy[r][j] = sy;
-        self.edge[r][j] = edge;
+        self.edge[r][j] = edge as u8;
     }
 
     /// Stores the neighbour at row `r`, column `j`, level position (x, y)
@@ -106,15 +107,15 @@ impl Grid {
         self.put(r, j, idx, stride, n.v, n.tx, n.ty, true);
     }
 
-    /// Copies rows 2–3 to rows 0–1 (the next class row's top).
+    /// Copies rows 2–4 to rows 0–2 (the next class row's top).
     #[inline(always)]
     fn shift(&mut self) {
-        self.idx.copy_within(2..4, 0);
-        self.stride.copy_within(2..4, 0);
-        self.v.copy_within(2..4, 0);
-        self.edge.copy_within(2..4, 0);
-        self.sx.copy_within(2..4, 0);
-        self.sy.copy_within(2..4, 0);
+        self.idx.copy_within(2..5, 0);
+        self.stride.copy_within(2..5, 0);
+        self.v.copy_within(2..5, 0);
+        self.edge.copy_within(2..5, 0);
+        self.sx.copy_within(2..5, 0);
+        self.sy.copy_within(2..5, 0);
     }
 }
 
@@ -149,18 +150,29 @@ fn put_pixel(
 }
 
 /// Reads the neighbours of the `n` class pixels from column `x0` of row
-/// `y` into `grid`. Rows y ± 2 are read only at odd offsets from the
-/// class. `next`: the grid holds the same columns of class row y − 2,
-/// whose rows 2–3 are this row's rows 0–1 (unchanged: the subpass writes
-/// neither row y − 1 nor row y − 2 at odd offsets).
+/// `y` into `grid`. Row y − 2 is read only at odd offsets from the class.
+/// `next`: the grid holds the same columns of class row y − 2, whose
+/// rows 2–4 are this row's rows 0–2 (unchanged since: the subpass writes
+/// neither row y − 1 nor row y − 2 at odd offsets, and row y only after
+/// this fill). `more`: the same task corrects class row y + 2 of these
+/// columns next, so row 4 (level row y + 2) is read whole, to become that
+/// row's row 2 — nothing writes row y + 2 before then, and its pixels
+/// are read before they are written. Otherwise row y + 2 may belong to
+/// another task, which writes its class pixels meanwhile: only its odd
+/// offsets are read.
+///
+/// Why whole: each level row is then read once per subpass, as row 4 of
+/// one class row and kept as row 2 of the next, instead of once at odd
+/// offsets (one neighbour at a time) and again whole (four at a time).
 ///
 /// Neighbours outside the level (within two texels of its border) take
 /// the scalar path's reflection one by one; the rest are read as row
 /// slices.
 ///
-/// `AVX2`: in the span's AVX2 copy, the row runs go four at a time
+/// `AVX2`: in the span's AVX2 copy, the whole rows go four at a time
 /// ([`avx2::fill_run`]).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn fill<const AVX2: bool>(
     grid: &mut Grid,
     atlas: &AtlasLevel<'_>,
@@ -168,7 +180,7 @@ pub(super) fn fill<const AVX2: bool>(
     y: usize,
     x0: usize,
     n: usize,
-    next: bool,
+    (next, more): (bool, bool),
 ) {
     let (w, h) = (st.width, st.height);
     let cols = 2 * n + 3;
@@ -178,13 +190,13 @@ pub(super) fn fill<const AVX2: bool>(
     let columns = &atlas.columns[..];
     let first = if next {
         grid.shift();
-        2
+        3
     } else {
         0
     };
     for r in first..5 {
-        // Rows y ± 2 only at odd grid columns.
-        let step = if r == 0 || r == 4 { 2 } else { 1 };
+        // Row y − 2, and row y + 2 unless `more`, only at odd grid columns.
+        let step = if r == 0 || (r == 4 && !more) { 2 } else { 1 };
         let (ly, lx) = ((y + r) as isize - 2, x0 as isize - 2);
         if ly < 0 || ly >= h as isize {
             for j in (step - 1..cols).step_by(step) {
@@ -248,8 +260,8 @@ pub(super) fn at<T: Copy>(win: &[&[T; 5]; 5], dx: i32, dy: i32) -> T {
 /// byte masked off.
 #[inline(always)]
 pub(super) fn any_edge(grid: &Grid, c: usize) -> bool {
-    let b: [bool; 4] = grid.edge3[c - 1..c + 3].try_into().expect("four columns");
-    u32::from_le_bytes(b.map(u8::from)) & 0x00FF_FFFF != 0
+    let b: [u8; 4] = grid.edge3[c - 1..c + 3].try_into().expect("four columns");
+    u32::from_le_bytes(b) & 0x00FF_FFFF != 0
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
@@ -328,9 +340,11 @@ mod tests {
                     let mut x0 = px;
                     while x0 < w {
                         let n = (w - x0).div_ceil(2).min(CHUNK);
+                        let rows = (px..h).step_by(2).count();
                         for (j, y) in (px..h).step_by(2).enumerate() {
-                            fill::<true>(&mut a, &atlas, &st, y, x0, n, j > 0);
-                            fill::<false>(&mut b, &atlas, &st, y, x0, n, j > 0);
+                            let at = (j > 0, j + 1 < rows);
+                            fill::<true>(&mut a, &atlas, &st, y, x0, n, at);
+                            fill::<false>(&mut b, &atlas, &st, y, x0, n, at);
                             let at = format!("level {level} {w}x{h} row {y} from {x0}");
                             same(&a.idx, &b.idx, &format!("idx ({at})"));
                             same(&a.stride, &b.stride, &format!("stride ({at})"));

@@ -99,9 +99,7 @@ pub(super) unsafe fn fill_run(
         store(&mut grid.v[r], vv);
         store(&mut grid.sx[r], sx);
         store(&mut grid.sy[r], sy);
-        for (e, b) in grid.edge[r][j..j + 4].iter_mut().zip(edge) {
-            *e = b != 0;
-        }
+        grid.edge[r][j..j + 4].copy_from_slice(&edge);
         k += 4;
     }
     for i in k..n {
