@@ -23,7 +23,9 @@
 //!   is u itself unless a neighbour's texel lies on the interior's edge;
 //!   the fill flags those (1.3 % of the pixels at 1024²), so the rest
 //!   list and prefetch C₁ without a column lookup, and only the winner's
-//!   coordinate is ever formed.
+//!   coordinate is ever formed — for the rest, S(n) − Δ from the state,
+//!   since C₁ is u = t(n) − Δ and takes n's fraction (the grid keeps no
+//!   coordinates).
 //! - **C₂ without chasing it.** C₂ entries point anywhere in the atlas,
 //!   which at level 0 outgrows the L2 cache: reading `similar[u]`, then
 //!   the texels it names, were two cache misses in a row per candidate.
@@ -52,13 +54,12 @@ mod grid;
 mod score;
 
 use super::nudge::nudge;
-use super::scalar::reflect;
 use super::{ALL_TYPES, DELTAS, Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::database::c2::Quad;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use gather::{Pending, c1_texel, gather};
+use gather::{Pending, gather};
 use grid::{CHUNK, Grid};
 use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
 
@@ -198,7 +199,8 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     let mut left = column(app, grid, 1);
     for i in 0..n + LOOKAHEAD {
         if i < n {
-            gather(atlas, grid, 2 * i + 2, C2, &mut ring[i % RING]);
+            let at = ((x0 + 2 * i) as i32, y as i32);
+            gather((atlas, st), (grid, 2 * i + 2), at, C2, &mut ring[i % RING]);
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
@@ -221,9 +223,9 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
                     scalar::correct_pixel_guided(atlas, st, (x, y), C2, g, prior)
                 }
                 _ => {
-                    let at = ((x0 + 2 * k, y), 2 * k + 2);
+                    let at = (x0 + 2 * k, y);
                     let p = &ring[k % RING];
-                    decide::<P, AVX2>(atlas, st, grid, &ns, at, p, C2, g, prior.v)
+                    decide::<P, AVX2>(atlas, st, &ns, at, p, C2, g, prior.v)
                 }
             };
             st.set(i, s, v);
@@ -234,21 +236,20 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
 /// Scores a gathered pixel's candidates against its synthesis
 /// neighbourhood `ns`; returns the winner's coordinate (with the fraction of
 /// the neighbour it came from) and optimal offset. `at`: the pixel's level
-/// position and grid column.
+/// position.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn decide<const P: u32, const AVX2: bool>(
     atlas: &AtlasLevel<'_>,
     st: &State,
-    grid: &Grid,
     ns: &Neighbourhood,
-    at: ((usize, usize), usize),
+    at: (usize, usize),
     p: &Pending,
     similar: bool,
     g: &Guide<'_>,
     vp: i32,
 ) -> (Coord, i32) {
-    let pixel = at.0.1 * st.width + at.0.0;
+    let pixel = at.1 * st.width + at.0;
     let app = atlas.level.appearance;
     // The coherence candidate first (a tie keeps the previous result), then
     // the rest in DELTAS order, C₁ before C₂ (ties keep the earlier).
@@ -275,10 +276,10 @@ fn decide<const P: u32, const AVX2: bool>(
                 false => (prev, v),
             };
         }
-        return finish(atlas, st, grid, at, p, (cost, i, hh), g);
+        return finish(atlas, st, at, p, (cost, i, hh), g);
     }
     let winner = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), u32::MAX, vp);
-    finish(atlas, st, grid, at, p, winner, g)
+    finish(atlas, st, at, p, winner, g)
 }
 
 /// The winner's offset `v`, nudged towards the pixel's geometric target
@@ -300,32 +301,48 @@ fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>)
 fn finish(
     atlas: &AtlasLevel<'_>,
     st: &State,
-    grid: &Grid,
-    ((x, y), c): ((usize, usize), usize),
+    (x, y): (usize, usize),
     p: &Pending,
     best: (u32, usize, i32),
     g: &Guide<'_>,
 ) -> (Coord, i32) {
     debug_assert!(best.1 < p.count);
     let pair = &p.pairs[best.1 / 2];
-    let (q, idx) = match best.1 % 2 {
-        0 => (c1_texel(atlas, grid, c, (p, pair.from as usize)), pair.c1),
-        _ => {
-            let c = atlas.level.similar[pair.u as usize];
-            let (x, y) = ((c & 0xFFFF) as i32, (c >> 16) as i32);
-            ((x, y), atlas.index(x, y) as i32)
-        }
-    };
     let (dx, dy) = DELTAS[pair.from as usize];
-    // The neighbour it came from, reflected at the level border.
-    let (w, h) = (st.width as i32, st.height as i32);
-    let (nx, ny) = (reflect(x as i32 + dx, w), reflect(y as i32 + dy, h));
-    let n = st.s((ny * w + nx) as usize);
     let pixel = y * st.width + x;
-    let frac = |v: i32| v - (round(v) << FRAC_BITS);
-    let s = Coord {
-        x: (q.0 << FRAC_BITS) + frac(n.x),
-        y: (q.1 << FRAC_BITS) + frac(n.y),
+    let (s, idx) = match (best.1 % 2, p.edge) {
+        // C₁ = u = t(n) − Δ with n's fraction: S(n) − Δ, n inside the
+        // level (no edge neighbour: the whole 3×3 is).
+        (0, false) => {
+            let i = pixel as isize + dy as isize * st.width as isize + dx as isize;
+            let n = st.s(i as usize);
+            let s = Coord {
+                x: n.x - (dx << FRAC_BITS),
+                y: n.y - (dy << FRAC_BITS),
+            };
+            (s, pair.c1)
+        }
+        (c, _) => {
+            // The neighbour, reflected at the level border and its texel
+            // extrapolated (as the grid has it).
+            let n = scalar::neighbour(atlas, st, x as i32 + dx, y as i32 + dy);
+            let q = match c {
+                0 => atlas.clamp_interior(n.tx - dx, n.ty - dy),
+                _ => {
+                    let c = atlas.level.similar[pair.u as usize];
+                    ((c & 0xFFFF) as i32, (c >> 16) as i32)
+                }
+            };
+            let s = Coord {
+                x: (q.0 << FRAC_BITS) + n.frac.0,
+                y: (q.1 << FRAC_BITS) + n.frac.1,
+            };
+            let idx = match c {
+                0 => pair.c1,
+                _ => atlas.index(q.0, q.1) as i32,
+            };
+            (s, idx)
+        }
     };
     (s, nudged(atlas, idx, best.2, pixel, g))
 }

@@ -3,8 +3,10 @@
 //! prefetched.
 
 use super::super::DELTAS;
+use super::super::scalar::neighbour;
 use super::grid::{Grid, any_edge, at, window};
 use crate::level::atlas::AtlasLevel;
+use crate::level::state::State;
 use crate::stages::isa::prefetch;
 
 /// A pixel whose candidates are gathered, awaiting scoring: C₁ and C₂ of
@@ -16,7 +18,8 @@ pub(super) struct Pending {
     /// Candidates (twice the pairs).
     pub count: usize,
     /// Whether a neighbour lies next to an edge, so that C₁ may differ
-    /// from u (else the winner's coordinate is u's, unclamped).
+    /// from u (else the winner's coordinate is u's, unclamped, and the
+    /// whole 3×3 lies inside the level).
     pub edge: bool,
 }
 
@@ -24,7 +27,7 @@ pub(super) struct Pending {
 #[derive(Clone, Copy, Default)]
 pub(super) struct Pair {
     /// C₁'s texel index: u's, unless u left its exemplar's interior and
-    /// was clamped back (the winner's coordinate is found by [`c1_texel`]).
+    /// was clamped back (the winner's coordinate is formed by `finish`).
     pub c1: i32,
     /// The row stride of C₁'s (and u's) exemplar.
     pub stride: i32,
@@ -45,11 +48,13 @@ pub(super) struct Pair {
 /// whether its u is new was a branch that varied from pixel to pixel and
 /// mispredicted often (listing every Δ instead, repeats included, was
 /// slower still).
+/// `pos`: the pixel's level position (read only where it has an edge
+/// neighbour).
 #[inline(always)]
 pub(super) fn gather(
-    atlas: &AtlasLevel<'_>,
-    grid: &Grid,
-    c: usize,
+    (atlas, st): (&AtlasLevel<'_>, &State),
+    (grid, c): (&Grid, usize),
+    pos: (i32, i32),
     similar: bool,
     out: &mut Pending,
 ) {
@@ -75,7 +80,7 @@ pub(super) fn gather(
         let k = first.trailing_zeros() as usize;
         first &= first - 1;
         let c1 = match edge {
-            true => clamped(atlas, grid, c, k, u[k], s[k]),
+            true => clamped(atlas, st, pos, k, (u[k], s[k])),
             false => u[k],
         };
         *slot = list(atlas, k, c1, (u[k], s[k]), similar);
@@ -155,44 +160,21 @@ fn list(
     }
 }
 
-/// The texel u = t(n) − Δ of the neighbour at Δ = `DELTAS[k]` of the
-/// pixel in grid column `c`.
-#[inline(always)]
-fn u_texel(grid: &Grid, c: usize, k: usize) -> (i32, i32) {
-    let (dx, dy) = DELTAS[k];
-    let (r, j) = ((2 + dy) as usize, (c as i32 + dx) as usize);
-    (grid.sx[r][j] - dx, grid.sy[r][j] - dy)
-}
-
-/// C₁'s texel: [`u_texel`] clamped into its exemplar's interior (the same
-/// exemplar as t(n)); u itself unless the pixel `p` has a neighbour next
-/// to an edge.
-#[inline(always)]
-pub(super) fn c1_texel(
-    atlas: &AtlasLevel<'_>,
-    grid: &Grid,
-    c: usize,
-    (p, k): (&Pending, usize),
-) -> (i32, i32) {
-    let (ux, uy) = u_texel(grid, c, k);
-    match p.edge {
-        true => atlas.clamp_interior(ux, uy),
-        false => (ux, uy),
-    }
-}
-
 /// C₁'s texel index, from u's (`u_idx`, in an exemplar of row stride
-/// `stride`), where the pixel has a neighbour next to an edge.
+/// `stride`), where the pixel at level position `at` has a neighbour next
+/// to an edge: u = t(n) − Δ (n at Δ = `DELTAS[k]`, extrapolated outside
+/// the level as the grid has it) clamped into its exemplar's interior.
 #[inline(never)]
 fn clamped(
     atlas: &AtlasLevel<'_>,
-    grid: &Grid,
-    c: usize,
+    st: &State,
+    (x, y): (i32, i32),
     k: usize,
-    u_idx: i32,
-    stride: i32,
+    (u_idx, stride): (i32, i32),
 ) -> i32 {
-    let u = u_texel(grid, c, k);
+    let (dx, dy) = DELTAS[k];
+    let n = neighbour(atlas, st, x + dx, y + dy);
+    let u = (n.tx - dx, n.ty - dy);
     let (cx, cy) = atlas.clamp_interior(u.0, u.1);
     u_idx + (cx - u.0) + (cy - u.1) * stride
 }

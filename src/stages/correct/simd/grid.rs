@@ -44,10 +44,6 @@ pub(super) struct Grid {
     /// test ([`any_edge`]) is one read instead of three rows' (~20
     /// instructions per pixel).
     pub edge3: [u8; GRID_COLS],
-    /// The rounded coordinate t(n), read only to clamp C₁ at an edge and
-    /// for the winner's coordinate.
-    pub sx: Field<i32>,
-    pub sy: Field<i32>,
 }
 
 impl Grid {
@@ -59,30 +55,15 @@ impl Grid {
             v: [[0; GRID_COLS]; 5],
             edge: [[1; GRID_COLS]; 5],
             edge3: [1; GRID_COLS],
-            sx: [[0; GRID_COLS]; 5],
-            sy: [[0; GRID_COLS]; 5],
         }
     }
 
     /// Stores the neighbour at row `r`, column `j`.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn put(
-        &mut self,
-        r: usize,
-        j: usize,
-        idx: i32,
-        stride: i32,
-        v: i32,
-        sx: i32,
-        sy: i32,
-        edge: bool,
-    ) {
+    fn put(&mut self, r: usize, j: usize, idx: i32, stride: i32, v: i32, edge: bool) {
         self.idx[r][j] = idx;
         self.stride[r][j] = stride;
         self.v[r][j] = v;
-        self.sx[r][j] = sx;
-        self.sy[r][j] = sy;
         self.edge[r][j] = edge as u8;
     }
 
@@ -104,7 +85,7 @@ impl Grid {
         let n = neighbour(atlas, st, x as i32, y as i32);
         let idx = atlas.index(n.tx, n.ty) as i32;
         let stride = atlas.columns[n.tx as usize].stride as i32;
-        self.put(r, j, idx, stride, n.v, n.tx, n.ty, true);
+        self.put(r, j, idx, stride, n.v, true);
     }
 
     /// Copies rows 2–4 to rows 0–2 (the next class row's top).
@@ -114,8 +95,6 @@ impl Grid {
         self.stride.copy_within(2..5, 0);
         self.v.copy_within(2..5, 0);
         self.edge.copy_within(2..5, 0);
-        self.sx.copy_within(2..5, 0);
-        self.sy.copy_within(2..5, 0);
     }
 }
 
@@ -137,16 +116,7 @@ fn put_pixel(
     let m = MARGIN as i32;
     let inside = (col.min_x < sx) & (sx < col.max_x) & (m < sy) & (sy < col.max_y);
     let idx = col.base + sy * col.stride as i32 + sx;
-    grid.put(
-        r,
-        j,
-        idx,
-        col.stride as i32,
-        v.load(Relaxed),
-        sx,
-        sy,
-        !inside,
-    );
+    grid.put(r, j, idx, col.stride as i32, v.load(Relaxed), !inside);
 }
 
 /// Reads the neighbours of the `n` class pixels from column `x0` of row
@@ -350,8 +320,6 @@ mod tests {
                             same(&a.stride, &b.stride, &format!("stride ({at})"));
                             same(&a.v, &b.v, &format!("v ({at})"));
                             same(&a.edge, &b.edge, &format!("edge ({at})"));
-                            same(&a.sx, &b.sx, &format!("sx ({at})"));
-                            same(&a.sy, &b.sy, &format!("sy ({at})"));
                         }
                         x0 += 2 * n;
                     }

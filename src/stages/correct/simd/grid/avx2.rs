@@ -97,8 +97,6 @@ pub(super) unsafe fn fill_run(
         store(&mut grid.idx[r], idx);
         store(&mut grid.stride[r], stride);
         store(&mut grid.v[r], vv);
-        store(&mut grid.sx[r], sx);
-        store(&mut grid.sy[r], sy);
         grid.edge[r][j..j + 4].copy_from_slice(&edge);
         k += 4;
     }
