@@ -185,6 +185,10 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
         g,
         ..
     } = *span;
+    // A local copy: the pixel stores (atomics) then cannot change it, so
+    // its tests leave the pixel loop.
+    let g = *g;
+    let g = &g;
     let w = st.width;
     let n = (x1 - x0).div_ceil(2);
     // True by construction; stated so that the compiler knows every grid
