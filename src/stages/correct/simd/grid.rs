@@ -37,7 +37,7 @@ pub(super) struct Grid {
     /// interior, so that C₁ = u needs the clamp: t(n) is not strictly
     /// inside the interior, or the neighbour lies outside the level (its
     /// texel is extrapolated). Elsewhere C₁ is u itself.
-    /// (1 or 0: bytes, so that the AVX2 fill stores four flags at once.)
+    /// (1 or 0: bytes, so that the AVX2 fill stores eight flags at once.)
     pub edge: Field<u8>,
     /// Per column, whether rows 1–3 (the pixel's 3×3) hold an
     /// [`Grid::edge`] neighbour: formed once per fill, so that a pixel's
@@ -133,13 +133,13 @@ fn put_pixel(
 ///
 /// Why whole: each level row is then read once per subpass, as row 4 of
 /// one class row and kept as row 2 of the next, instead of once at odd
-/// offsets (one neighbour at a time) and again whole (four at a time).
+/// offsets (one neighbour at a time) and again whole.
 ///
 /// Neighbours outside the level (within two texels of its border) take
 /// the scalar path's reflection one by one; the rest are read as row
 /// slices.
 ///
-/// `AVX2`: in the span's AVX2 copy, the whole rows go four at a time
+/// `AVX2`: in the span's AVX2 copy, the whole rows go eight at a time
 /// ([`avx2::fill_run`]).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -291,7 +291,7 @@ mod tests {
         assert_eq!(a, b, "{what} differs between the AVX2 and the scalar fill");
     }
 
-    /// `fill::<true>` (row runs four at a time in AVX2) leaves every field
+    /// `fill::<true>` (row runs eight at a time in AVX2) leaves every field
     /// of the grid as `fill::<false>` does, chunk after chunk, first rows
     /// and continued ones, at the level's borders too.
     #[test]

@@ -7,9 +7,8 @@
 //! always point into one exemplar, so one column lookup serves eight, and
 //! the rest is a handful of 256-bit operations (with the row runs' ends
 //! and the exemplar changes, ~17 instructions per neighbour four at a time,
-//! ~11 eight at a time). Where the eight
-//! straddle two exemplars they go four at a time, and where four do, one
-//! by one, as before.
+//! ~11 eight at a time). Where the eight straddle two exemplars they go
+//! one by one, as before.
 
 use super::{Grid, put_pixel};
 use crate::database::layout::MARGIN;
@@ -48,17 +47,11 @@ pub(super) unsafe fn fill_run(
         let at = k.min(n - 8);
         // SAFETY: at + 8 ≤ n (the caller's guarantees forwarded).
         if !unsafe { put8(grid, r, (j0, at), columns, s, v) } {
-            for k in [at, at + 4] {
-                // SAFETY: as above, k + 4 ≤ n.
-                unsafe { put4_or_each(grid, r, (j0, k), columns, s, v) };
+            for i in at..at + 8 {
+                put_pixel(grid, r, j0 + i, columns, &s[i], &v[i]);
             }
         }
         k = at + 8;
-    }
-    if k + 4 <= n {
-        // SAFETY: k + 4 ≤ n.
-        unsafe { put4_or_each(grid, r, (j0, k), columns, s, v) };
-        k += 4;
     }
     for i in k..n {
         put_pixel(grid, r, j0 + i, columns, &s[i], &v[i]);
@@ -140,65 +133,4 @@ unsafe fn put8(
     store(&mut grid.v[r], vv);
     grid.edge[r][j..j + 8].copy_from_slice(&edge);
     true
-}
-
-/// Four neighbours from `k` on: at once if they lie in one exemplar, else
-/// one by one.
-///
-/// # Safety
-/// `k + 4 ≤ n`, and [`fill_run`]'s.
-#[inline]
-#[target_feature(enable = "avx2,bmi2")]
-unsafe fn put4_or_each(
-    grid: &mut Grid,
-    r: usize,
-    (j0, k): (usize, usize),
-    columns: &[Column],
-    s: &[AtomicU64],
-    v: &[AtomicI32],
-) {
-    // SAFETY: the four S and V lie in the slices; no concurrent writer.
-    let (sv, vv) = unsafe {
-        (
-            _mm256_loadu_si256(s.as_ptr().add(k).cast()),
-            _mm_loadu_si128(v.as_ptr().add(k).cast()),
-        )
-    };
-    let t = round4(sv);
-    let (sx, sy) = (_mm256_castsi256_si128(t), _mm256_extracti128_si256::<1>(t));
-    let col = &columns[_mm_cvtsi128_si32(sx) as usize];
-    let gt = |a: __m128i, b: i32| _mm_cmpgt_epi32(a, _mm_set1_epi32(b));
-    let lt = |a: __m128i, b: i32| _mm_cmpgt_epi32(_mm_set1_epi32(b), a);
-    let margin = MARGIN as i32;
-    let same = _mm_and_si128(
-        gt(sx, col.min_x - margin - 1),
-        lt(sx, col.max_x + margin + 1),
-    );
-    if _mm_movemask_epi8(same) != 0xFFFF {
-        for i in k..k + 4 {
-            put_pixel(grid, r, j0 + i, columns, &s[i], &v[i]);
-        }
-        return;
-    }
-    let stride = _mm_set1_epi32(col.stride as i32);
-    let idx = _mm_add_epi32(
-        _mm_add_epi32(_mm_set1_epi32(col.base), _mm_mullo_epi32(sy, stride)),
-        sx,
-    );
-    let inside = _mm_and_si128(
-        _mm_and_si128(gt(sx, col.min_x), lt(sx, col.max_x)),
-        _mm_and_si128(gt(sy, margin), lt(sy, col.max_y)),
-    );
-    let inside_bits = _mm_movemask_ps(_mm_castsi128_ps(inside)) as u32;
-    let edge = _pdep_u32(!inside_bits & 0xF, 0x0101_0101).to_le_bytes();
-    let j = j0 + k;
-    let store = |row: &mut [i32], x: __m128i| {
-        let out: &mut [i32; 4] = (&mut row[j..j + 4]).try_into().expect("four columns");
-        // SAFETY: `out` is four i32, the width of the store.
-        unsafe { _mm_storeu_si128(out.as_mut_ptr().cast(), x) };
-    };
-    store(&mut grid.idx[r], idx);
-    store(&mut grid.stride[r], stride);
-    store(&mut grid.v[r], vv);
-    grid.edge[r][j..j + 4].copy_from_slice(&edge);
 }
