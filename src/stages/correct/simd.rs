@@ -197,7 +197,15 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     grid::fill::<AVX2>(grid, atlas, st, y, x0, n, rows);
     let grid = &*grid;
     let mut ring = [Pending::default(); RING];
-    let parent = parent.map(|pa| ParentRow::new(pa, y));
+    // The parent's offset at each pixel of the chunk, read before the
+    // pixel loop (one pass over the two parent rows).
+    let mut anchors = [0i32; CHUNK];
+    if let Some(pa) = parent {
+        let row = ParentRow::new(pa, y);
+        for (k, a) in anchors[..n].iter_mut().enumerate() {
+            *a = row.v(x0 + 2 * k);
+        }
+    }
     let app = atlas.level.appearance;
     // The shared N_S texels of the grid column left of the next pixel.
     let mut left = column(app, grid, 1);
@@ -214,10 +222,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
             left = right;
             let prior = Prior {
                 weight: P,
-                v: match &parent {
-                    Some(r) => r.v(x0 + 2 * k),
-                    None => 0,
-                },
+                v: anchors[k],
             };
             // Type-constrained pixels take the scalar path (rejection and
             // seeding live there; they are few and at coarse levels).
