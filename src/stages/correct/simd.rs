@@ -59,7 +59,7 @@ use crate::database::c2::Quad;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use gather::{Pending, gather};
+use gather::{Pending, gather, source_at};
 use grid::{CHUNK, Grid};
 use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
 
@@ -159,8 +159,8 @@ fn run_span<const P: u32, const AVX2: bool, const C2: bool>(span: &Span<'_>) {
         let b = x1.min(a + 2 * CHUNK);
         for (j, &y) in ys.iter().enumerate() {
             debug_assert!(j == 0 || y == ys[j - 1] + 2);
-            let at = (j > 0, j + 1 < ys.len());
-            correct_chunk::<P, AVX2, C2>(span, (y, a, b), at, &mut grid);
+            let rows = (j > 0, j + 1 < ys.len());
+            correct_chunk::<P, AVX2, C2>(span, (y, a, b), rows, &mut grid);
         }
         a = b;
     }
@@ -332,11 +332,9 @@ fn finish(
             (s, pair.c1)
         }
         (c, _) => {
-            // The neighbour, reflected at the level border and its texel
-            // extrapolated (as the grid has it).
-            let n = scalar::neighbour(atlas, st, x as i32 + dx, y as i32 + dy);
+            let (n, u) = source_at(atlas, st, (x as i32, y as i32), pair.from as usize);
             let q = match c {
-                0 => atlas.clamp_interior(n.tx - dx, n.ty - dy),
+                0 => atlas.clamp_interior(u.0, u.1),
                 _ => {
                     let c = atlas.level.similar[pair.u as usize];
                     ((c & 0xFFFF) as i32, (c >> 16) as i32)

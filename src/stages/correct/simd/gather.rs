@@ -3,7 +3,7 @@
 //! prefetched.
 
 use super::super::DELTAS;
-use super::super::scalar::neighbour;
+use super::super::scalar::{Neighbour, neighbour};
 use super::grid::{Grid, any_edge};
 use crate::level::atlas::AtlasLevel;
 use crate::level::state::State;
@@ -226,21 +226,35 @@ fn list(
     }
 }
 
-/// C₁'s texel index, from u's (`u_idx`, in an exemplar of row stride
-/// `stride`), where the pixel at level position `at` has a neighbour next
-/// to an edge: u = t(n) − Δ (n at Δ = `DELTAS[k]`, extrapolated outside
-/// the level as the grid has it) clamped into its exemplar's interior.
-#[inline(never)]
-fn clamped(
+/// The neighbour n at Δ = `DELTAS[k]` of the pixel at level position
+/// (x, y), as the grid reads it (reflected at the level border, its texel
+/// extrapolated), and its u = t(n) − Δ: for the pixels with an edge
+/// neighbour, whose C₁ must be clamped, and for a winner's fraction.
+#[inline(always)]
+pub(super) fn source_at(
     atlas: &AtlasLevel<'_>,
     st: &State,
     (x, y): (i32, i32),
     k: usize,
-    (u_idx, stride): (i32, i32),
-) -> i32 {
+) -> (Neighbour, (i32, i32)) {
     let (dx, dy) = DELTAS[k];
     let n = neighbour(atlas, st, x + dx, y + dy);
     let u = (n.tx - dx, n.ty - dy);
+    (n, u)
+}
+
+/// C₁'s texel index, from u's (`u_idx`, in an exemplar of row stride
+/// `stride`), where the pixel at level position `at` has a neighbour next
+/// to an edge: u ([`source_at`]) clamped into its exemplar's interior.
+#[inline(never)]
+fn clamped(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    at: (i32, i32),
+    k: usize,
+    (u_idx, stride): (i32, i32),
+) -> i32 {
+    let (_, u) = source_at(atlas, st, at, k);
     let (cx, cy) = atlas.clamp_interior(u.0, u.1);
     u_idx + (cx - u.0) + (cy - u.1) * stride
 }
