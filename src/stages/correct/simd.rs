@@ -201,10 +201,9 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     // pixel loop (one pass over the two parent rows).
     let mut anchors = [0i32; CHUNK];
     if let Some(pa) = parent {
-        let row = ParentRow::new(pa, y);
-        for (k, a) in anchors[..n].iter_mut().enumerate() {
-            *a = row.v(x0 + 2 * k);
-        }
+        // SAFETY: the parent level is not written during its child's
+        // correction.
+        unsafe { ParentRow::new(pa, y).fill(x0, &mut anchors[..n]) };
     }
     let app = atlas.level.appearance;
     // The shared N_S texels of the grid column left of the next pixel.
@@ -212,7 +211,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     for i in 0..n + LOOKAHEAD {
         if i < n {
             let at = ((x0 + 2 * i) as i32, y as i32);
-            gather((atlas, st), (grid, 2 * i + 2), at, C2, &mut ring[i % RING]);
+            gather::<AVX2>((atlas, st), (grid, 2 * i + 2), at, C2, &mut ring[i % RING]);
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;
