@@ -211,7 +211,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     for i in 0..n + LOOKAHEAD {
         if i < n {
             let at = ((x0 + 2 * i) as i32, y as i32);
-            gather::<AVX2>((atlas, st), (grid, 2 * i + 2), at, C2, &mut ring[i % RING]);
+            gather((atlas, st), (grid, 2 * i + 2), at, C2, &mut ring[i % RING]);
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;

@@ -8,8 +8,6 @@ use super::grid::{Grid, any_edge};
 use crate::level::atlas::AtlasLevel;
 use crate::level::state::State;
 use crate::stages::isa::prefetch;
-#[cfg(target_arch = "x86_64")]
-use core::arch::x86_64::__m128i;
 
 /// A pixel whose candidates are gathered, awaiting scoring: C₁ and C₂ of
 /// each distinct u, candidate `i` being pair `i / 2`'s C₁ (`i` even) or
@@ -52,17 +50,16 @@ pub(super) struct Pair {
 /// slower still).
 /// `pos`: the pixel's level position (read only where it has an edge
 /// neighbour).
-/// `AVX2`: in the span's AVX2 copy (see [`firsts`]).
 #[inline(always)]
-pub(super) fn gather<const AVX2: bool>(
+pub(super) fn gather(
     (atlas, st): (&AtlasLevel<'_>, &State),
     (grid, c): (&Grid, usize),
     pos: (i32, i32),
     similar: bool,
     out: &mut Pending,
 ) {
-    let Sources { u, s, lanes } = sources(grid, c);
-    let mut first = firsts::<AVX2>(&u, lanes);
+    let (u, s) = sources(grid, c);
+    let mut first = firsts(&u);
     out.count = 2 * first.count_ones() as usize;
     // C₁ is u itself unless a neighbour lies next to an edge (rare).
     let edge = any_edge(grid, c);
@@ -83,31 +80,17 @@ pub(super) fn gather<const AVX2: bool>(
     }
 }
 
-/// The texel index of every `u = t(n) − Δ` of a pixel, in DELTAS order,
-/// and the row stride of its exemplar (u lies in the exemplar of S(n),
-/// one texel from its interior, so its texel index identifies it:
-/// `idx(n) − Δx − Δy·stride(n)`); on x86-64 also u₁…u₈ as vectors
-/// (`lanes`), as [`firsts`] compares them.
-pub(super) struct Sources {
-    pub u: [i32; 9],
-    pub s: [i32; 9],
-    pub lanes: Lanes,
-}
-
-/// u₁…u₄ and u₅…u₈ (SSE2 vectors) on x86-64; nothing elsewhere.
-#[cfg(target_arch = "x86_64")]
-pub(super) type Lanes = [__m128i; 2];
-#[cfg(not(target_arch = "x86_64"))]
-pub(super) type Lanes = ();
-
-/// The [`Sources`] of the pixel in grid column `c`.
+/// The texel index of every `u = t(n) − Δ` of the pixel in grid column
+/// `c`, in DELTAS order, and the row stride of its exemplar (u lies in the
+/// exemplar of S(n), one texel from its interior, so its texel index
+/// identifies it: `idx(n) − Δx − Δy·stride(n)`).
 ///
 /// On x86-64 a grid row's three neighbours are one vector (SSE2): three
 /// rows of index and stride loads, an add or subtract per row, and
 /// shuffles into DELTAS order, instead of eighteen loads and nine
 /// multiply-adds one by one.
 #[inline(always)]
-fn sources(grid: &Grid, c: usize) -> Sources {
+fn sources(grid: &Grid, c: usize) -> ([i32; 9], [i32; 9]) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: SSE2 is part of the x86-64 baseline.
     unsafe {
@@ -140,22 +123,17 @@ fn sources(grid: &Grid, c: usize) -> Sources {
             let lo = _mm_shuffle_ps::<0b10_00_01_00>(a, ab);
             let bc = _mm_shuffle_ps::<0b00_00_00_10>(b, c);
             let hi = _mm_shuffle_ps::<0b10_01_10_00>(bc, c);
-            [_mm_castps_si128(lo), _mm_castps_si128(hi)]
+            (_mm_castps_si128(lo), _mm_castps_si128(hi))
         };
-        // Δ = (0, 0) is the centre row's column c, the rest `order`'s.
-        let array = |centre: __m128i, [lo, hi]: Lanes| {
-            let mut a = [0i32; 9];
-            a[0] = _mm_cvtsi128_si32(_mm_shuffle_epi32::<1>(centre));
-            _mm_storeu_si128(a[1..5].as_mut_ptr().cast(), lo);
-            _mm_storeu_si128(a[5..9].as_mut_ptr().cast(), hi);
-            a
-        };
-        let lanes = order(u1, u2, u3);
-        Sources {
-            u: array(u2, lanes),
-            s: array(s2, order(s1, s2, s3)),
-            lanes,
+        let mut u = [0i32; 9];
+        let mut s = [0i32; 9];
+        for (out, (a, b, c)) in [(&mut u, (u1, u2, u3)), (&mut s, (s1, s2, s3))] {
+            let (lo, hi) = order(a, b, c);
+            out[0] = _mm_cvtsi128_si32(_mm_shuffle_epi32::<1>(b));
+            _mm_storeu_si128(out[1..5].as_mut_ptr().cast(), lo);
+            _mm_storeu_si128(out[5..9].as_mut_ptr().cast(), hi);
         }
+        (u, s)
     }
     #[cfg(not(target_arch = "x86_64"))]
     sources_scalar(grid, c)
@@ -164,7 +142,7 @@ fn sources(grid: &Grid, c: usize) -> Sources {
 /// [`sources`] by its definition: the path off x86-64, and the reference
 /// its vector form is tested against.
 #[cfg(any(test, not(target_arch = "x86_64")))]
-fn sources_scalar(grid: &Grid, c: usize) -> Sources {
+fn sources_scalar(grid: &Grid, c: usize) -> ([i32; 9], [i32; 9]) {
     use super::grid::{at, window};
     let (idx, stride) = (window(&grid.idx, c), window(&grid.stride, c));
     let s: [i32; 9] = std::array::from_fn(|k| at(&stride, DELTAS[k].0, DELTAS[k].1));
@@ -172,51 +150,22 @@ fn sources_scalar(grid: &Grid, c: usize) -> Sources {
         let (dx, dy) = DELTAS[k];
         at(&idx, dx, dy) - dx - dy * s[k]
     });
-    Sources {
-        u,
-        s,
-        lanes: lanes_of(&u),
-    }
+    (u, s)
 }
 
-/// [`Lanes`] of u (the scalar reference's, and the tests').
-#[cfg(any(test, not(target_arch = "x86_64")))]
-fn lanes_of(u: &[i32; 9]) -> Lanes {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE2 is part of the x86-64 baseline; the loads read
-    // u[1..5] and u[5..9].
-    unsafe {
-        use core::arch::x86_64::*;
-        [
-            _mm_loadu_si128(u[1..5].as_ptr().cast()),
-            _mm_loadu_si128(u[5..9].as_ptr().cast()),
-        ]
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = u;
-}
-
-/// Bit k set: no earlier Δ has Δ k's u (bit 0 always); `lanes` holds
-/// u₁…u₈ ([`Sources`]).
+/// Bit k set: no earlier Δ has Δ k's u (bit 0 always).
 ///
-/// On x86-64 the 36 pairwise compares are vector compares, not scalar
-/// ones (those were a tenth of the kernel's instructions). The SSE2
-/// baseline compares each of u₀…u₇ against u₁…u₈: eight broadcasts, two
-/// compares and a pack each, and the two-bit mask narrowed. The AVX2 copy
-/// (`AVX2`) holds u₁…u₈ in one vector: one compare per u_j, kept for the
-/// lanes k > j, and one bit per lane at the end.
-#[cfg(target_arch = "x86_64")]
+/// On x86-64 the 36 pairwise compares are eight vector compares of one u
+/// against u₁…u₈ (SSE2, the baseline: both builds of the span use it); the
+/// scalar compares were a tenth of the kernel's instructions.
 #[inline(always)]
-fn firsts<const AVX2: bool>(u: &[i32; 9], [lo, hi]: Lanes) -> u32 {
-    use core::arch::x86_64::*;
-    if AVX2 {
-        // SAFETY: `AVX2` is set only in the span's AVX2 copy, which runs
-        // only where the CPU has AVX2.
-        let dup = unsafe { duplicates_avx2(u, lo, hi) };
-        return 1 | (!(dup << 1) & 0x1FE);
-    }
+fn firsts(u: &[i32; 9]) -> u32 {
+    #[cfg(target_arch = "x86_64")]
     // SAFETY: SSE2 is part of the x86-64 baseline.
     unsafe {
+        use core::arch::x86_64::*;
+        let lo = _mm_setr_epi32(u[1], u[2], u[3], u[4]);
+        let hi = _mm_setr_epi32(u[5], u[6], u[7], u[8]);
         // Two bits per k (k − 1 as an i16 lane): set where an earlier u_j
         // equals u_k.
         let mut dup = 0u32;
@@ -232,32 +181,8 @@ fn firsts<const AVX2: bool>(u: &[i32; 9], [lo, hi]: Lanes) -> u32 {
         d = (d | d >> 4) & 0x00FF;
         1 | (!(d << 1) & 0x1FE)
     }
-}
-
-/// [`firsts`] off x86-64: the pairwise compares.
-#[cfg(not(target_arch = "x86_64"))]
-#[inline(always)]
-fn firsts<const AVX2: bool>(u: &[i32; 9], _: Lanes) -> u32 {
+    #[cfg(not(target_arch = "x86_64"))]
     firsts_scalar(u)
-}
-
-/// Bit k − 1 set: some u_j (j < k) equals u_k, for k = 1…8 (u₁…u₈ in
-/// `lo`, `hi`), by [`firsts`]' one compare per u_j.
-#[cfg(target_arch = "x86_64")]
-#[inline]
-#[target_feature(enable = "avx2")]
-fn duplicates_avx2(u: &[i32; 9], lo: __m128i, hi: __m128i) -> u32 {
-    use core::arch::x86_64::*;
-    let v = _mm256_set_m128i(hi, lo);
-    // k of each lane.
-    let k = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 8);
-    let mut dup = _mm256_setzero_si256();
-    for (j, &uj) in u[..8].iter().enumerate() {
-        let later = _mm256_cmpgt_epi32(k, _mm256_set1_epi32(j as i32));
-        let eq = _mm256_cmpeq_epi32(v, _mm256_set1_epi32(uj));
-        dup = _mm256_or_si256(dup, _mm256_and_si256(eq, later));
-    }
-    _mm256_movemask_ps(_mm256_castsi256_ps(dup)) as u32
 }
 
 /// [`firsts`] by its definition: the pairwise compares (the path off
@@ -337,7 +262,7 @@ fn clamped(
 #[cfg(test)]
 mod tests {
     use super::super::grid::{CHUNK, Grid};
-    use super::{firsts, firsts_scalar, lanes_of, sources, sources_scalar};
+    use super::{firsts, firsts_scalar, sources, sources_scalar};
 
     #[test]
     fn sources_match_their_definition_at_every_column() {
@@ -358,9 +283,7 @@ mod tests {
             }
             // Every column a pixel of a full chunk sits at.
             for c in (2..=2 * CHUNK).step_by(2) {
-                let (a, b) = (sources(&grid, c), sources_scalar(&grid, c));
-                assert_eq!((a.u, a.s), (b.u, b.s), "column {c}");
-                assert_eq!(lanes(a.lanes), lanes(b.lanes), "column {c}");
+                assert_eq!(sources(&grid, c), sources_scalar(&grid, c), "column {c}");
             }
         }
     }
@@ -388,31 +311,8 @@ mod tests {
                 [i32::MIN, -1, 0x0001_0000, 0x7FFF_0000][(h >> 30) as usize] | (h & 1) as i32
             }));
         }
-        #[cfg(target_arch = "x86_64")]
-        let avx2 = crate::stages::isa::avx2();
-        #[cfg(not(target_arch = "x86_64"))]
-        let avx2 = false;
-        if !avx2 {
-            eprintln!("the AVX2 compares skipped: this CPU has no AVX2");
-        }
         for u in &us {
-            let want = firsts_scalar(u);
-            assert_eq!(firsts::<false>(u, lanes_of(u)), want, "u = {u:?}");
-            if avx2 {
-                assert_eq!(firsts::<true>(u, lanes_of(u)), want, "AVX2, u = {u:?}");
-            }
-        }
-    }
-
-    /// The lanes as numbers (u₁…u₈ on x86-64).
-    fn lanes(l: super::Lanes) -> Vec<i32> {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: two i32x4 vectors are eight i32.
-        return unsafe { std::mem::transmute::<super::Lanes, [i32; 8]>(l) }.to_vec();
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            let () = l;
-            Vec::new()
+            assert_eq!(firsts(u), firsts_scalar(u), "u = {u:?}");
         }
     }
 }
