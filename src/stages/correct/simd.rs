@@ -40,6 +40,10 @@
 //!   `i16x8` loads; residuals are formed in `i32x8`, clamped to ±[`CLAMP`]
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
+//! - **A chunk's sources at once.** The AVX2 copy forms every pixel's
+//!   nine u and its mask of distinct ones for a whole chunk before the
+//!   pixel loop, eight pixels per vector ([`gather`]'s `avx2`), instead
+//!   of per pixel inside it.
 //! - **AVX2 where the CPU has it.** The span is compiled twice, for the
 //!   SSE2 baseline and for AVX2 with BMI1/BMI2/LZCNT/POPCNT, and picked at
 //!   run time (integer arithmetic: the same bytes either way). The AVX2
@@ -59,7 +63,7 @@ use crate::database::c2::Quad;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
-use gather::{Pending, gather, source_at};
+use gather::{Pending, Table, gather, per_pixel, source_at};
 use grid::{CHUNK, Grid};
 use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
 
@@ -154,13 +158,14 @@ fn span_avx2<const P: u32, const C2: bool>(span: &Span<'_>) {
 fn run_span<const P: u32, const AVX2: bool, const C2: bool>(span: &Span<'_>) {
     let (ys, x0, x1) = (span.ys, span.x0, span.x1);
     let mut grid = Grid::new();
+    let mut table = Table::new();
     let mut a = x0;
     while a < x1 {
         let b = x1.min(a + 2 * CHUNK);
         for (j, &y) in ys.iter().enumerate() {
             debug_assert!(j == 0 || y == ys[j - 1] + 2);
             let rows = (j > 0, j + 1 < ys.len());
-            correct_chunk::<P, AVX2, C2>(span, (y, a, b), rows, &mut grid);
+            correct_chunk::<P, AVX2, C2>(span, (y, a, b), rows, (&mut grid, &mut table));
         }
         a = b;
     }
@@ -176,7 +181,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     span: &Span<'_>,
     (y, x0, x1): (usize, usize, usize),
     rows: (bool, bool),
-    grid: &mut Grid,
+    (grid, table): (&mut Grid, &mut Table),
 ) {
     let Span {
         atlas,
@@ -196,6 +201,13 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     assert!(n <= CHUNK);
     grid::fill::<AVX2>(grid, atlas, st, y, x0, n, rows);
     let grid = &*grid;
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 {
+        // SAFETY: `AVX2` is set only in the span's AVX2 copy, which runs
+        // only where the CPU has AVX2.
+        unsafe { gather::avx2::tabulate(grid, n, table) };
+    }
+    let table = &*table;
     let mut ring = [Pending::default(); RING];
     // The parent's offset at each pixel of the chunk, read before the
     // pixel loop (one pass over the two parent rows).
@@ -211,7 +223,28 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
     for i in 0..n + LOOKAHEAD {
         if i < n {
             let at = ((x0 + 2 * i) as i32, y as i32);
-            gather((atlas, st), (grid, 2 * i + 2), at, C2, &mut ring[i % RING]);
+            let (c, out) = (2 * i + 2, &mut ring[i % RING]);
+            if AVX2 {
+                let source = |k: usize| (table.u[k][i], table.s[k][i]);
+                gather(
+                    (atlas, st),
+                    (grid, c),
+                    at,
+                    (table.first[i], source),
+                    C2,
+                    out,
+                );
+            } else {
+                let (u, s, first) = per_pixel(grid, c);
+                gather(
+                    (atlas, st),
+                    (grid, c),
+                    at,
+                    (first, |k| (u[k], s[k])),
+                    C2,
+                    out,
+                );
+            }
         }
         if i >= LOOKAHEAD {
             let k = i - LOOKAHEAD;

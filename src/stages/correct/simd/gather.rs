@@ -4,10 +4,13 @@
 
 use super::super::DELTAS;
 use super::super::scalar::{Neighbour, neighbour};
-use super::grid::{Grid, any_edge};
+use super::grid::{CHUNK, Grid, any_edge};
 use crate::level::atlas::AtlasLevel;
 use crate::level::state::State;
 use crate::stages::isa::prefetch;
+
+#[cfg(target_arch = "x86_64")]
+pub(super) mod avx2;
 
 /// A pixel whose candidates are gathered, awaiting scoring: C₁ and C₂ of
 /// each distinct u, candidate `i` being pair `i / 2`'s C₁ (`i` even) or
@@ -50,16 +53,17 @@ pub(super) struct Pair {
 /// slower still).
 /// `pos`: the pixel's level position (read only where it has an edge
 /// neighbour).
+/// `first` and `source` are the pixel's [`firsts`] mask and, per Δ k, u's
+/// texel index and stride (its [`sources`], or a [`Table`]'s row).
 #[inline(always)]
 pub(super) fn gather(
     (atlas, st): (&AtlasLevel<'_>, &State),
     (grid, c): (&Grid, usize),
     pos: (i32, i32),
+    (mut first, source): (u32, impl Fn(usize) -> (i32, i32)),
     similar: bool,
     out: &mut Pending,
 ) {
-    let (u, s) = sources(grid, c);
-    let mut first = firsts(&u);
     out.count = 2 * first.count_ones() as usize;
     // C₁ is u itself unless a neighbour lies next to an edge (rare).
     let edge = any_edge(grid, c);
@@ -72,12 +76,41 @@ pub(super) fn gather(
         }
         let k = first.trailing_zeros() as usize;
         first &= first - 1;
+        let (u, s) = source(k);
         let c1 = match edge {
-            true => clamped(atlas, st, pos, k, (u[k], s[k])),
-            false => u[k],
+            true => clamped(atlas, st, pos, k, (u, s)),
+            false => u,
         };
-        *slot = list(atlas, k, c1, (u[k], s[k]), similar);
+        *slot = list(atlas, k, c1, (u, s), similar);
     }
+}
+
+/// A chunk's [`sources`] and [`firsts`], per Δ (DELTAS order) and pixel:
+/// u's texel index, its exemplar's row stride, and the mask of first
+/// occurrences — what the AVX2 span forms for a whole chunk at once
+/// ([`avx2::tabulate`]) before its pixel loop.
+pub(super) struct Table {
+    pub u: [[i32; CHUNK]; 9],
+    pub s: [[i32; CHUNK]; 9],
+    pub first: [u32; CHUNK],
+}
+
+impl Table {
+    pub fn new() -> Table {
+        Table {
+            u: [[0; CHUNK]; 9],
+            s: [[0; CHUNK]; 9],
+            first: [0; CHUNK],
+        }
+    }
+}
+
+/// The pixel in grid column `c`'s [`sources`] and [`firsts`] mask, formed
+/// for it alone (the baseline span's way).
+#[inline(always)]
+pub(super) fn per_pixel(grid: &Grid, c: usize) -> ([i32; 9], [i32; 9], u32) {
+    let (u, s) = sources(grid, c);
+    (u, s, firsts(&u))
 }
 
 /// The texel index of every `u = t(n) − Δ` of the pixel in grid column
@@ -286,6 +319,50 @@ mod tests {
                 assert_eq!(sources(&grid, c), sources_scalar(&grid, c), "column {c}");
             }
         }
+    }
+
+    #[test]
+    fn a_chunks_table_holds_each_pixels_sources_and_firsts() {
+        #[cfg(target_arch = "x86_64")]
+        if crate::stages::isa::avx2() {
+            let mut grid = Grid::new();
+            let mut table = super::Table::new();
+            let mut h = 0x0BAD_5EEDu32;
+            for round in 0..64 {
+                // Few distinct indices, so that neighbours repeat (as in
+                // coherent patches); some rounds wide values too.
+                for r in 0..5 {
+                    for j in 0..grid.idx[r].len() {
+                        h ^= h << 13;
+                        h ^= h >> 17;
+                        h ^= h << 5;
+                        let small = (h % 4) as i32 + j as i32 / 2;
+                        grid.idx[r][j] = if round % 4 == 0 {
+                            (h >> 1) as i32
+                        } else {
+                            small
+                        };
+                        grid.stride[r][j] = (h >> 24) as i32 % 3;
+                    }
+                }
+                let n = 1 + round % CHUNK;
+                // SAFETY: the CPU has AVX2 (checked above).
+                unsafe { super::avx2::tabulate(&grid, n, &mut table) };
+                for i in 0..n {
+                    let (u, s, first) = super::per_pixel(&grid, 2 * i + 2);
+                    let row =
+                        |t: &[[i32; CHUNK]; 9]| -> [i32; 9] { std::array::from_fn(|k| t[k][i]) };
+                    assert_eq!(
+                        (row(&table.u), row(&table.s)),
+                        (u, s),
+                        "round {round}, pixel {i}"
+                    );
+                    assert_eq!(table.first[i], first, "round {round}, pixel {i}");
+                }
+            }
+            return;
+        }
+        eprintln!("skipped: this CPU has no AVX2");
     }
 
     #[test]
