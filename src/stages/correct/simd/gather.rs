@@ -189,8 +189,12 @@ fn sources_scalar(grid: &Grid, c: usize) -> ([i32; 9], [i32; 9]) {
 /// Bit k set: no earlier Δ has Δ k's u (bit 0 always).
 ///
 /// On x86-64 the 36 pairwise compares are eight vector compares of one u
-/// against u₁…u₈ (SSE2, the baseline: both builds of the span use it); the
-/// scalar compares were a tenth of the kernel's instructions.
+/// against u₁…u₈ (SSE2, the baseline); the scalar compares were a tenth
+/// of the kernel's instructions. The baseline span calls this per pixel
+/// ([`per_pixel`]); the AVX2 span finds the same masks for a whole chunk
+/// at once ([`avx2::tabulate`], tested against this). A 256-bit compare of
+/// one pixel's u inside the pixel loop ran fewer instructions but slower
+/// (LLVM turned it into long shuffle chains; ×1.13 in interleaved runs).
 #[inline(always)]
 fn firsts(u: &[i32; 9]) -> u32 {
     #[cfg(target_arch = "x86_64")]
