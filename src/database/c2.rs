@@ -36,8 +36,16 @@ impl Quad {
     /// stride `s` (the caller guarantees they lie in it).
     #[inline(always)]
     pub fn around(app: &[u64], k: i32, s: i32) -> Quad {
+        Quad::beside(app, k - s - 1, k + s - 1)
+    }
+
+    /// The diagonals of the texel between `up` (its up-left diagonal's
+    /// index) and `down` (its down-left one's); their right-hand diagonals
+    /// are two texels further on.
+    #[inline(always)]
+    pub fn beside(app: &[u64], up: i32, down: i32) -> Quad {
         let t = |i: i32| app[i as usize];
-        Quad([t(k - s - 1), t(k + s - 1), t(k - s + 1), t(k + s + 1)])
+        Quad([t(up), t(down), t(up + 2), t(down + 2)])
     }
 }
 

@@ -361,7 +361,7 @@ fn finish(
                 x: n.x - (dx << FRAC_BITS),
                 y: n.y - (dy << FRAC_BITS),
             };
-            (s, pair.c1)
+            (s, pair.c1())
         }
         (c, _) => {
             let (n, u) = source_at(atlas, st, (x as i32, y as i32), pair.from as usize);
@@ -377,7 +377,7 @@ fn finish(
                 y: (q.1 << FRAC_BITS) + n.frac.1,
             };
             let idx = match c {
-                0 => pair.c1,
+                0 => pair.c1(),
                 _ => atlas.index(q.0, q.1) as i32,
             };
             (s, idx)

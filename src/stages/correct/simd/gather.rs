@@ -27,18 +27,33 @@ pub(super) struct Pending {
 }
 
 /// The two candidates of one u.
+///
+/// C₁ is kept as the texel indices scoring reads (its diagonals' rows),
+/// not as its own index and row stride: they are the addresses `list`
+/// prefetches anyway, and every candidate is scored while only the winner
+/// needs C₁'s own index ([`Pair::c1`]), so the address arithmetic is done
+/// once per pair instead of again in the scorer's loop.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Pair {
-    /// C₁'s texel index: u's, unless u left its exemplar's interior and
-    /// was clamped back (the winner's coordinate is formed by `finish`).
-    pub c1: i32,
-    /// The row stride of C₁'s (and u's) exemplar.
-    pub stride: i32,
+    /// The texel up-left of C₁ (`c1 − stride − 1`), and down-left of it
+    /// (`c1 + stride − 1`), where C₁ is u's texel unless u left its
+    /// exemplar's interior and was clamped back (the winner's coordinate
+    /// is formed by `finish`).
+    pub up: i32,
+    pub down: i32,
     /// u's texel index: C₂ is `similar[u]`, its diagonal texels `c2[u]`
     /// (`AtlasLevel`). Only the winner's coordinate is ever looked up.
     pub u: i32,
     /// Index into DELTAS of the neighbour both came from.
     pub from: u8,
+}
+
+impl Pair {
+    /// C₁'s texel index: midway between `up` and `down`, one texel right.
+    #[inline(always)]
+    pub fn c1(&self) -> i32 {
+        ((self.up + self.down) >> 1) + 1
+    }
 }
 
 /// Lists the candidates of the pixel in grid column `c` (C₁ and C₂ of every
@@ -250,14 +265,15 @@ fn list(
     // the 32 bytes q ± s − 1 … q ± s + 2), near S(p), whose lines N_S
     // reads anyway; and C₂'s from `c2[u]`, one line.
     let app = atlas.level.appearance;
-    prefetch(app, c1 - stride - 1);
-    prefetch(app, c1 + stride - 1);
+    let (up, down) = (c1 - stride - 1, c1 + stride - 1);
+    prefetch(app, up);
+    prefetch(app, down);
     if similar {
         prefetch(atlas.c2, u_idx);
     }
     Pair {
-        c1,
-        stride,
+        up,
+        down,
         u: u_idx,
         from: k as u8,
     }

@@ -185,7 +185,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         return best;
     }
     for (j, pair) in pairs.iter().enumerate() {
-        let c1 = Quad::around(app, pair.c1, pair.stride);
+        let c1 = Quad::beside(app, pair.up, pair.down);
         let (sc, hh) = score_with::<P>(ns, &c1, 1, None, vp);
         if sc < best.0 {
             best = (sc, 2 * j, hh);

@@ -50,33 +50,33 @@ pub(super) fn ns256(ns: &Neighbourhood) -> Ns256 {
     }
 }
 
-/// The four diagonal texels of the candidate whose texel index is `q` in
-/// an exemplar of row stride `s`, as 16 i16 lanes: (−1,−1), (−1,1) in the
-/// low half, (1,−1), (1,1) in the high half.
+/// The four diagonal texels of the candidate whose up-left and down-left
+/// diagonals are texels `up` and `down` ([`Pair`]), as 16 i16 lanes:
+/// (−1,−1), (−1,1) in the low half, (1,−1), (1,1) in the high half.
 ///
 /// # Safety
-/// `q ± s − 1 … q ± s + 2` must be indices of `app`. Every candidate is an
-/// interior coordinate of its exemplar, [`MARGIN`] = 2 texels from each
-/// edge: C₁ by `AtlasLevel::clamp_interior`, C₂ because the database
-/// checks every similarity entry when it is opened (`check_level`). So the
-/// rows above and below and the columns up to two to the right lie in the
-/// same exemplar, whose texels are all in `app`.
+/// `up … up + 3` and `down … down + 3` must be indices of `app`. Every
+/// candidate is an interior coordinate of its exemplar, [`MARGIN`] = 2
+/// texels from each edge: C₁ by `AtlasLevel::clamp_interior`, C₂ because
+/// the database checks every similarity entry when it is opened
+/// (`check_level`). So the rows above and below and the columns up to two
+/// to the right lie in the same exemplar, whose texels are all in `app`.
 ///
 /// [`MARGIN`]: crate::database::layout::MARGIN
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn candidate_texels(app: &[u64], q: i32, s: i32) -> __m256i {
-    debug_assert!(q - s > 0 && ((q + s + 2) as usize) < app.len());
+unsafe fn candidate_texels(app: &[u64], up: i32, down: i32) -> __m256i {
+    debug_assert!(up >= 0 && ((down + 3) as usize) < app.len());
     let p = app.as_ptr();
-    // SAFETY: the caller guarantees both 32-byte reads (texels q − s − 1 …
-    // q − s + 2 and q + s − 1 … q + s + 2) lie in `app`; unaligned loads.
+    // SAFETY: the caller guarantees both 32-byte reads (texels up … up + 3
+    // and down … down + 3) lie in `app`; unaligned loads.
     let (up, down) = unsafe {
         (
-            _mm256_loadu_si256(p.offset((q - s - 1) as isize).cast()),
-            _mm256_loadu_si256(p.offset((q + s - 1) as isize).cast()),
+            _mm256_loadu_si256(p.offset(up as isize).cast()),
+            _mm256_loadu_si256(p.offset(down as isize).cast()),
         )
     };
-    // Texels 0 and 2 of each row: columns q − 1 and q + 1.
+    // Texels 0 and 2 of each row: the candidate's columns − 1 and + 1.
     _mm256_unpacklo_epi64(up, down)
 }
 
@@ -88,15 +88,15 @@ struct Residuals {
     flat: bool,
 }
 
-/// [`Residuals`] of the candidate at `q` (stride `s`).
+/// [`Residuals`] of a pair's C₁.
 ///
 /// # Safety
 /// As [`candidate_texels`].
 #[inline]
 #[target_feature(enable = "avx2")]
-unsafe fn residuals<const P: u32>(app: &[u64], ns: &Ns256, q: i32, s: i32) -> Residuals {
+unsafe fn residuals<const P: u32>(app: &[u64], ns: &Ns256, pair: &Pair) -> Residuals {
     // SAFETY: forwarded from the caller.
-    let t = unsafe { candidate_texels(app, q, s) };
+    let t = unsafe { candidate_texels(app, pair.up, pair.down) };
     residuals_of::<P>(ns, t)
 }
 
@@ -129,13 +129,24 @@ fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
         let prior = Prior { weight: P, v: vp };
         (prior, prior.optimal(sum1))
     };
-    let off = _mm256_blend_epi32::<0b0101_0101>(_mm256_setzero_si256(), _mm256_set1_epi32(3 * h));
+    // 3h in the mode-0 lanes (the low half of each 64-bit lane), 0 in the
+    // others: one broadcast, no blend.
+    let off = _mm256_set1_epi64x(i64::from((3 * h) as u32));
     let d = _mm256_packs_epi32(_mm256_sub_epi32(r.even, off), r.odd);
     let d = _mm256_min_epi16(
         _mm256_max_epi16(d, _mm256_set1_epi16(-CLAMP as i16)),
         _mm256_set1_epi16(CLAMP as i16),
     );
-    (h, prior.cost(h), _mm256_madd_epi16(d, d))
+    (h, cost(prior, h), _mm256_madd_epi16(d, d))
+}
+
+/// [`Prior::cost`] with one compare: its clamp then square is the square
+/// capped at CLAMP², once the square is exact (i64; the product 3(h − V)
+/// itself wraps in i32 as in the scalar `score` and the WGSL kernel).
+#[inline(always)]
+fn cost(prior: Prior, h: i32) -> u32 {
+    let r = i64::from(3 * (h - prior.v));
+    prior.weight * (r * r).min(i64::from(CLAMP * CLAMP)) as u32
 }
 
 /// Score and optimal offset of a pair's C₁ alone (κ = 1), where C₂ does
@@ -152,13 +163,20 @@ pub(super) unsafe fn score_c1<const P: u32>(
     vp: i32,
 ) -> (u32, i32) {
     // SAFETY: forwarded from the caller.
-    let a = unsafe { residuals::<P>(app, ns, pair.c1, pair.stride) };
+    let a = unsafe { residuals::<P>(app, ns, pair) };
     // Σ d₁: the mode-0 lanes 0, 2, 4, 6 of `even`.
     let (h, cost, squares) = fit::<P>(&a, lane_sum(a.even), vp);
     // The squares sum to at most 16·9459² < 2³¹; with the prior < 2³².
-    let odd = _mm256_srli_epi64::<32>(squares);
-    let total = lane_sum(squares).wrapping_add(lane_sum(odd)) as u32;
-    (total.wrapping_add(cost), h)
+    (hsum(squares).wrapping_add(cost), h)
+}
+
+/// The sum of the eight i32 lanes of `x` (wrapping).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn hsum(x: __m256i) -> u32 {
+    let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
+    let x = _mm_add_epi32(x, _mm_unpackhi_epi64(x, x));
+    _mm_cvtsi128_si32(_mm_add_epi32(x, _mm_shuffle_epi32::<0b01>(x))) as u32
 }
 
 /// The sum of lanes 0, 2, 4 and 6 of `x` (i32, wrapping).
@@ -186,7 +204,7 @@ pub(super) unsafe fn score_pair<const P: u32>(
     vp: i32,
 ) -> [(u32, i32); 2] {
     // SAFETY: forwarded from the caller.
-    let a = unsafe { residuals::<P>(app, ns, pair.c1, pair.stride) };
+    let a = unsafe { residuals::<P>(app, ns, pair) };
     let quad: *const Quad = &c2[pair.u as usize];
     // SAFETY: a `Quad` is 32 bytes, 32-byte aligned.
     let b = residuals_of::<P>(ns, unsafe { _mm256_load_si256(quad.cast()) });
@@ -206,4 +224,33 @@ pub(super) unsafe fn score_pair<const P: u32>(
     let s1 = (sums as u32).wrapping_add(ca);
     let s2 = ((sums >> 32) as u32).wrapping_add(cb) << 1;
     [(s1, ha), (s2, hb)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stages::correct::PRIORS;
+
+    #[test]
+    fn the_capped_square_is_the_priors_cost() {
+        // Offsets inside the clamp, at it, past it, and far past it (the
+        // square of 3(h − V) beyond i32), for every weight.
+        let mut x = 0x2545_F491u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        };
+        let edge = CLAMP as u32 / 3;
+        for _ in 0..20_000 {
+            let scale = [4, edge + 2, 1 << 16, 1 << 28][(next() % 4) as usize];
+            let mut within = || (next() % (2 * scale)) as i32 - scale as i32;
+            let (h, v) = (within(), within());
+            for weight in PRIORS {
+                let prior = Prior { weight, v };
+                assert_eq!(cost(prior, h), prior.cost(h), "P {weight}, h {h}, V {v}");
+            }
+        }
+    }
 }
