@@ -35,11 +35,11 @@ pub(super) struct Pending {
 /// once per pair instead of again in the scorer's loop.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Pair {
-    /// The texel up-left of C₁ (`c1 − stride − 1`), and down-left of it
-    /// (`c1 + stride − 1`), where C₁ is u's texel unless u left its
-    /// exemplar's interior and was clamped back (the winner's coordinate
-    /// is formed by `finish`).
+    /// The texel up-left of C₁ (`c1 − stride − 1`), where C₁ is u's texel
+    /// unless u left its exemplar's interior and was clamped back (the
+    /// winner's coordinate is formed by `finish`).
     pub up: i32,
+    /// The texel down-left of C₁ (`c1 + stride − 1`).
     pub down: i32,
     /// u's texel index: C₂ is `similar[u]`, its diagonal texels `c2[u]`
     /// (`AtlasLevel`). Only the winner's coordinate is ever looked up.

@@ -68,8 +68,6 @@ pub(in super::super) fn tabulate(grid: &Grid, n: usize, t: &mut Table) {
             dup = _mm256_or_si256(dup, _mm256_and_si256(eq, _mm256_set1_epi32(1 << k)));
         }
         let first = _mm256_andnot_si256(dup, _mm256_set1_epi32(0x1FF));
-        let out: &mut [u32; 8] = (&mut t.first[i0..i0 + 8]).try_into().expect("eight pixels");
-        // SAFETY: `out` is eight u32, the width of the store.
-        unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), first) };
+        store(bytemuck::cast_slice_mut(&mut t.first), i0, first);
     }
 }
