@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 use terrasynth::Heightfield;
 use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
 use terrasynth::eval::drainage::{Edges, d8_area};
-use terrasynth::eval::{self, Reference, Value, describe, id};
+use terrasynth::eval::{self, Reference, Value, describe, id, novelty};
 use terrasynth::io::CoordsMap;
 use terrasynth::io::coords_map::{NO_EXEMPLAR, Source};
 use terrasynth::progress::Silent;
@@ -114,7 +114,7 @@ fn a_funnel_drains_into_one_cell_and_a_cone_spreads_its_flow() {
 /// A periodic surface with power spectrum ∝ f^−β (random phases, amplitude
 /// f^−β/2), made by an inverse FFT.
 fn power_law(n: usize, beta: f64, seed: u32) -> Heightfield {
-    let (mut re, mut im) = (vec![0.0; n * n], vec![0.0; n * n]);
+    let mut spec = vec![eval::fft::Complex64::default(); n * n];
     for v in 0..n {
         for u in 0..n {
             let s = |i: usize| {
@@ -131,13 +131,12 @@ fn power_law(n: usize, beta: f64, seed: u32) -> Heightfield {
             let h = terrasynth::hash::hash4(seed, 7, u as u32, v as u32);
             let phase = h as f64 / u32::MAX as f64 * std::f64::consts::TAU;
             let amp = f.powf(-beta / 2.0);
-            re[v * n + u] = amp * phase.cos();
-            im[v * n + u] = amp * phase.sin();
+            spec[v * n + u] = eval::fft::Complex64::from_polar(amp, phase);
         }
     }
-    eval::fft::fft2(&mut re, &mut im, n, n, true);
-    let scale = 300.0 / re.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
-    Heightfield::from_fn(n, n, 30.0, |x, y| (re[y * n + x] * scale) as f32).unwrap()
+    eval::fft::Fft2::new(n, n).inverse(&mut spec);
+    let scale = 300.0 / spec.iter().fold(0.0f64, |a, b| a.max(b.re.abs()));
+    Heightfield::from_fn(n, n, 30.0, |x, y| (spec[y * n + x].re * scale) as f32).unwrap()
 }
 
 #[test]
@@ -419,6 +418,51 @@ fn bad_inputs_get_clear_errors() {
     assert!(e.contains("(3, 5)") && e.contains("fill"), "{e}");
 }
 
+/// Novelty on real terrain (issue 46): a jitter-free synthesis is a copy of
+/// its exemplar (a toroidal shift of it: only the windows across the wrap
+/// are not), while one half of a DEM against the other scores like the
+/// DEM's own top and bottom halves — real terrain is not a copy of itself.
+#[test]
+fn novelty_sees_copies_and_not_real_terrain() {
+    let Some(ex) = dem::exemplar("pyrenees_andorra", (0, 0, 888, 888), false) else {
+        eprintln!("skipping: shared DEMs not found in {}", dem::DEM);
+        return;
+    };
+    let p = novelty::Params::default();
+    let hf = ex.heights.clone();
+    let (db, _) = database::build(vec![ex], &BuildOptions::default(), &Silent).unwrap();
+    let copy = Synthesizer::new(
+        &db,
+        Params {
+            jitter: 0.0,
+            ..Params::default()
+        },
+    )
+    .unwrap()
+    .synthesize(888, 888, 11)
+    .unwrap();
+    let c = novelty::copies(&copy, &[&hf], &p).unwrap();
+    let (west, east) = (
+        hf.crop(0, 0, 444, 888).unwrap(),
+        hf.crop(444, 0, 444, 888).unwrap(),
+    );
+    let other = novelty::copies(&east, &[&west], &p).unwrap();
+    let base = novelty::halves(&hf, &p).unwrap();
+    eprintln!(
+        "copy share: jitter-free {:.2}, east half against west {:.2}, top against bottom {:.2}",
+        c.share, other.share, base.share
+    );
+    // Measured: 0.88, 0.00 and 0.00.
+    assert!(c.share >= 0.8, "a shifted copy: {}", c.share);
+    assert!(
+        other.share <= base.share + 0.1,
+        "real terrain against its neighbour: {} (halves {})",
+        other.share,
+        base.share
+    );
+    assert!(other.median_ncc < 0.9 && c.median_ncc > 0.99);
+}
+
 fn cli(args: &[&std::ffi::OsStr]) -> std::process::Output {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_terrasynth"))
         .args(args)
@@ -484,6 +528,38 @@ fn cli_synth_coords_eval_and_suite() {
     assert!((used - 1.0).abs() < 1e-9, "shares sum to 1: {used}");
     let plot = image::open(tmp.path().join("plot.png")).unwrap();
     assert_eq!((plot.width(), plot.height()), (1440, 520));
+    // Novelty against the database's exemplar (the crop): the synthesis's
+    // windows against it, the crop's halves, the synthesis against itself.
+    let n = &v["novelty"];
+    for k in ["copies", "repetition"] {
+        let share = n[k]["share"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&share), "{k}: {share}");
+        assert_eq!(
+            n[k]["scored"].as_u64().unwrap() + n[k]["flat"].as_u64().unwrap(),
+            4,
+            "{k}: 2 x 2 windows"
+        );
+    }
+    assert_eq!(n["baselines"].as_array().unwrap().len(), 1);
+    // The crop against itself is all copies; novelty alone needs no
+    // reference; the copy map is drawn.
+    let out = cli(&[
+        "eval".as_ref(),
+        reference.as_os_str(),
+        "--exemplars".as_ref(),
+        reference.as_os_str(),
+        "--json".as_ref(),
+        "--copy-map".as_ref(),
+        &p("copies.png"),
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v.get("ratio").is_none(), "no reference, no realism");
+    assert_eq!(v["novelty"]["copies"]["share"].as_f64(), Some(1.0));
+    let map = image::open(tmp.path().join("copies.png")).unwrap();
+    assert!(
+        map.width() >= 288 && map.height() > 272,
+        "the preview under a caption"
+    );
     let help = cli(&["eval".as_ref(), "--help".as_ref()]);
     // clap wraps long lines: compare with whitespace collapsed.
     let words = |s: &str| s.split_whitespace().collect::<Vec<_>>().join(" ");
@@ -519,6 +595,9 @@ fn cli_synth_coords_eval_and_suite() {
     assert_eq!(dem["seeds"].as_array().unwrap().len(), 2);
     assert!(dem["median"]["ratio"].as_f64().unwrap() > 0.0);
     assert!(dem["baseline"].as_f64().unwrap() > 0.0);
+    assert!(dem["copy_baseline"].as_f64().is_some());
+    assert!(dem["median"]["copy_share"].as_f64().is_some());
+    assert!(dem["targets"]["copies"].as_bool().is_some());
     assert_eq!(
         v["typed"]["median"].as_array().unwrap().len(),
         types.present().len()
@@ -526,6 +605,7 @@ fn cli_synth_coords_eval_and_suite() {
     for f in [
         "crop_s1_side.png",
         "crop_s1_plot.png",
+        "crop_s1_copies.png",
         "crop_s2.png",
         "typed_s2_coords.png",
         "report.json",

@@ -456,6 +456,55 @@ fn eval<'py>(
     py.import("json")?.call_method1("loads", (json,))
 }
 
+/// How much of a synthesis is a recognisable copy of its exemplars
+/// (``terrasynth eval``'s novelty): 64-cell windows of ``synth`` (heights
+/// averaged 2×2) whose best normalised cross-correlation with any window
+/// of any of ``exemplars``, in any of the 8 orientations, is at least
+/// ``threshold``; windows flatter than ``flat`` × the exemplars' median
+/// window standard deviation are skipped; at most ``max_windows`` windows,
+/// evenly spread.
+///
+/// Returns a dict: ``copies`` (``share``, ``median_ncc``, ``scored``,
+/// ``flat``, ``windows``: each scored window's corner, best NCC and where
+/// it matched), ``baselines`` and ``baseline`` (each exemplar's top half
+/// against its bottom half: what real terrain scores against itself) and
+/// ``repetition`` (windows with a near-duplicate elsewhere in ``synth``).
+#[pyfunction]
+#[pyo3(signature = (synth, exemplars, *, window=64, downsample=2, threshold=0.95, flat=0.25, max_windows=150))]
+#[allow(clippy::too_many_arguments)]
+fn novelty<'py>(
+    py: Python<'py>,
+    synth: &Bound<'py, PyAny>,
+    exemplars: Vec<Bound<'py, PyAny>>,
+    window: usize,
+    downsample: usize,
+    threshold: f64,
+    flat: f64,
+    max_windows: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    // NCC ignores the cell size.
+    let s = heightfield(synth, 1.0, "synth")?;
+    let ex = exemplars
+        .iter()
+        .map(|e| heightfield(e, 1.0, "exemplars"))
+        .collect::<PyResult<Vec<_>>>()?;
+    let p = terrasynth::eval::novelty::Params {
+        window,
+        downsample,
+        threshold,
+        flat,
+        max_windows,
+    };
+    let json = py
+        .allow_threads(|| -> Result<String, String> {
+            let refs: Vec<&terrasynth::Heightfield> = ex.iter().collect();
+            let r = terrasynth::eval::novelty::measure(&s, &refs, &p).map_err(|e| e.to_string())?;
+            serde_json::to_string(&r).map_err(|e| e.to_string())
+        })
+        .map_err(err)?;
+    py.import("json")?.call_method1("loads", (json,))
+}
+
 /// terrasynth's engine: example-based terrain synthesis (Gain, Merry &
 /// Marais 2015) with windows of unbounded worlds.
 #[pymodule]
@@ -467,6 +516,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_heightfield, m)?)?;
     m.add_function(wrap_pyfunction!(write_heightfield, m)?)?;
     m.add_function(wrap_pyfunction!(eval, m)?)?;
+    m.add_function(wrap_pyfunction!(novelty, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

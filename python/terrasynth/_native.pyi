@@ -1,7 +1,7 @@
 """Type stubs of the extension module (python/src/lib.rs)."""
 
 import os
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -75,3 +75,15 @@ def eval(
     reference_cell_size: Optional[float] = None,
 ) -> Dict[str, Any]:
     """`terrasynth eval --json`'s comparison: ratio, descriptors, ..."""
+
+def novelty(
+    synth: Union[npt.NDArray[np.float32], npt.NDArray[np.float64]],
+    exemplars: Sequence[Union[npt.NDArray[np.float32], npt.NDArray[np.float64]]],
+    *,
+    window: int = 64,
+    downsample: int = 2,
+    threshold: float = 0.95,
+    flat: float = 0.25,
+    max_windows: int = 150,
+) -> Dict[str, Any]:
+    """Copy share against the exemplars, their halves' baseline, self-repetition."""

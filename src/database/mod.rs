@@ -190,6 +190,21 @@ impl Database {
     pub fn heights(&self) -> &[u16] {
         bytemuck::cast_slice(&self.file_bytes()[self.heights.clone()])
     }
+    /// Exemplar `i`'s level-0 heights in metres, with its cell size (what
+    /// the build analysed, after any resampling): for previews and for
+    /// measuring a synthesis against its exemplars.
+    pub fn exemplar(&self, i: usize) -> crate::heightfield::Heightfield {
+        let r = self.level(0).layout.rects[i];
+        let q = self.quantization();
+        let start = r.offset as usize;
+        let data = self.heights()[start..start + r.texels() as usize]
+            .iter()
+            .map(|&u| q.metres(u as f64) as f32)
+            .collect();
+        let cell = self.meta.exemplars[i].cell_size_m;
+        crate::heightfield::Heightfield::from_vec(r.width as usize, r.height as usize, cell, data)
+            .expect("a database's exemplar rectangles are valid heightfield sizes")
+    }
     pub fn level(&self, i: usize) -> Level<'_> {
         let b = self.file_bytes();
         let r = &self.levels[i];

@@ -17,6 +17,11 @@ pub enum EvalError {
     )]
     Nodata { count: usize, x: usize, y: usize },
     #[error(
+        "novelty settings {0:?} are invalid: expected window / downsample >= 4, max_windows >= 2, \
+         0 < threshold <= 1 and flat >= 0"
+    )]
+    NoveltyParams(super::novelty::Params),
+    #[error(
         "coordinates map pixel ({x}, {y}) names exemplar {exemplar}, but the database has {count} (0..={max})",
         max = count.saturating_sub(1)
     )]

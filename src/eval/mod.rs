@@ -35,6 +35,7 @@ pub mod drainage;
 pub mod elevation;
 mod error;
 pub mod fft;
+pub mod novelty;
 pub mod plot;
 pub mod roughness;
 pub mod slope;
@@ -226,13 +227,7 @@ pub fn describe(hf: &Heightfield) -> Result<Descriptors, EvalError> {
             min: MIN_SIDE,
         });
     }
-    if let Some(i) = hf.data().iter().position(|v| v.is_nan()) {
-        return Err(EvalError::Nodata {
-            count: hf.nodata_count(),
-            x: i % w,
-            y: i / w,
-        });
-    }
+    check_nodata(hf)?;
     let ((spectrum, drainage), (slope, rest)) = rayon::join(
         || {
             rayon::join(
@@ -275,6 +270,18 @@ pub fn describe(hf: &Heightfield) -> Result<Descriptors, EvalError> {
         spectrum,
         relief: elevation::relief(&heights),
     })
+}
+
+/// Refuses a terrain with nodata, naming its first hole.
+pub(crate) fn check_nodata(hf: &Heightfield) -> Result<(), EvalError> {
+    match hf.data().iter().position(|v| v.is_nan()) {
+        Some(i) => Err(EvalError::Nodata {
+            count: hf.nodata_count(),
+            x: i % hf.width(),
+            y: i / hf.width(),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// A cell's neighbourhood, read by offset.

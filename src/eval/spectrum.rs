@@ -15,7 +15,7 @@
 //! average). On the shared DEMs and their halves (≥ 300 cells across) the
 //! band is the same 4–64 cells for every terrain.
 
-use super::fft::fft2;
+use super::fft::{Complex64, Fft2};
 use crate::heightfield::Heightfield;
 use rayon::prelude::*;
 
@@ -58,18 +58,19 @@ pub fn spectrum(hf: &Heightfield) -> Spectrum {
     };
     let (wx, wy) = (hann(w), hann(h));
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
-    let mut re = vec![0.0f64; pw * ph];
-    re.par_chunks_mut(pw)
+    let mut spec = vec![Complex64::default(); pw * ph];
+    spec.par_chunks_mut(pw)
         .take(h)
         .enumerate()
         .for_each(|(y, row)| {
             for x in 0..w {
                 let trend = a + bx * (x as f64 - cx) + by * (y as f64 - cy);
-                row[x] = (hf.get(x, y) as f64 - trend) * wx[x] * wy[y];
+                row[x].re = (hf.get(x, y) as f64 - trend) * wx[x] * wy[y];
             }
         });
-    let mut im = vec![0.0f64; pw * ph];
-    fft2(&mut re, &mut im, pw, ph, false);
+    // The spectrum transposed: bin (u, v) at u·ph + v.
+    let mut bins_t = vec![Complex64::default(); pw * ph];
+    Fft2::new(pw, ph).forward_transposed(&mut spec, h, &mut bins_t);
     let energy: f64 = wx.iter().map(|v| v * v).sum::<f64>() * wy.iter().map(|v| v * v).sum::<f64>();
 
     // Ring averages in log-spaced bins from the lowest non-zero frequency.
@@ -89,10 +90,9 @@ pub fn spectrum(hf: &Heightfield) -> Spectrum {
                 if f < f_min {
                     continue; // the mean (removed) and sub-bin frequencies
                 }
-                let k = v * pw + u;
                 let b = &mut acc[bin_of(f).min(bins - 1)];
                 b.0 += f;
-                b.1 += re[k] * re[k] + im[k] * im[k];
+                b.1 += bins_t[u * ph + v].norm_sqr();
                 b.2 += 1;
             }
             acc

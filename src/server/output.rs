@@ -7,7 +7,6 @@ use super::error::ApiError;
 use super::request::{self, PathParam};
 use super::view::View;
 use crate::database::Database;
-use crate::heightfield::Heightfield;
 use crate::io::{self, Format, WriteOptions};
 use axum::body::Body;
 use axum::extract::{RawQuery, State};
@@ -54,17 +53,7 @@ pub async fn exemplar(State(app): State<Arc<App>>, PathParam(index): PathParam) 
 
 /// An exemplar's level-0 heights, rendered like the terrain.
 fn exemplar_png(db: &Database, i: usize) -> Api<Vec<u8>> {
-    let r = db.level(0).layout.rects[i];
-    let q = db.quantization();
-    let n = r.texels() as usize;
-    let start = r.offset as usize;
-    let data: Vec<f32> = db.heights()[start..start + n]
-        .iter()
-        .map(|&u| q.metres(u as f64) as f32)
-        .collect();
-    let cell = db.meta().exemplars[i].cell_size_m;
-    let hf = Heightfield::from_vec(r.width as usize, r.height as usize, cell, data)
-        .map_err(|e| ApiError::Internal(e.to_string()))?;
+    let hf = db.exemplar(i);
     let style = super::view::Style::new(db);
     let view = View {
         range: false,

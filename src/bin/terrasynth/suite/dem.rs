@@ -1,26 +1,38 @@
 //! The protocol on one DEM: its single-exemplar database, a synthesis per
-//! seed compared with the DEM, and the medians over seeds against issue 14's
-//! targets.
+//! seed compared with the DEM (realism, and novelty: its copy share against
+//! the DEM and its self-repetition), and the medians over seeds against the
+//! targets of issues 14 and 46.
 
 use super::{Dem, Result, SuiteArgs};
 use crate::bench::median;
-use crate::eval::SizeArg;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 use terrasynth::Heightfield;
 use terrasynth::database::{BuildOptions, ExemplarInput, cache};
-use terrasynth::eval::{self, Comparison, DESCRIPTORS, Reference};
+use terrasynth::eval::{self, Comparison, DESCRIPTORS, Reference, novelty};
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::render::{self, RenderOptions};
 use terrasynth::synth::{Params, Synthesizer};
 
-/// The targets of issue 14's "Done means", per DEM (median over seeds).
-pub(super) const TARGET_RATIO: f64 = 1.3;
+/// The targets of issues 14 and 46, per DEM (median over seeds): realism
+/// ratio, median slope, relief, pits, and the copy share's margin over the
+/// DEM's own halves.
+pub(super) const TARGET_RATIO: f64 = 1.2;
 pub(super) const TARGET_SLOPE: f64 = 0.10;
 pub(super) const TARGET_RELIEF: f64 = 0.85;
 pub(super) const TARGET_PITS: f64 = 1.5;
+pub(super) const TARGET_COPY_POINTS: f64 = 0.05;
+
+/// One synthesis's novelty figures (`eval::novelty`).
+#[derive(Serialize, Clone, Copy)]
+pub(super) struct SeedNovelty {
+    pub(super) copy_share: f64,
+    pub(super) median_ncc: f64,
+    pub(super) windows: usize,
+    pub(super) repetition: f64,
+}
 
 #[derive(Serialize)]
 pub(super) struct SeedResult {
@@ -28,6 +40,8 @@ pub(super) struct SeedResult {
     pub(super) synth_ms: f64,
     #[serde(flatten)]
     pub(super) comparison: Comparison,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) novelty: Option<SeedNovelty>,
 }
 
 /// Medians over seeds.
@@ -44,15 +58,19 @@ pub(super) struct Medians {
     pub(super) pits_real: f64,
     pub(super) pits_synth: f64,
     pub(super) pits_ratio: f64,
+    /// Copy share and self-repetition (when novelty is measured).
+    pub(super) copy_share: Option<f64>,
+    pub(super) repetition: Option<f64>,
 }
 
-/// Whether each of issue 14's targets is met.
+/// Whether each target is met (`copies`: None when novelty is not measured).
 #[derive(Serialize)]
 pub(super) struct Targets {
     pub(super) ratio: bool,
     pub(super) slope: bool,
     pub(super) relief: bool,
     pub(super) pits: bool,
+    pub(super) copies: Option<bool>,
 }
 
 #[derive(Serialize)]
@@ -66,6 +84,9 @@ pub(super) struct DemResult {
     /// units of its left half against its right (about 1; what an equally
     /// real synthesis could score).
     pub(super) baseline: f64,
+    /// The copy share of the DEM's top half against its bottom half: what
+    /// real terrain scores against another part of itself.
+    pub(super) copy_baseline: Option<f64>,
     pub(super) seeds: Vec<SeedResult>,
     pub(super) median: Medians,
     pub(super) targets: Targets,
@@ -79,6 +100,7 @@ fn write_outputs(
     exemplar: &Heightfield,
     synth: &Heightfield,
     plot: Option<(&Reference, &eval::Descriptors, &Comparison)>,
+    copies: Option<&novelty::Novelty>,
 ) -> Result<()> {
     let err = |e: &dyn std::fmt::Display| e.to_string();
     io::write(
@@ -98,11 +120,20 @@ fn write_outputs(
         let img = eval::plot::plot(r, d, c, stem);
         render::write_png(&out.join(format!("{stem}_plot.png")), &img).map_err(|e| err(&e))?;
     }
+    if let Some(n) = copies {
+        let img = novelty::copy_map(synth, n, stem).map_err(|e| err(&e))?;
+        render::write_png(&out.join(format!("{stem}_copies.png")), &img).map_err(|e| err(&e))?;
+    }
     Ok(())
 }
 
 /// The protocol on one DEM.
-pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemResult> {
+pub(super) fn run_dem(
+    dem: &Dem,
+    a: &SuiteArgs,
+    novelty: Option<&novelty::Params>,
+    cache_dir: &Path,
+) -> Result<DemResult> {
     let t = Instant::now();
     let name = &dem.name;
     let input = ExemplarInput {
@@ -130,10 +161,11 @@ pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemR
     let baseline = reference
         .baseline(&dem.hf)
         .map_err(|e| format!("{name}: {e}"))?;
-    let (w, h) = match a.synth_size {
-        SizeArg::Exemplar => (dem.hf.width(), dem.hf.height()),
-        SizeArg::Fixed(w, h) => (w, h),
-    };
+    let copy_baseline = novelty
+        .map(|p| novelty::halves(&dem.hf, p).map(|n| n.share))
+        .transpose()
+        .map_err(|e| format!("{name}: {e}"))?;
+    let (w, h) = a.synth_size.of(dem.hf.width(), dem.hf.height());
     let params = Params {
         jitter: a.jitter,
         passes: a.passes,
@@ -147,6 +179,14 @@ pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemR
         let synth_ms = ts.elapsed().as_secs_f64() * 1e3;
         let d = eval::describe(&out.heightfield).map_err(|e| format!("{name}: {e}"))?;
         let c = reference.compare(&d);
+        let measured = novelty
+            .map(|p| {
+                let copies = novelty::copies(&out.heightfield, &[&dem.hf], p)?;
+                let repetition = novelty::repetition(&out.heightfield, &[&dem.hf], p)?;
+                Ok((copies, repetition))
+            })
+            .transpose()
+            .map_err(|e: eval::EvalError| format!("{name}: {e}"))?;
         if let Some(o) = &a.out_dir {
             let plot = (k == 0).then_some((&reference, &d, &c));
             write_outputs(
@@ -155,10 +195,27 @@ pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemR
                 &dem.hf,
                 &out.heightfield,
                 plot,
+                measured.as_ref().map(|m| &m.0),
             )?;
         }
+        let novelty = measured.map(|(c, r)| SeedNovelty {
+            copy_share: c.share,
+            median_ncc: c.median_ncc,
+            windows: c.scored,
+            repetition: r.share,
+        });
+        let copies = novelty
+            .map(|n| {
+                format!(
+                    ", copies {:.0} % (median NCC {:.3}), repeats {:.0} %",
+                    n.copy_share * 100.0,
+                    n.median_ncc,
+                    n.repetition * 100.0
+                )
+            })
+            .unwrap_or_default();
         eprintln!(
-            "{name} seed {seed}: ratio {:.2}, median slope {:.1}° → {:.1}°, relief kept {:.0} %, pits ×{:.2} ({:.1} s)",
+            "{name} seed {seed}: ratio {:.2}, median slope {:.1}° → {:.1}°, relief kept {:.0} %, pits ×{:.2}{copies} ({:.1} s)",
             c.ratio,
             c.median_slope.reference,
             c.median_slope.synth,
@@ -170,6 +227,7 @@ pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemR
             seed,
             synth_ms,
             comparison: c,
+            novelty,
         });
     }
     let med =
@@ -190,12 +248,18 @@ pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemR
         pits_real: first.pits.reference,
         pits_synth: med(&|c| c.pits.synth),
         pits_ratio: med(&|c| c.pits.ratio),
+        copy_share: novelty_median(&seeds, |n| n.copy_share),
+        repetition: novelty_median(&seeds, |n| n.repetition),
     };
     let targets = Targets {
         ratio: median.ratio <= TARGET_RATIO,
         slope: (median.slope_ratio - 1.0).abs() <= TARGET_SLOPE,
         relief: median.relief_kept >= TARGET_RELIEF,
         pits: median.pits_ratio <= TARGET_PITS,
+        copies: median
+            .copy_share
+            .zip(copy_baseline)
+            .map(|(c, b)| c <= b + TARGET_COPY_POINTS + 1e-9),
     };
     Ok(DemResult {
         name: name.clone(),
@@ -204,8 +268,18 @@ pub(super) fn run_dem(dem: &Dem, a: &SuiteArgs, cache_dir: &Path) -> Result<DemR
         cell_size_m: dem.hf.cell_size(),
         synth_size: [w, h],
         baseline,
+        copy_baseline,
         seeds,
         median,
         targets,
     })
+}
+
+/// The median over seeds of a novelty figure (None when not measured).
+fn novelty_median(seeds: &[SeedResult], f: impl Fn(&SeedNovelty) -> f64) -> Option<f64> {
+    let v: Vec<f64> = seeds
+        .iter()
+        .filter_map(|s| s.novelty.as_ref().map(&f))
+        .collect();
+    (!v.is_empty()).then(|| median(v))
 }

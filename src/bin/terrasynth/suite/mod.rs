@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use terrasynth::Heightfield;
 use terrasynth::database::default;
+use terrasynth::eval::novelty;
 use terrasynth::io;
 use terrasynth::synth::Params;
 
@@ -41,7 +42,8 @@ pub struct SuiteArgs {
         requires = "suite"
     )]
     seeds: Vec<u32>,
-    /// Synthesis size per DEM: `exemplar` (its own size) or WxH.
+    /// Synthesis size per DEM: `exemplar` (its own size), a multiple of its
+    /// sides (`3x`: a world 3× its side) or WxH.
     #[arg(long = "size", value_parser = parse_size_arg, default_value = "exemplar", requires = "suite")]
     synth_size: SizeArg,
     /// Output size of the typed database's syntheses (type usage).
@@ -83,6 +85,7 @@ struct Dem {
 #[derive(Serialize)]
 struct SuiteReport {
     dir: PathBuf,
+    novelty: Option<novelty::Params>,
     seeds: Vec<u32>,
     jitter: f64,
     passes: u32,
@@ -95,14 +98,15 @@ struct SuiteReport {
 
 type Result<T> = std::result::Result<T, String>;
 
-pub fn run(a: &SuiteArgs, json: bool) -> CliResult {
+/// Runs the protocol; `novelty`: the copy-share rule (None: skipped).
+pub fn run(a: &SuiteArgs, novelty: Option<novelty::Params>, json: bool) -> CliResult {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.jobs.unwrap_or(0))
         .build()?;
-    pool.install(|| run_in_pool(a, json))
+    pool.install(|| run_in_pool(a, novelty, json))
 }
 
-fn run_in_pool(a: &SuiteArgs, json: bool) -> CliResult {
+fn run_in_pool(a: &SuiteArgs, novelty: Option<novelty::Params>, json: bool) -> CliResult {
     let t0 = Instant::now();
     let dir = a.suite.as_deref().expect("run only with --suite");
     if a.seeds.is_empty() {
@@ -136,7 +140,7 @@ fn run_in_pool(a: &SuiteArgs, json: bool) -> CliResult {
     );
     let results = chosen
         .par_iter()
-        .map(|d| dem::run_dem(d, a, &cache_dir))
+        .map(|d| dem::run_dem(d, a, novelty.as_ref(), &cache_dir))
         .collect::<Result<Vec<_>>>()?;
     let typed = if a.no_typed {
         None
@@ -145,6 +149,7 @@ fn run_in_pool(a: &SuiteArgs, json: bool) -> CliResult {
     };
     let report = SuiteReport {
         dir: dir.to_path_buf(),
+        novelty,
         seeds: a.seeds.clone(),
         jitter: a.jitter,
         passes: a.passes,

@@ -1,7 +1,7 @@
 //! The protocol's table for a person (`--json` prints the report itself).
 
 use super::SuiteReport;
-use super::dem::{TARGET_PITS, TARGET_RATIO, TARGET_RELIEF, TARGET_SLOPE};
+use super::dem::{TARGET_COPY_POINTS, TARGET_PITS, TARGET_RATIO, TARGET_RELIEF, TARGET_SLOPE};
 use crate::eval::print_type_usage;
 use terrasynth::eval::DESCRIPTORS;
 
@@ -18,7 +18,7 @@ pub(super) fn print_report(r: &SuiteReport) {
         r.passes
     );
     println!(
-        "{:<26} {:>9} {:>7} {:>6} {:>5}  {:>20}  {:>7}  {:>22}  targets",
+        "{:<26} {:>9} {:>7} {:>6} {:>5}  {:>20}  {:>7}  {:>22}  {:>15} {:>7}  targets",
         "DEM",
         "size",
         "cell m",
@@ -27,12 +27,14 @@ pub(super) fn print_report(r: &SuiteReport) {
         "median slope real→synth",
         "relief",
         "pits real→synth",
+        "copies real→syn",
+        "repeats",
     );
     for d in &r.dems {
         let m = &d.median;
         let t = &d.targets;
         println!(
-            "{:<26} {:>9} {:>7.1} {:>6.2} {:>5.2}  {:>6.1}° → {:>5.1}° ({:>3.0} %)  {:>6.0} %  {:>5.2} % → {:>5.2} % ({:>4.2}×)  {}{}{}{}",
+            "{:<26} {:>9} {:>7.1} {:>6.2} {:>5.2}  {:>6.1}° → {:>5.1}° ({:>3.0} %)  {:>6.0} %  {:>5.2} % → {:>5.2} % ({:>4.2}×)  {:>15} {:>7}  {}{}{}{}{}",
             d.name,
             format!("{}x{}", d.width, d.height),
             d.cell_size_m,
@@ -45,19 +47,31 @@ pub(super) fn print_report(r: &SuiteReport) {
             m.pits_real * 100.0,
             m.pits_synth * 100.0,
             m.pits_ratio,
+            match (d.copy_baseline, m.copy_share) {
+                (Some(b), Some(c)) => format!("{:.0} % → {:.0} %", b * 100.0, c * 100.0),
+                _ => "-".into(),
+            },
+            m.repetition
+                .map(|r| format!("{:.0} %", r * 100.0))
+                .unwrap_or_else(|| "-".into()),
             mark(t.ratio),
             mark(t.slope),
             mark(t.relief),
-            mark(t.pits)
+            mark(t.pits),
+            t.copies.map(mark).unwrap_or("")
         );
     }
     println!(
         "real: the DEM's top half against its bottom half, in the same units (real terrain against itself)"
     );
     println!(
-        "targets (issue 14): ratio ≤ {TARGET_RATIO}, median slope within {:.0} %, relief ≥ {:.0} %, pits ≤ {TARGET_PITS}×",
+        "copies: share of 64-px windows matching the DEM at NCC ≥ 0.95 in any orientation, its halves → the synthesis; repeats: windows with a near-duplicate elsewhere in the synthesis"
+    );
+    println!(
+        "targets (issues 14, 46): ratio ≤ {TARGET_RATIO}, median slope within {:.0} %, relief ≥ {:.0} %, pits ≤ {TARGET_PITS}×, copies ≤ the halves' + {:.0} points",
         TARGET_SLOPE * 100.0,
-        TARGET_RELIEF * 100.0
+        TARGET_RELIEF * 100.0,
+        TARGET_COPY_POINTS * 100.0
     );
     println!();
     print!("{:<26}", "descriptor ratios");
