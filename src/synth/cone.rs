@@ -30,7 +30,7 @@
 //! to ~`2 · 16` pixels (16 from the level's own correction, half the margin
 //! of the level below): a 1024² window computes a 1060² level 0 and ever
 //! smaller levels above, whatever the world's size. The coarse start (level
-//! L's hashed blocks, or the exemplar centre) is a pure function of
+//! L's hashed pieces, or the exemplar centre) is a pure function of
 //! absolute position and is computed over the top region only.
 
 use super::stages::correct::SUBPASSES;

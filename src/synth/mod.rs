@@ -1,7 +1,7 @@
 //! Coarse-to-fine parallel synthesis (paper §4, DESIGN §3, §5, §6).
 //!
 //! Levels top..0 of any output size: the top level is the coarse start
-//! ([`coarse`]: verbatim exemplar blocks, or the start exemplar's centre
+//! ([`coarse`]: exemplar pieces laid by an altitude guide, or the start exemplar's centre
 //! without jitter); each finer level is `upsample_jitter` of the one
 //! above and, at levels ≤ L (the database's coarsest), `passes` correction
 //! passes of four interleaved subpasses; `reconstruct` turns level 0 into
@@ -42,7 +42,7 @@ use std::cell::RefCell;
 use std::sync::OnceLock;
 
 pub use params::{
-    Guides, LevelGuide, LevelMaps, LevelTiming, Params, SynthError, Synthesis, Timings,
+    Guides, LevelGuide, LevelMaps, LevelTiming, PIECE_SIZES, Params, SynthError, Synthesis, Timings,
 };
 pub(crate) use window::union;
 pub use window::{Frames, PassResult};
@@ -66,9 +66,10 @@ pub struct Synthesizer<'db> {
     params: Params,
     atlas: Vec<AtlasLevel<'db>>,
     jitter: i32,
-    /// The coarse start's profile of the exemplars, built by the first
-    /// synthesis that starts from blocks.
-    profile: OnceLock<coarse::Profile>,
+    /// The coarse start's pool and guide, built by the first synthesis
+    /// that starts from pieces (the pool ranks every interior texel of
+    /// level L).
+    pieces: OnceLock<(coarse::Pool, coarse::Guide)>,
     #[cfg(feature = "gpu")]
     gpu: Option<crate::backend::gpu::Gpu>,
 }
@@ -88,6 +89,9 @@ impl<'db> Synthesizer<'db> {
         if let Some(index) = params.start_exemplar.filter(|&i| i >= count) {
             return Err(SynthError::StartExemplar { index, count });
         }
+        if !PIECE_SIZES.contains(&params.piece_size) {
+            return Err(SynthError::PieceSize(params.piece_size));
+        }
         let atlas = (0..db.level_count())
             .map(|i| AtlasLevel::new(db, i))
             .collect();
@@ -97,7 +101,7 @@ impl<'db> Synthesizer<'db> {
             params,
             atlas,
             jitter,
-            profile: OnceLock::new(),
+            pieces: OnceLock::new(),
             #[cfg(feature = "gpu")]
             gpu: None,
         })
@@ -271,13 +275,7 @@ impl<'db> Synthesizer<'db> {
     fn levels(&self, width: usize, height: usize) -> (Start, usize, usize) {
         let m = top_level(width, height);
         let l = self.coarsest();
-        let start = Start::choose(
-            self.jitter > 0,
-            m,
-            l,
-            &self.atlas[l],
-            self.params.start_exemplar,
-        );
+        let start = Start::choose(self.jitter > 0, m, l, self.params.piece_size);
         (start, start.top(m, l), l)
     }
 
@@ -346,20 +344,16 @@ impl<'db> Synthesizer<'db> {
         let (m, l) = (top_level(width, height), self.coarsest());
         let region = cone.region(cone.top());
         match start {
-            Start::Blocks { bits } => {
-                let from = self.params.start_exemplar;
-                let world = level_size(width, height, l);
-                let at = (region, world);
+            Start::Pieces { side } => {
                 let atlas = &self.atlas[l];
-                let profile = self
-                    .profile
-                    .get_or_init(|| coarse::Profile::new(self.db, atlas, from));
-                let src = coarse::Source {
-                    atlas,
-                    from,
-                    profile,
-                };
-                coarse::blocks(src, at, (l, bits), seed, self.jitter)
+                let (pool, guide) = self.pieces.get_or_init(|| {
+                    (
+                        coarse::Pool::new(atlas, self.params.start_exemplar),
+                        coarse::Guide::new(),
+                    )
+                });
+                let src = coarse::Source { atlas, pool, guide };
+                coarse::pieces(src, region, (l, side), seed, self.jitter)
             }
             Start::Centre => {
                 let top = start.top(m, l);

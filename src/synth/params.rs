@@ -15,12 +15,21 @@ pub struct Params {
     pub jitter: f64,
     /// Correction passes per level (paper: 2), each of four subpasses.
     pub passes: u32,
-    /// The exemplar synthesis starts from: its blocks make the coarse start
-    /// (see [`coarse`]), or without jitter its centre; the output takes its
-    /// cell size. `None`: blocks from every exemplar in proportion to its
-    /// area (each terrain type by its share of the database), exemplar 0's
-    /// centre without jitter, and exemplar 0's cell size.
+    /// The exemplar synthesis starts from: its pieces make the coarse start
+    /// (see [`super::coarse`]), or without jitter its centre; the output
+    /// takes its cell size. `None`: pieces from every exemplar (each place
+    /// by the altitude of its surroundings, so each exemplar and terrain
+    /// type by its share of the database's altitudes), exemplar 0's centre
+    /// without jitter, and exemplar 0's cell size.
     pub start_exemplar: Option<usize>,
+    /// Side, in output pixels, of the exemplar pieces the coarse start lays
+    /// (one of [`PIECE_SIZES`]; rounded to whole texels of the start
+    /// level): the knob between new and faithful. Small pieces (the
+    /// default, 32) make landforms the exemplars do not hold — no 64-px
+    /// window is one piece; large ones keep the exemplars' own landforms,
+    /// massifs and valley networks whole, and copy them (a world shows
+    /// them again and again).
+    pub piece_size: usize,
     /// Height prior weight P of the correction (one of
     /// `super::stages::correct::PRIORS`; 0 is the paper's pure relative height
     /// matching). See the `correct` stage's module docs.
@@ -49,12 +58,20 @@ impl Default for Params {
             jitter: 0.4,
             passes: 2,
             start_exemplar: None,
+            piece_size: DEFAULT_PIECE_SIZE,
             prior: super::stages::correct::DEFAULT_PRIOR,
             similar_from: 1,
             keep_levels: false,
         }
     }
 }
+
+/// The piece sizes of the coarse start (output pixels; see
+/// [`Params::piece_size`]).
+pub const PIECE_SIZES: std::ops::RangeInclusive<usize> = 8..=1024;
+
+/// The default piece size: half the novelty measure's window.
+pub const DEFAULT_PIECE_SIZE: usize = 32;
 
 /// Invalid synthesis requests.
 #[non_exhaustive]
@@ -68,6 +85,8 @@ pub enum SynthError {
     Prior(u32),
     #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
     StartExemplar { index: usize, count: usize },
+    #[error("piece size {0} is invalid: expected {min}..={max} pixels", min = PIECE_SIZES.start(), max = PIECE_SIZES.end())]
+    PieceSize(usize),
     #[error(transparent)]
     Size(#[from] crate::size::SizeError),
     #[error(transparent)]

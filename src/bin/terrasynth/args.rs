@@ -135,11 +135,17 @@ pub struct SynthesisArgs {
     /// Correction passes per level.
     #[arg(long, default_value_t = 2)]
     pub passes: u32,
-    /// Exemplar (index) the synthesis starts from: its blocks make the
-    /// coarse structure and the output takes its cell size. Default: blocks
-    /// from every exemplar by area, exemplar 0's cell size.
+    /// Exemplar (index) the synthesis starts from: its pieces make the
+    /// coarse structure and the output takes its cell size. Default: pieces
+    /// from every exemplar, exemplar 0's cell size.
     #[arg(long)]
     pub start_exemplar: Option<usize>,
+    /// Side in pixels (8..=1024) of the exemplar pieces the coarse start
+    /// lays: the knob between new and faithful. Small pieces (default)
+    /// make new landforms; large ones (256, 512) keep the exemplars' own
+    /// massifs and valleys whole — and repeat them across a world.
+    #[arg(long, default_value_t = terrasynth::synth::Params::default().piece_size)]
+    pub piece_size: usize,
     /// Height prior P of the correction: 0 (the paper's pure relative
     /// height matching), 1, 2, 4 or 8. Higher keeps candidates nearer the
     /// altitude the coarser level chose (more relief, less drift).
@@ -160,6 +166,7 @@ impl SynthesisArgs {
             jitter: self.jitter,
             passes: self.passes,
             start_exemplar: self.start_exemplar,
+            piece_size: self.piece_size,
             prior: self.height_prior,
             similar_from: self.similar_from,
             keep_levels,

@@ -23,7 +23,7 @@ pub struct Args {
     /// A scene file: the world is its terrain (its database, size, seed and
     /// controls replace --db, --size, --seed, --jitter, --passes,
     /// --start-exemplar and --height-prior).
-    #[arg(long, conflicts_with_all = ["db", "size", "seed", "jitter", "passes", "start_exemplar", "height_prior"])]
+    #[arg(long, conflicts_with_all = ["db", "size", "seed", "jitter", "passes", "start_exemplar", "piece_size", "height_prior"])]
     scene: Option<PathBuf>,
     /// Tile side in pixels (the last row and column may be shorter).
     #[arg(long, default_value_t = 1024)]
@@ -159,6 +159,7 @@ pub fn run(a: Args) -> CliResult {
         "jitter": params.jitter,
         "passes": params.passes,
         "start_exemplar": params.start_exemplar,
+        "piece_size": params.piece_size,
         "height_prior": params.prior,
     });
     source["seed"] = match &world {

@@ -7,100 +7,94 @@
 //! level ≤ L an exact copy of the centre, tiled toroidally when the output
 //! is larger than the exemplar.
 //!
-//! **With jitter**, level L starts as a mosaic of *blocks* of 2^b × 2^b
-//! texels, each copied verbatim around a hash-chosen texel of any exemplar
-//! ([`blocks`]), drawn uniformly over every interior texel (so every
-//! exemplar, every terrain type and every part of an exemplar is drawn by
-//! its area), plus the paper's jitter; from L down, jitter and correction
-//! rearrange them. Each 2 × 2 group of blocks keeps, of eight such draws,
-//! the one whose heights, slopes and terrain types are distributed most
-//! like its exemplars' (`fit.rs`).
+//! **With jitter**, level L starts as a mosaic of square **pieces** of
+//! the exemplars, [`Params::piece_size`](crate::synth::Params) output
+//! pixels across (32 by default): each piece copies the exemplar around a
+//! texel drawn from the [`Pool`] of every interior texel ranked by the
+//! altitude of its surroundings, at the rank an altitude guide — a smooth
+//! random field of its own (`guide.rs`) — sets for the piece's place
+//! ([`pieces`]), plus the paper's jitter; from L down, jitter and
+//! correction join and refine them.
 //!
-//! Why blocks, and why as large as the exemplars allow (b = ⌊log₂⌋ of the
-//! smallest exemplar interior side at L): pixel-based correction can join
-//! patches but cannot create large-scale structure. A mosaic of many small
-//! blocks (the fully jittered coarse level of Lefebvre & Hoppe 2005, which
-//! this crate used with b = 2) has no structure above the block size, and
-//! its joins — blocks from different altitudes side by side — are what the
-//! correction then levels: measured on the shared DEMs, level L kept 55–65 %
-//! of the exemplar's height spread and the output 55–70 % of its relief.
-//! Large blocks keep the exemplars' massifs and valley networks; the output
-//! still differs from any exemplar below the block scale (coherent patches
-//! at level 0 average ~100 pixels), and outputs larger than the exemplars
-//! get more blocks rather than a tiled copy. Halving the blocks (b − 1)
-//! was measured too: relief ≥ 85 % on 2 of the 8 DEMs instead of 4, and
-//! "hills" took 69 % of a typed output where they are 48 % of the
-//! exemplars — every join is levelled towards the middle.
+//! Why pieces smaller than the novelty measure's window (64 px, `eval
+//! novelty`): what a person recognises as a landform is its shape at that
+//! scale, and a piece is a verbatim copy. The start laid blocks as large as
+//! the exemplars allowed, so an output was the exemplar's own massifs
+//! rearranged — on the 8 shared DEMs 39–69 % of its 64-px windows matched
+//! the exemplar at NCC ≥ 0.95 (their own halves: 0–21 %), and a world 3×
+//! the exemplar's side showed the same summits again and again. With
+//! 32-px pieces no window is one piece; the landforms at that scale are
+//! joins of pieces from unrelated places, and the layout of highs and lows
+//! is the guide's, new for every seed and every place of a world.
 //!
 //! Computed on the host for every backend and uploaded: it is small
 //! (level L, ⌈W/2^L⌉ × ⌈H/2^L⌉ pixels), so it has no kernel mirror. Every
-//! choice is a hash of the seed and the block's absolute position
-//! (DESIGN §6), or a comparison of such draws over the block's group and
-//! the world's size, so any window of a terrain starts from the same
-//! blocks.
+//! choice is a hash of the seed and the piece's absolute position
+//! (DESIGN §6), so any window of a terrain starts from the same pieces.
 
-mod blocks;
-mod fit;
+mod guide;
+mod pieces;
+mod pool;
 
-pub use blocks::blocks;
-pub use fit::Profile;
+pub use guide::Guide;
+pub use pieces::pieces;
+pub use pool::Pool;
 
-use crate::database::layout::MARGIN;
 use crate::synth::atlas::AtlasLevel;
 use crate::synth::cone::Rect;
 use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::state::{State, level_size};
 
-/// What the blocks draw from: the database level L of `atlas`, exemplar
-/// `from` (or every exemplar), and the [`Profile`] of the same.
+/// What the pieces draw from: the database level L of `atlas`, its
+/// [`Pool`] (of one exemplar or all), and the [`Guide`]'s distribution.
 #[derive(Clone, Copy)]
 pub struct Source<'a> {
     pub atlas: &'a AtlasLevel<'a>,
-    pub from: Option<usize>,
-    pub profile: &'a Profile,
+    pub pool: &'a Pool,
+    pub guide: &'a Guide,
 }
 
 /// The coarsest level synthesis starts from (and corrects), whatever
 /// coarser levels the database holds.
 ///
 /// Why not the database's coarsest level L: synthesis coordinates stay
-/// [`MARGIN`] texels inside every exemplar at every level, and a level-L
-/// texel is 2^L pixels across — at L = 5 (the shared DEMs) the outer 64
-/// pixels of every exemplar side, 20–29 % of its area, were never drawn
-/// (measured from `--coords`: 0.0–0.5 % of the output from the outer 64
-/// columns of franconian_jura, 8 % of its area), and that is where those
-/// DEMs keep their lowest valleys and highest ridges: the output kept
-/// 76–85 % of their relief. Starting at level 3 loses 16 pixels a side;
-/// the blocks keep their size in pixels (b grows as the level falls).
-/// Level 2 left too few levels to join the blocks: straight seams showed
-/// along block edges (looked at on thuringia).
-pub const MAX_START_LEVEL: usize = 3;
+/// [`MARGIN`](crate::database::layout::MARGIN) texels inside every exemplar
+/// at every level, and a level-L texel is 2^L pixels across — at L = 5
+/// (the shared DEMs) the outer 64 pixels of every exemplar side, 20–29 %
+/// of its area, were never drawn, and that is where those DEMs keep many of
+/// their lowest valleys and highest ridges (the output kept 76–85 % of
+/// their relief).
+///
+/// Why level 2 (8 px of each exemplar side out of reach) and not 3: the
+/// start is pieces of 32 px (8 texels at level 2, 4 at level 3), and
+/// correction joins pieces by levelling the heights across each join. A
+/// 4-texel piece is three quarters join, so correcting level 3 levelled
+/// the whole start: on the 8 shared DEMs (seeds 11–13) the outputs kept
+/// 73–85 % of their relief where the start held 93–97 % (relief ≥ 85 %
+/// on 1 of the 8, realism ratio ≤ 1.2 on 5); starting at level 2 they
+/// keep 88–95 % (8 of 8) and the ratio is ≤ 1.2 on 7. The blocks the
+/// start laid before were 512 px, and level 3 joined them.
+pub const MAX_START_LEVEL: usize = 2;
 
 /// How a synthesis starts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Start {
-    /// The start exemplar's centre at level M (no jitter, or no room for a
-    /// block above L).
+    /// The start exemplar's centre at level M (no jitter).
     Centre,
-    /// Verbatim blocks of 2^bits × 2^bits level-L texels, made at level L.
-    Blocks { bits: usize },
+    /// Pieces of `side` level-L texels, made at level L.
+    Pieces { side: i32 },
 }
 
 impl Start {
-    /// The start of an output whose coarsest level is `m`, for a database
-    /// whose coarsest level `l` is `atlas_l`: blocks (from exemplar `from`,
-    /// or every exemplar) when there is jitter and room above L, else the
-    /// centre.
-    pub fn choose(
-        jittered: bool,
-        m: usize,
-        l: usize,
-        atlas_l: &AtlasLevel<'_>,
-        from: Option<usize>,
-    ) -> Start {
-        let bits = block_bits(atlas_l, from).min(m.saturating_sub(l));
-        if jittered && bits > 0 {
-            Start::Blocks { bits }
+    /// The start of an output whose coarsest level is `m`, for a synthesis
+    /// whose coarsest corrected level is `l`: pieces of `piece_size` output
+    /// pixels (at least a texel) when there is jitter and level L exists
+    /// (outputs under 2^(L+1) pixels have no level L), else the centre.
+    pub fn choose(jittered: bool, m: usize, l: usize, piece_size: usize) -> Start {
+        if jittered && m >= l {
+            Start::Pieces {
+                side: ((piece_size + (1 << l >> 1)) >> l).max(1) as i32,
+            }
         } else {
             Start::Centre
         }
@@ -110,40 +104,12 @@ impl Start {
     pub fn top(self, m: usize, l: usize) -> usize {
         match self {
             Start::Centre => m,
-            Start::Blocks { .. } => l,
+            Start::Pieces { .. } => l,
         }
     }
 }
 
-/// Inclusive interior bounds `[x0, x1] × [y0, y1]` of exemplar `from`, or
-/// of every exemplar, of a level, in atlas texels.
-fn interiors<'a>(
-    a: &'a AtlasLevel<'_>,
-    from: Option<usize>,
-) -> impl Iterator<Item = (i32, i32, i32, i32)> + 'a {
-    let rects = &a.level.layout.rects;
-    let rects = match from {
-        Some(e) => &rects[e..=e],
-        None => &rects[..],
-    };
-    rects.iter().map(|r| {
-        let c = a.columns[r.x0 as usize];
-        (c.min_x, c.max_x, MARGIN as i32, c.max_y)
-    })
-}
-
-/// The largest b such that a 2^b block fits the interior of exemplar
-/// `from` (or of every exemplar) at level L.
-pub fn block_bits(a: &AtlasLevel<'_>, from: Option<usize>) -> usize {
-    let side = interiors(a, from)
-        .map(|(x0, x1, y0, y1)| (x1 - x0 + 1).min(y1 - y0 + 1))
-        .min()
-        .unwrap_or(1)
-        .max(1);
-    side.ilog2() as usize
-}
-
-/// Level `top` of a `width × height` output without blocks, over `region`
+/// Level `top` of a `width × height` output without jitter, over `region`
 /// (absolute level-`top` pixels): the centre of exemplar `e` at the level
 /// `min(top, l)` of `a`, spread so that each level halves the spacing (in
 /// level-L units above L).

@@ -169,6 +169,7 @@ pub(super) fn run_dem(
     let params = Params {
         jitter: a.jitter,
         passes: a.passes,
+        piece_size: a.piece_size,
         ..Params::default()
     };
     let synth = Synthesizer::new(&db, params).map_err(|e| format!("{name}: {e}"))?;

@@ -62,6 +62,10 @@ pub struct SuiteArgs {
     /// Correction passes per level (synth's default).
     #[arg(long, default_value_t = Params::default().passes, requires = "suite")]
     passes: u32,
+    /// Side in pixels of the coarse start's exemplar pieces (synth's
+    /// default): the knob between new and faithful.
+    #[arg(long, default_value_t = Params::default().piece_size, requires = "suite")]
+    piece_size: usize,
     /// Worker threads (default: one per core).
     #[arg(long, requires = "suite")]
     jobs: Option<usize>,
@@ -89,6 +93,7 @@ struct SuiteReport {
     seeds: Vec<u32>,
     jitter: f64,
     passes: u32,
+    piece_size: usize,
     threads: usize,
     dems: Vec<dem::DemResult>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -130,12 +135,13 @@ fn run_in_pool(a: &SuiteArgs, novelty: Option<novelty::Params>, json: bool) -> C
         .into());
     }
     eprintln!(
-        "realism protocol: {} DEMs from {}, seeds {:?}, jitter {}, {} passes, {} threads",
+        "realism protocol: {} DEMs from {}, seeds {:?}, jitter {}, {} passes, {}-px pieces, {} threads",
         chosen.len(),
         dir.display(),
         a.seeds,
         a.jitter,
         a.passes,
+        a.piece_size,
         rayon::current_num_threads()
     );
     let results = chosen
@@ -153,6 +159,7 @@ fn run_in_pool(a: &SuiteArgs, novelty: Option<novelty::Params>, json: bool) -> C
         seeds: a.seeds.clone(),
         jitter: a.jitter,
         passes: a.passes,
+        piece_size: a.piece_size,
         threads: rayon::current_num_threads(),
         dems: results,
         typed,

@@ -11,11 +11,12 @@ fn mark(ok: bool) -> &'static str {
 
 pub(super) fn print_report(r: &SuiteReport) {
     println!(
-        "realism protocol: {} DEMs, seeds {:?}, jitter {}, {} passes; medians over seeds",
+        "realism protocol: {} DEMs, seeds {:?}, jitter {}, {} passes, {}-px pieces; medians over seeds",
         r.dems.len(),
         r.seeds,
         r.jitter,
-        r.passes
+        r.passes,
+        r.piece_size
     );
     println!(
         "{:<26} {:>9} {:>7} {:>6} {:>5}  {:>20}  {:>7}  {:>22}  {:>15} {:>7}  targets",

@@ -72,6 +72,7 @@ pub(super) fn run_typed(
     let params = Params {
         jitter: a.jitter,
         passes: a.passes,
+        piece_size: a.piece_size,
         keep_levels: true,
         ..Params::default()
     };

@@ -1,0 +1,105 @@
+//! The pieces of the coarse start: where they lie, what they copy.
+
+use super::Source;
+use crate::database::layout::MARGIN;
+use crate::hash::{below, hash4};
+use crate::synth::cone::Rect;
+use crate::synth::fixed::{Coord, FRAC_BITS};
+use crate::synth::stages::upsample_jitter;
+use crate::synth::state::State;
+use rayon::prelude::*;
+
+/// Hash salt of the draw within a piece's band (kept apart from the
+/// jitter's `hash4(seed, level, x, y)`, whose level is always < 2^16).
+const SALT: u32 = 0xC0A5_0000;
+
+/// The share of the pool a piece draws from: the ranks within ±1 % of the
+/// guide's quantile.
+///
+/// Why a band and not the exact quantile: neighbouring pieces with nearly
+/// the same guide rank would copy neighbouring texels of the same place;
+/// 2 % of the pool is a few hundred texels of a shared DEM at level 3,
+/// spread over its regions at that altitude.
+const BAND_PER_MILLE: u32 = 20;
+
+/// Level L of an output over `region` (absolute level-L pixels: the whole
+/// level, or a window's cone): the level is cut into square pieces of
+/// `side` texels on a grid anchored at the world's origin; piece (i, j)
+/// copies the exemplar around one texel of the pool — drawn by a hash of
+/// the seed and (i, j) from the pool's ranks around the guide's rank at
+/// the piece's centre — mirrored at the interior's edges; each pixel gets
+/// the level's jitter (`jitter`, fixed point, the same hash as
+/// `upsample_jitter`) and offset V = 0 (its own altitude).
+///
+/// A piece depends on the seed and its position alone, so any window of a
+/// world starts from the same pieces.
+pub fn pieces(
+    src: Source<'_>,
+    region: Rect,
+    (l, side): (usize, i32),
+    seed: u32,
+    jitter: i32,
+) -> State {
+    let (w, h) = (region.width(), region.height());
+    // The pieces the region touches, and the texel each is centred on.
+    let piece = |v: usize| (v as i32).div_euclid(side);
+    let (i0, j0) = (piece(region.x0), piece(region.y0));
+    let (ni, nj) = (
+        (piece(region.x1 - 1) - i0 + 1) as usize,
+        (piece(region.y1 - 1) - j0 + 1) as usize,
+    );
+    let n = src.pool.len();
+    let band = ((u64::from(n) * u64::from(BAND_PER_MILLE) / 1000) as u32).clamp(1, n);
+    let centre_px = |i: i32| (i * side * 2 + side) << l >> 1;
+    let centres: Vec<(i32, i32)> = (0..ni * nj)
+        .into_par_iter()
+        .map(|k| {
+            let (i, j) = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
+            let u = src.guide.rank(seed, centre_px(i), centre_px(j));
+            let target = ((u64::from(u) * u64::from(n - 1)) >> 16) as u32;
+            let lo = target.saturating_sub(band / 2).min(n - band);
+            src.pool
+                .at(lo + below(hash4(seed, SALT, i as u32, j as u32), band))
+        })
+        .collect();
+    let st = State::new(w, h);
+    (0..h).into_par_iter().for_each(|r| {
+        let y = (region.y0 + r) as i32;
+        let j = y.div_euclid(side);
+        for c in 0..w {
+            let x = (region.x0 + c) as i32;
+            let i = x.div_euclid(side);
+            let (cx, cy) = centres[(j - j0) as usize * ni + (i - i0) as usize];
+            let col = src.atlas.columns[cx as usize];
+            let (x0, y0) = (col.min_x, MARGIN as i32);
+            let (nx, ny) = (col.max_x - x0 + 1, col.max_y - y0 + 1);
+            let tx = x0 + mirror(cx - x0 + x - i * side - side / 2, nx);
+            let ty = y0 + mirror(cy - y0 + y - j * side - side / 2, ny);
+            let (jx, jy) = upsample_jitter::jitter(seed, l as u32, x as u32, y as u32, jitter);
+            let s = Coord {
+                x: inside((tx << FRAC_BITS) + jx, x0, nx),
+                y: inside((ty << FRAC_BITS) + jy, y0, ny),
+            };
+            st.set(r * w + c, s, 0);
+        }
+    });
+    st
+}
+
+/// Texel `t` of an axis of `n` interior texels, mirrored at both ends
+/// (…, 1, 0 | 0, 1, …, n − 1 | n − 1, n − 2, …).
+fn mirror(t: i32, n: i32) -> i32 {
+    let r = t.rem_euclid(2 * n);
+    if r < n { r } else { 2 * n - 1 - r }
+}
+
+/// Fixed-point `v` clamped to `[min − ½, min + n − ½)` texels, so that it
+/// rounds (half up) to one of the `n` interior texels from `min` (jitter may
+/// carry a mirrored edge texel half a texel out).
+fn inside(v: i32, min: i32, n: i32) -> i32 {
+    let half = 1 << (FRAC_BITS - 1);
+    v.clamp(
+        (min << FRAC_BITS) - half,
+        ((min + n) << FRAC_BITS) - half - 1,
+    )
+}
