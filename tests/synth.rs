@@ -34,12 +34,7 @@ fn start(
     (seed, jitter): (u32, i32),
 ) -> State {
     let pool = coarse::Pool::new(atlas, from);
-    let guide = coarse::Guide::new();
-    let src = coarse::Source {
-        atlas,
-        pool: &pool,
-        guide: &guide,
-    };
+    let src = coarse::Source { atlas, pool: &pool };
     coarse::pieces(src, region, (l, side), seed, jitter)
 }
 

@@ -66,10 +66,9 @@ pub struct Synthesizer<'db> {
     params: Params,
     atlas: Vec<AtlasLevel<'db>>,
     jitter: i32,
-    /// The coarse start's pool and guide, built by the first synthesis
-    /// that starts from pieces (the pool ranks every interior texel of
-    /// level L).
-    pieces: OnceLock<(coarse::Pool, coarse::Guide)>,
+    /// The coarse start's pool, built by the first synthesis that starts
+    /// from pieces (it ranks every interior texel of level L).
+    pool: OnceLock<coarse::Pool>,
     #[cfg(feature = "gpu")]
     gpu: Option<crate::backend::gpu::Gpu>,
 }
@@ -101,7 +100,7 @@ impl<'db> Synthesizer<'db> {
             params,
             atlas,
             jitter,
-            pieces: OnceLock::new(),
+            pool: OnceLock::new(),
             #[cfg(feature = "gpu")]
             gpu: None,
         })
@@ -346,13 +345,20 @@ impl<'db> Synthesizer<'db> {
         match start {
             Start::Pieces { side } => {
                 let atlas = &self.atlas[l];
-                let (pool, guide) = self.pieces.get_or_init(|| {
-                    (
-                        coarse::Pool::new(atlas, self.params.start_exemplar),
-                        coarse::Guide::new(),
-                    )
-                });
-                let src = coarse::Source { atlas, pool, guide };
+                // Built outside the lock and then set, not in `get_or_init`:
+                // the pool is built by rayon, and a rayon thread blocked on
+                // the lock while another initializes it can starve that
+                // initialization of threads (a deadlock with 2 threads).
+                // Two syntheses starting at once may both build it; the
+                // first kept is the same pool.
+                let pool = match self.pool.get() {
+                    Some(pool) => pool,
+                    None => {
+                        let built = coarse::Pool::new(atlas, self.params.start_exemplar);
+                        self.pool.get_or_init(|| built)
+                    }
+                };
+                let src = coarse::Source { atlas, pool };
                 coarse::pieces(src, region, (l, side), seed, self.jitter)
             }
             Start::Centre => {

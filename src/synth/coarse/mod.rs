@@ -36,7 +36,6 @@ mod guide;
 mod pieces;
 mod pool;
 
-pub use guide::Guide;
 pub use pieces::pieces;
 pub use pool::Pool;
 
@@ -45,13 +44,12 @@ use crate::synth::cone::Rect;
 use crate::synth::fixed::{Coord, FRAC_BITS};
 use crate::synth::state::{State, level_size};
 
-/// What the pieces draw from: the database level L of `atlas`, its
-/// [`Pool`] (of one exemplar or all), and the [`Guide`]'s distribution.
+/// What the pieces draw from: the database level L of `atlas` and its
+/// [`Pool`] (of one exemplar or all).
 #[derive(Clone, Copy)]
 pub struct Source<'a> {
     pub atlas: &'a AtlasLevel<'a>,
     pub pool: &'a Pool,
-    pub guide: &'a Guide,
 }
 
 /// The coarsest level synthesis starts from (and corrects), whatever

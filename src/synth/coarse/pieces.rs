@@ -1,6 +1,6 @@
 //! The pieces of the coarse start: where they lie, what they copy.
 
-use super::Source;
+use super::{Source, guide};
 use crate::database::layout::MARGIN;
 use crate::hash::{below, hash4};
 use crate::synth::cone::Rect;
@@ -51,11 +51,17 @@ pub fn pieces(
     let n = src.pool.len();
     let band = ((u64::from(n) * u64::from(BAND_PER_MILLE) / 1000) as u32).clamp(1, n);
     let centre_px = |i: i32| (i * side * 2 + side) << l >> 1;
-    let centres: Vec<(i32, i32)> = (0..ni * nj)
-        .into_par_iter()
+    let places: Vec<(i32, i32)> = (0..ni * nj)
         .map(|k| {
             let (i, j) = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
-            let u = src.guide.rank(seed, centre_px(i), centre_px(j));
+            (centre_px(i), centre_px(j))
+        })
+        .collect();
+    let centres: Vec<(i32, i32)> = guide::quantiles(seed, &places)
+        .into_par_iter()
+        .enumerate()
+        .map(|(k, u)| {
+            let (i, j) = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
             let target = ((u64::from(u) * u64::from(n - 1)) >> 16) as u32;
             let lo = target.saturating_sub(band / 2).min(n - band);
             src.pool

@@ -94,10 +94,10 @@ pub use crate::stages::correct::nudge::{MAX_TOL, Target};
 
 /// The tolerance slope s (eq. 8) of points: ¼ where the paper has ½.
 ///
-/// Why: since synthesis starts at level 3 (`coarse::MAX_START_LEVEL`),
-/// two fewer levels shape a point's surroundings, and with ½ its site
-/// missed by 2.25 % of relief on average where it had missed by 1.68 %
-/// (12 seeds × 12 points, Pyrenees, 512²); with ¼, 1.73 %. Points keep the
+/// Why: since synthesis starts at level 3 or finer (`coarse::MAX_START_LEVEL`;
+/// 3 when this was measured), fewer levels shape a point's surroundings,
+/// and with ½ its site missed by 2.25 % of relief on average where it had
+/// missed by 1.68 % (12 seeds × 12 points, Pyrenees, 512²); with ¼, 1.73 %. Points keep the
 /// level cap, so a lowered point still opens into a valley, not a pit.
 pub const S: f64 = 0.25;
 /// The tolerance slope of curves, which also act over their whole reach at
