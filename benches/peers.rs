@@ -3,11 +3,11 @@
 //! and for the Rust peer, EmbarkStudios' texture-synthesis (0.8.2, the
 //! library under its 0.8.3 CLI; archived), on the same threads.
 //!
-//! The exemplar is the embedded `alpine` (`data/alpine.png`): terrasynth
-//! synthesizes from a database of it alone (built before timing, as its
-//! databases are built once and reused) and, for reference, from the
-//! embedded default database (three exemplars, what `terrasynth bench`
-//! times); the peer gets the same heights scaled to 8-bit grey (it works on
+//! The exemplar is the embedded `pyrenees_andorra` (`data/`, SRTM
+//! mountains): terrasynth synthesizes from a database of it alone (built
+//! before timing, as its databases are built once and reused) and, for
+//! reference, from the embedded default database (four exemplars, what
+//! `terrasynth bench` times); the peer gets the same heights scaled to 8-bit grey (it works on
 //! colour images) and its default parameters. Each timing covers what the
 //! library does for one output, in process, from exemplar in memory to
 //! output in memory. The peer takes about a minute per 1024² output on two
@@ -111,11 +111,13 @@ fn main() {
         .unwrap_or(3)
         .max(1);
     let threads = rayon::current_num_threads();
-    let alpine = default::inputs().swap_remove(0);
-    assert_eq!(alpine.name, "alpine");
-    let exemplar = grey(&alpine.heights);
-    let one = build(vec![alpine], &BuildOptions::default(), &Silent)
-        .expect("a database of alpine")
+    let pyrenees = default::inputs()
+        .into_iter()
+        .find(|e| e.name == "pyrenees_andorra")
+        .expect("the embedded Pyrenees");
+    let exemplar = grey(&pyrenees.heights);
+    let one = build(vec![pyrenees], &BuildOptions::default(), &Silent)
+        .expect("a database of the Pyrenees")
         .0;
     let all = default::load_or_build(&default::cache_dir(), &Silent)
         .expect("the default database")
@@ -138,7 +140,7 @@ fn main() {
     };
     let mut table = format!(
         "CPU: {cpu}, {threads} threads for each library; load average before: {}\n\n\
-         | output (from a 512² exemplar) | terrasynth, one exemplar | terrasynth, default database (3) | texture-synthesis 0.8.2 | peer ÷ terrasynth |\n\
+         | output (from a 512² exemplar) | terrasynth, one exemplar | terrasynth, default database (4) | texture-synthesis 0.8.2 | peer ÷ terrasynth |\n\
          |---|---|---|---|---|\n",
         load()
     );

@@ -5,11 +5,12 @@
 //! - `upsample_jitter`, `correct` (one subpass), `reconstruct`: the real
 //!   level states of a 1024² synthesis (level 1 → 0, level 0);
 //! - `reduce_types`, `reduce_weights`: the 512² type mask of the embedded
-//!   `alpine` exemplar as a session paints it (R⁰, and W⁰ from its
-//!   regions), reduced one level;
+//!   `catalan_coast_hills` exemplar (the one with all four types) as a
+//!   session paints it (R⁰, and W⁰ from its regions), reduced one level;
 //! - `shade`: the preview of the 1024² synthesis;
-//! - `fill_ssd`: every fill candidate of the `alpine` exemplar as a patch
-//!   source, under every transform, against a half-filled window of it.
+//! - `fill_ssd`: every fill candidate of the `pyrenees_andorra` exemplar
+//!   (mountains, as sketches ask for) as a patch source, under every
+//!   transform, against a half-filled window of it.
 //!
 //! Variants as in `tests/stage_<x>.rs`: `scalar` (the oracle, where the
 //! CPU has a SIMD path), `simd` or `cpu`, and with `--features gpu` and an
@@ -80,7 +81,7 @@ fn inputs() -> Inputs {
     let preview = render::prepare(&out.heightfield, &RenderOptions::default()).unwrap();
 
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data");
-    let mask = TypeMask::read(&data.join("alpine_types.png")).unwrap();
+    let mask = TypeMask::read(&data.join("catalan_coast_hills_types.png")).unwrap();
     let last = mask.indices.iter().filter(|&&t| t != UNCONSTRAINED).max();
     let full = (1u32 << last.map_or(1, |&t| t as u32 + 1)) - 1;
     let types = mask
@@ -104,9 +105,9 @@ fn inputs() -> Inputs {
         })
         .collect();
 
-    let hf = terrasynth::io::read(&data.join("alpine.png"), &Default::default()).unwrap();
+    let hf = terrasynth::io::read(&data.join("pyrenees_andorra.png"), &Default::default()).unwrap();
     let patch = terrasynth::patch::Params::default();
-    let src = PreparedSource::prepare("alpine", &hf, &patch, 1.0).unwrap();
+    let src = PreparedSource::prepare("pyrenees_andorra", &hf, &patch, 1.0).unwrap();
     let m = patch.patch / COARSE;
     let mut cells: Vec<i32> = (0..m * m)
         .map(|i| src.coarse[(20 + i / m) * src.coarse_w + 30 + i % m])

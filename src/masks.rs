@@ -14,7 +14,9 @@
 //!   `value = round(255 × ln(cells) / ln(all cells))`, so a single cell is
 //!   0 and a river draining the whole grid 255;
 //! - **types**: [`crate::procedural::types::TypeMask::classify`] (ridge,
-//!   slope, valley floor, plateau, cliff), the same masks the database uses;
+//!   slope, valley floor, plateau, cliff), the local classes of the
+//!   procedural styles' masks (the embedded database's masks are regional
+//!   — sea, flat, hills, mountains — and come with its DEMs);
 //! - **splat** (RGBA, weights summing to 255): R grass on gentle ground,
 //!   G rock on slopes above 30° (fully at 45°), B snow on the top 15 % of
 //!   the relief where not rock, A wet ground where flow accumulation is in

@@ -126,8 +126,8 @@ fn edit(dir: &Path, backend: &str) -> (Output, Option<Vec<u8>>) {
     let out_dir = dir.join(backend);
     let out = terrasynth(&[
         "edit",
-        scenes.join("canyonlands.json").to_str().unwrap(),
-        scenes.join("canyonlands_edit1.json").to_str().unwrap(),
+        scenes.join("coast_range.json").to_str().unwrap(),
+        scenes.join("coast_range_edit1.json").to_str().unwrap(),
         "--out-dir",
         out_dir.to_str().unwrap(),
         "--ext",

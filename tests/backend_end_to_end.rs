@@ -87,7 +87,7 @@ fn scene_session_matches_end_to_end() {
     let Some(ctx) = ctx() else { return };
     let db = default_db();
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/scenes");
-    let scenes: Vec<Scene> = ["canyonlands.json", "canyonlands_edit1.json"]
+    let scenes: Vec<Scene> = ["coast_range.json", "coast_range_edit1.json"]
         .iter()
         .map(|f| Scene::read(&dir.join(f)).unwrap())
         .collect();

@@ -99,7 +99,7 @@ fn convert_fills_nodata_on_request() {
 fn synth_never_overwrites_its_scene_and_checks_memory_first() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("x.json");
-    let text = std::fs::read(repo("data/scenes/canyonlands.json")).unwrap();
+    let text = std::fs::read(repo("data/scenes/coast_range.json")).unwrap();
     std::fs::write(&scene, &text).unwrap();
     let png = dir.path().join("x.png");
     let out = terrasynth(&[
@@ -215,7 +215,7 @@ fn a_closed_stdout_ends_a_command_without_a_panic() {
     let (reader, writer) = std::io::pipe().unwrap();
     drop(reader);
     let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
-        .args(["info", repo("data/hills.png").to_str().unwrap()])
+        .args(["info", repo("data/thuringia_hills.png").to_str().unwrap()])
         .stdout(writer)
         .stderr(std::process::Stdio::piped())
         .output()

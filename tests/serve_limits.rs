@@ -211,7 +211,7 @@ fn mangled() -> impl Strategy<Value = Vec<u8>> {
         "points": [{"id": "p", "at": [20, 20], "height_m": 900, "slope_deg": 10, "radius_px": 6}],
         "curves": [{"points": [[5, 40], [30, 45], [60, 40]], "smoothing": 2,
                     "widgets": [{"at": 0.5, "height_m": 700, "slope_deg": [20, 20], "reach_px": [8, 8]}]}],
-        "types": {"strokes": [{"type": "ridge", "points": [[10, 10], [20, 12]], "radius_px": 4}]},
+        "types": {"strokes": [{"type": "hills", "points": [[10, 10], [20, 12]], "radius_px": 4}]},
         "freeze": {"strokes": [{"points": [[50, 10]], "radius_px": 3}]},
     });
     let paths = [

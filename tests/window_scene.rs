@@ -39,8 +39,8 @@ fn everything() -> serde_json::Value {
                 {"at": 0.0, "height_m": 1800, "slope_deg": [-20, -20], "reach_px": [25, 25]},
                 {"at": 1.0, "height_m": 1500, "slope_deg": [-10, -30], "reach_px": [15, 30]}]}],
         "types": {"strokes": [
-            {"type": "plateau", "points": [[200, 40], [300, 60]], "radius_px": 25},
-            {"type": "valley floor", "points": [[40, 220]], "radius_px": 30},
+            {"type": "mountains", "points": [[200, 40], [300, 60]], "radius_px": 25},
+            {"type": "flat", "points": [[40, 220]], "radius_px": 30},
             {"erase": true, "points": [[260, 50]], "radius_px": 8}]},
         "freeze": {"strokes": [{"points": [[150, 30], [170, 90]], "radius_px": 12}]},
         "pastes": [
@@ -93,7 +93,7 @@ fn windows_of_a_scene_with_every_control_are_its_crops() {
             Rect::new(270, 205, 50, 51),
             // The exemplar paste, a point and types.
             Rect::new(60, 170, 90, 70),
-            // The freeze stroke and the plateau paint, straddling a tile
+            // The freeze stroke and the mountains paint, straddling a tile
             // border of 128.
             Rect::new(120, 20, 97, 81),
             // Everything.

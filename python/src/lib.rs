@@ -52,8 +52,8 @@ struct PyDatabase {
 
 #[pymethods]
 impl PyDatabase {
-    /// The database of the embedded exemplars (alpine, canyon, hills):
-    /// loaded from the cache (``$TERRASYNTH_CACHE_DIR``, else
+    /// The database of the embedded exemplars (four real SRTM DEMs: a
+    /// coast, a plain, mountains, hills): loaded from the cache (``$TERRASYNTH_CACHE_DIR``, else
     /// ``~/.cache/terrasynth``) or built there on first use (a few
     /// seconds), exactly as the ``terrasynth`` CLI does without ``--db``.
     #[staticmethod]

@@ -1,6 +1,11 @@
-//! The embedded default database: the exemplars in `data/` (made by the
-//! crate's own generator, `terrasynth generate`) are compiled into the
-//! binary, so `terrasynth synth` works on a fresh machine with no files.
+//! The embedded default database: four 512² crops of real SRTM DEMs in
+//! `data/` (a coast, a plain, high mountains, rolling hills; sources and
+//! credits in `data/CREDITS.md`) with their type masks (sea, flat, hills,
+//! mountains), compiled into the binary so that `terrasynth synth` works on
+//! a fresh machine with no files. They are real terrain rather than the
+//! crate's own procedural styles (`terrasynth generate`) because the first
+//! command a user runs should make terrain out of real terrain, and the
+//! types the editor paints should be real landscape kinds.
 //!
 //! Analysing them takes seconds, so the database is built on first use and
 //! cached in the user's cache directory under a name that hashes the
@@ -49,7 +54,15 @@ macro_rules! embed {
     };
 }
 
-const EMBEDDED: [Embedded; 3] = [embed!("alpine"), embed!("canyon"), embed!("hills")];
+/// In alphabetical order, which puts the coast first: the database numbers
+/// types by first appearance, so the editor's palette reads sea, flat,
+/// hills, mountains (the masks' own indices).
+const EMBEDDED: [Embedded; 4] = [
+    embed!("catalan_coast_hills"),
+    embed!("north_german_plain"),
+    embed!("pyrenees_andorra"),
+    embed!("thuringia_hills"),
+];
 
 /// Names of the embedded exemplars, in database order.
 pub fn names() -> Vec<&'static str> {
@@ -124,12 +137,24 @@ mod tests {
     #[test]
     fn embedded_exemplars_decode_with_types() {
         let inputs = inputs();
-        assert_eq!(inputs.len(), 3);
+        assert_eq!(
+            names(),
+            [
+                "catalan_coast_hills",
+                "north_german_plain",
+                "pyrenees_andorra",
+                "thuringia_hills"
+            ]
+        );
         for e in &inputs {
             let m = e.types.as_ref().unwrap();
             assert_eq!((m.width, m.height), (e.heights.width(), e.heights.height()));
-            assert!(!m.names.is_empty(), "{}: named types", e.name);
+            assert_eq!((m.width, m.height), (512, 512), "{}", e.name);
+            let named: Vec<&str> = (0..4).map(|i| m.names[&i].as_str()).collect();
+            assert_eq!(named, ["sea", "flat", "hills", "mountains"], "{}", e.name);
             assert_eq!(e.heights.nodata_count(), 0);
+            // SRTM3 resampled to square cells of about 3 arc-seconds.
+            assert!((92.0..93.0).contains(&e.heights.cell_size()), "{}", e.name);
         }
     }
 
@@ -140,6 +165,7 @@ mod tests {
         let silent = &crate::progress::Silent;
         let (a, built) = load_or_build(&dir, silent).unwrap();
         assert!(built && cache_path(&dir).exists());
+        assert_eq!(a.type_names(), ["sea", "flat", "hills", "mountains"]);
         let (b, built) = load_or_build(&dir, silent).unwrap();
         assert!(!built);
         assert!(a.file_bytes() == b.file_bytes());

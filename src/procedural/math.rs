@@ -4,7 +4,7 @@
 //! from them is reproducible across CPUs, compilers and thread counts (Rust
 //! never contracts `a * b + c` into a fused multiply-add on its own). libm's
 //! transcendentals (`powf`, `exp`, `sin`…) carry no such guarantee, so the
-//! generators that feed the committed exemplars in `data/` use these helpers
+//! generators whose output is pinned by golden hashes use these helpers
 //! instead.
 
 /// `x^e` for `x > 0` and `e >= 0`, from multiplications and square roots only.

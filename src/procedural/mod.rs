@@ -1,5 +1,5 @@
-//! The procedural toolbox (seed 002 ch. 4–5 and §7.3) and the default
-//! exemplar styles made with it.
+//! The procedural toolbox (seed 002 ch. 4–5 and §7.3) and the terrain
+//! styles of `terrasynth generate` made with it.
 //!
 //! Building blocks, each usable on its own:
 //! - [`noise`]: gradient noise from a stateless integer hash;
@@ -10,7 +10,7 @@
 //! - [`mod@creep`]: linear hillslope diffusion;
 //! - [`types`]: terrain-type masks derived from a heightfield.
 //!
-//! [`styles`] combines them into the embedded default exemplars in `data/`.
+//! [`styles`] combines them into evolved landscapes (alpine, canyon, hills).
 //!
 //! Everything here is deterministic: the same parameters give the same bits
 //! on every machine and at every thread count. Only `+ − × ÷` and `sqrt` are

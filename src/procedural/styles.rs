@@ -1,5 +1,6 @@
-//! The default exemplar styles: eroded alpine ridges, canyons and mesas,
-//! rolling hills — the embedded exemplars in `data/`.
+//! The procedural styles of `terrasynth generate`: eroded alpine ridges,
+//! canyons and mesas, rolling hills (`tests/procedural.rs` pins their
+//! output at the defaults by golden hashes).
 //!
 //! Noise alone does not look like terrain: real landscapes are organised by
 //! their drainage, every valley leading into a larger one. So each style is
@@ -15,7 +16,7 @@
 //! Sizes are in cells of [`CELL_SIZE_M`] metres; a larger `size` shows more
 //! of the same landscape (feature sizes are fixed in metres). Everything is
 //! deterministic (see the module [`super`]), so `generate` recreates the
-//! committed files byte for byte.
+//! same files byte for byte.
 
 use super::error::ProceduralError;
 use super::fbm::{Fractal, Shape};
@@ -34,14 +35,14 @@ use std::collections::BTreeMap;
 
 /// Cell size of the generated terrain, in metres (a typical DEM posting).
 pub const CELL_SIZE_M: f64 = 30.0;
-/// Side of the committed exemplars in `data/`.
+/// Side `generate` makes by default (the golden hashes' size).
 pub const DEFAULT_SIZE: usize = 512;
-/// Seed of the committed exemplars.
+/// Seed `generate` uses by default (the golden hashes' seed).
 pub const DEFAULT_SEED: u32 = 2015;
 /// Smallest accepted side (the coarsest level of the hills is 1/16 of it).
 pub const MIN_SIZE: usize = 32;
 
-/// A default exemplar style.
+/// A procedural terrain style.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Style {
     Alpine,
@@ -52,7 +53,7 @@ pub enum Style {
 impl Style {
     pub const ALL: [Style; 3] = [Style::Alpine, Style::Canyon, Style::Hills];
 
-    /// The name used on the command line and for the files in `data/`.
+    /// The name used on the command line and in `data/styles.json`.
     pub fn name(self) -> &'static str {
         match self {
             Style::Alpine => "alpine",

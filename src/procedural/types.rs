@@ -15,7 +15,8 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The terrain types of the default exemplars; the discriminant is the pixel value.
+/// The terrain types of the procedural styles' masks; the discriminant is
+/// the pixel value.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum TerrainType {

@@ -107,10 +107,10 @@ def test_eval_reports_the_realism_ratio(db):
 
 
 def test_scene_window_is_the_crop_of_the_scene(root):
-    scene = root / "data" / "scenes" / "canyonlands.json"
+    scene = root / "data" / "scenes" / "coast_range.json"
     whole = terrasynth.synthesize_scene(scene)
     assert whole.shape == (512, 512)
-    x, y, w, h = 150, 290, 97, 75  # across the canyon curve
+    x, y, w, h = 200, 280, 97, 75  # across the river curve
     win = terrasynth.synthesize_scene(scene, (x, y, w, h))
     assert win.tobytes() == whole[y : y + h, x : x + w].tobytes()
 
@@ -128,7 +128,7 @@ def test_scene_matches_the_cli(root, tmp_path):
         if os.environ.get("TERRASYNTH_REQUIRE_CLI"):
             pytest.fail("TERRASYNTH_REQUIRE_CLI is set but no terrasynth CLI was found")
         pytest.skip("no terrasynth CLI built (cargo build --release)")
-    scene = root / "data" / "scenes" / "canyonlands.json"
+    scene = root / "data" / "scenes" / "coast_range.json"
     out = tmp_path / "cli.exr"
     subprocess.run([str(cli), "synth", "--scene", str(scene), "-o", str(out)], check=True, capture_output=True)
     ref, _, _ = terrasynth.read_heightfield(out)
@@ -163,5 +163,6 @@ def test_errors_are_python_exceptions(db, tmp_path):
 
 
 def test_database_describes_itself(db, root):
-    assert db.path is None and len(db.exemplars) == 3 and db.levels >= 2
+    assert db.path is None and len(db.exemplars) == 4 and db.levels >= 2
+    assert db.type_names == ["sea", "flat", "hills", "mountains"]
     assert db.cell_size() > 0 and "Database(default" in repr(db)

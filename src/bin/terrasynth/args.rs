@@ -114,7 +114,7 @@ pub fn load_database(
             let dir = default::cache_dir();
             if !default::cache_path(&dir).exists() {
                 eprintln!(
-                    "building the default database from the embedded exemplars ({}); cached in {}",
+                    "building the default database from the embedded SRTM DEMs ({}); cached in {}",
                     default::names().join(", "),
                     dir.display()
                 );

@@ -1,5 +1,5 @@
-//! `terrasynth generate`: a procedural terrain in one of the default
-//! exemplar styles, with its terrain-type mask.
+//! `terrasynth generate`: a procedural terrain in one of the built-in
+//! styles, with its terrain-type mask.
 
 use crate::CliResult;
 use crate::progress::Bar;
@@ -10,7 +10,7 @@ use terrasynth::procedural::styles::{DEFAULT_SEED, DEFAULT_SIZE};
 
 #[derive(clap::Args)]
 #[command(
-    after_help = "Besides OUT, writes the terrain-type mask OUT_types.png (8-bit, one type index per pixel) and OUT_types.json (the type names).\nThe defaults (--size 512, --seed 2015) recreate the exemplars in data/ byte for byte."
+    after_help = "Besides OUT, writes the terrain-type mask OUT_types.png (8-bit, one type index per pixel) and OUT_types.json (the type names).\nThe same style, size and seed give the same bytes on every machine and thread count.\nThe embedded default database is real terrain (SRTM DEMs, see data/CREDITS.md), not these styles; build a database of generated terrain with `terrasynth db build`."
 )]
 pub struct Args {
     /// Terrain style (see --list).
