@@ -221,7 +221,17 @@ impl Target {
                 }
                 let mut spectrum = vec![Complex64::default(); side * side];
                 plan.forward_transposed(&mut grid, og.h, &mut spectrum);
-                let ssd = window_ssd(&og, n, mean);
+                let mut ssd = window_ssd(&og, n, mean);
+                // A window whose spread is below FLAT_SSD of the mean
+                // window's is flat: its prefix-sum SSD is rounding residue,
+                // and the correlation's rounding divided by it gave best
+                // NCCs above 1 (a 3×-side coast: median 1.12).
+                let floor = FLAT_SSD * ssd.iter().sum::<f64>() / ssd.len() as f64;
+                for v in &mut ssd {
+                    if *v <= floor {
+                        *v = 0.0;
+                    }
+                }
                 let inv_sd = ssd
                     .iter()
                     .map(|&v| if v > 0.0 { 1.0 / v.sqrt() } else { 0.0 })
@@ -344,6 +354,12 @@ impl Target {
     }
 }
 
+/// Share of the target's mean window SSD under which a window counts as
+/// flat (NCC 0): far above the prefix sums' rounding (about 1e-16 of the
+/// image's Σe²), far below any relief (a window of 1 024 cells at 3 mm
+/// std against one of 100 m).
+const FLAT_SSD: f64 = 1e-9;
+
 /// `Σ(e − ē)²` of every `n × n` window of `g` (values less `shift`), per
 /// valid position, row-major: `Σe² − (Σe)²/n²` from prefix sums.
 fn window_ssd(g: &Grid, n: usize, shift: f64) -> Vec<f64> {
@@ -429,6 +445,33 @@ mod tests {
         seen.sort_by(|a, b| a.partial_cmp(b).unwrap());
         seen.dedup();
         assert_eq!(seen.len(), 8, "eight distinct orientations");
+    }
+
+    #[test]
+    fn flat_parts_of_a_large_target_match_nothing() {
+        // A large target, half of it flat far from the mean (a sea beside
+        // land, with quantisation noise): its flat windows must score 0,
+        // not rounding over rounding.
+        let (w, h, n) = (700, 700, 32);
+        let rough = grid(w, h, 5);
+        let v = (0..w * h)
+            .map(|i| {
+                if i % w < w / 2 {
+                    // Quantisation-sized noise (a millimetre).
+                    -500.0 + rough.v[i] * 1e-5
+                } else {
+                    rough.v[i] * 30.0 + 900.0
+                }
+            })
+            .collect();
+        let g = Grid { w, h, v };
+        let target = Target::new(&g, n);
+        let templates: Vec<Vec<f64>> = (0..6)
+            .map(|k| g.window(w / 2 + 40 * k, 20 + 90 * k, n))
+            .collect();
+        for b in target.best(&templates, &|_, _| None).into_iter().flatten() {
+            assert!(b.ncc <= 1.0 + 1e-9, "NCC {} at ({}, {})", b.ncc, b.x, b.y);
+        }
     }
 
     #[test]
