@@ -282,8 +282,8 @@ fn coordinates_maps_are_exact_and_round_trip() {
                 let c = l0.coords[y * l0.width + x];
                 let s = map.sources[y * w + x];
                 let (tx, ty) = (
-                    terrasynth::synth::fixed::round(c.x),
-                    terrasynth::synth::fixed::round(c.y),
+                    terrasynth::level::fixed::round(c.x),
+                    terrasynth::level::fixed::round(c.y),
                 );
                 assert_eq!(
                     (s.exemplar, s.x as i32, s.y as i32),

@@ -7,12 +7,12 @@ use proptest::prelude::*;
 use std::sync::OnceLock;
 use terrasynth::database::layout::MARGIN;
 use terrasynth::database::{Database, default};
+use terrasynth::level::atlas::AtlasLevel;
+use terrasynth::level::fixed::{FRAC_BITS, round};
+use terrasynth::level::state::State;
 use terrasynth::progress::Silent;
 use terrasynth::stages::correct::scalar::texel_height;
-use terrasynth::synth::atlas::AtlasLevel;
 use terrasynth::synth::cone::Rect;
-use terrasynth::synth::fixed::{FRAC_BITS, round};
-use terrasynth::synth::state::State;
 use terrasynth::synth::{Params, Synthesizer, coarse};
 
 fn db() -> &'static Database {
@@ -45,7 +45,7 @@ fn start_level() -> (usize, AtlasLevel<'static>) {
 }
 
 /// Mode-1 height of the atlas texel a coordinate rounds to.
-fn height_at(atlas: &AtlasLevel<'_>, s: terrasynth::synth::fixed::Coord) -> i32 {
+fn height_at(atlas: &AtlasLevel<'_>, s: terrasynth::level::fixed::Coord) -> i32 {
     texel_height(atlas.appearance(round(s.x), round(s.y)))
 }
 

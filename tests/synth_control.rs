@@ -182,7 +182,7 @@ fn painted_types_take_their_coordinates_from_that_type() {
     let share = |s: &Session<'_>| {
         let f = s.frames().unwrap();
         let lvl = db.level(2);
-        let atlas = terrasynth::synth::atlas::AtlasLevel::new(db, 2);
+        let atlas = terrasynth::level::atlas::AtlasLevel::new(db, 2);
         let last = f.levels()[2].last().unwrap();
         let w = N / 4;
         let (mut inside, mut ok) = (0, 0);
