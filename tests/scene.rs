@@ -5,6 +5,7 @@
 use serde_json::{Value, json};
 use std::path::Path;
 use terrasynth::scene::{Freeze, PasteSource, Scene, SceneErrorKind, TypePaint};
+use terrasynth::synth::control::Lift;
 
 fn base() -> Value {
     json!({
@@ -46,6 +47,19 @@ fn a_valid_scene_parses_to_what_it_says() {
     assert!(matches!(&s.freeze, Some(Freeze::Strokes(v)) if v.len() == 1));
     assert_eq!(s.pastes[0].source, PasteSource::Exemplar(1));
     assert_eq!(s.pastes[0].delta_m, -50.0);
+    // Version 1 had only the source's own heights.
+    assert_eq!(s.pastes[0].lift, Lift::Source);
+    // Version 2 lands pastes on the ground unless one says otherwise.
+    let mut v = base();
+    v["version"] = json!(2);
+    let mut second = v["pastes"][0].clone();
+    second["lift"] = json!("source");
+    v["pastes"].as_array_mut().unwrap().push(second);
+    let s2 = parse(&v).unwrap();
+    assert_eq!(
+        (s2.pastes[0].lift, s2.pastes[1].lift),
+        (Lift::Ground, Lift::Source)
+    );
     // Paths are relative to the scene file.
     let mut v = base();
     v["database"] = json!("db/ex.tsdb");
@@ -158,7 +172,12 @@ fn out_of_range_values_name_path_and_range() {
             "0..=4 texels",
         ),
         (Box::new(|v| v["passes"] = json!(17)), "passes", "0..=16"),
-        (Box::new(|v| v["version"] = json!(2)), "version", "1"),
+        (Box::new(|v| v["version"] = json!(3)), "version", "1 or 2"),
+        (
+            Box::new(|v| v["pastes"][0]["lift"] = json!("sky")),
+            "pastes[0].lift",
+            "\"ground\" or \"source\"",
+        ),
         (
             Box::new(|v| v["freeze"]["strokes"][0]["radius_px"] = json!(-2)),
             "freeze.strokes[0].radius_px",

@@ -10,7 +10,8 @@ use terrasynth::heightfield::Heightfield;
 use terrasynth::progress::Silent;
 use terrasynth::synth::Params;
 use terrasynth::synth::control::{
-    Constraint, ConstraintId, PASTE_FEATHER, Paste, PasteSource, PointConstraint, UNCONSTRAINED,
+    Constraint, ConstraintId, Lift, PASTE_FEATHER, Paste, PasteSource, PointConstraint,
+    UNCONSTRAINED,
 };
 use terrasynth::synth::session::{Edit, Session};
 
@@ -329,6 +330,7 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
             lasso: vec![(20.0, 150.0), (60.0, 150.0), (40.0, 190.0)],
             offset: (110, -30),
             delta_m: 80.0,
+            lift: Lift::Source,
         })],
         vec![Edit::Freeze(Some(
             (0..N * N).map(|k| (k % N) < 40 && (k / N) < 40).collect(),
@@ -379,6 +381,7 @@ fn an_exemplar_paste_copies_the_exemplar_pixels() {
             lasso: lasso.clone(),
             offset: (ox, oy),
             delta_m: 0.0,
+            lift: Lift::Source,
         })])
         .unwrap()
         .heightfield;
@@ -416,6 +419,7 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
             lasso: lasso.clone(),
             offset: (ox, oy),
             delta_m: delta,
+            lift: Lift::Source,
         })])
         .unwrap()
         .heightfield;

@@ -104,6 +104,28 @@ fn windows_of_a_scene_with_every_control_are_its_crops() {
     );
 }
 
+/// Version 2: the same pastes land on the ground, each lifted by the
+/// median step along its whole rim — a window that sees part of a target
+/// must find the same lift as the whole scene.
+#[test]
+fn windows_of_a_scene_with_ground_pastes_are_its_crops() {
+    let mut v = everything();
+    v["version"] = json!(2);
+    check(
+        &scene(v),
+        &[
+            // Part of the first paste's target, and the third's source.
+            Rect::new(245, 100, 40, 40),
+            // A corner of the third paste's target.
+            Rect::new(300, 240, 20, 16),
+            // Part of the exemplar paste.
+            Rect::new(60, 170, 50, 40),
+            // Everything.
+            Rect::new(0, 0, 320, 256),
+        ],
+    );
+}
+
 #[test]
 fn scenes_without_pastes_take_one_frame() {
     let mut v = everything();

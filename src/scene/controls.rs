@@ -342,6 +342,7 @@ impl SceneEdits {
             lasso: p.lasso.iter().map(|q| (q.x, q.y)).collect(),
             offset: (offset.x.round() as i64, offset.y.round() as i64),
             delta_m: p.delta_m,
+            lift: p.lift,
         })
     }
 }

@@ -2,7 +2,7 @@
 //! and seed, and every user control (paper §3, §5): point and curve
 //! constraints, junction heights, painted types, frozen regions and pastes.
 //!
-//! # Format (version 1)
+//! # Format (version 2)
 //!
 //! Positions are output pixels `[x, y]` (x right, y down; pixel (i, j)
 //! covers `[i, i+1) × [j, j+1)`), inside `[0, width] × [0, height]` unless
@@ -12,7 +12,7 @@
 //!
 //! ```json
 //! {
-//!   "version": 1,                       // optional; only 1 exists
+//!   "version": 2,                       // optional, 1 or 2 (absent = 1); 2 changed only the default of a paste's "lift"
 //!   "database": "exemplars.tsdb",       // optional: path (relative to the scene file); absent or null = the embedded database
 //!   "size": [1024, 1024],               // width, height: 1..=65535 each
 //!   "seed": 7,                          // 0..=4294967295
@@ -50,7 +50,11 @@
 //!     "exemplar": 2,                    // with "exemplar": its index in the database
 //!     "lasso": [[10, 10], [80, 12], [60, 90]],  // >= 3 points: the region, in source pixels
 //!     "to": [700, 300],                 // where the lasso's centroid goes, output pixels
-//!     "delta_m": 0                      // optional, -20000..=20000: height offset δ (rising over 16 px inside the lasso)
+//!     "delta_m": 0,                     // optional, -20000..=20000: height offset δ, metres
+//!     "lift": "ground"                  // optional: "ground" (default in version 2) lifts the paste so that it meets the
+//!                                       // terrain along its lasso (the median step there is 0), then by δ, exactly to the
+//!                                       // lasso; "source" (default in version 1) keeps the source's own heights, δ rising
+//!                                       // over 16 px inside the lasso (synth::control::Lift)
 //!   }]
 //! }
 //! ```
@@ -78,6 +82,7 @@ pub use error::{SceneError, SceneErrorKind};
 pub use raster::stroke_mask;
 pub use window::WindowedScene;
 
+use crate::synth::control::Lift;
 use crate::synth::control::curve::{CurveSpec, JunctionHeight};
 use glam::DVec2;
 use std::path::{Path, PathBuf};
@@ -171,6 +176,8 @@ pub struct PasteSpec {
     /// Where the lasso's centroid is pasted, output pixels.
     pub to: DVec2,
     pub delta_m: f64,
+    /// What δ is added to (version 2's default: the ground).
+    pub lift: Lift,
 }
 
 impl Scene {

@@ -93,7 +93,7 @@ fn same_path(a: Option<&Path>, b: Option<&Path>) -> bool {
 /// A document with no controls.
 pub fn blank(width: usize, height: usize, seed: u32, database: Option<&Value>) -> Value {
     let mut doc = json!({
-        "version": 1,
+        "version": 2,
         "size": [width, height],
         "seed": seed,
         "points": [],

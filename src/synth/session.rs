@@ -10,12 +10,14 @@
 //! [`crate::synth::Guides::restrict`]).
 
 use super::control::{
-    Blend, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED, inside,
+    Blend, ConstraintId, Controls, FIRST_LEVEL, Lift, Paste, PasteSource, UNCONSTRAINED, inside,
+    lift,
 };
 use super::window::row_bounds;
 use super::{Frames, Guides, Params, SynthError, Synthesizer, union};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
+use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::{level_size, top_level};
 use crate::stages::correct::{W_COHERENT, W_FREE, W_FROZEN};
@@ -363,7 +365,7 @@ impl Session<'_> {
         let frames = self.frames.as_mut().expect("a frame exists before a paste");
         // The kept final states no longer match the results written here.
         frames.states.clear();
-        let delta = (p.delta_m / db.quantization().scale_m).round() as i32;
+        let mut delta = (p.delta_m / db.quantization().scale_m).round() as i32;
         // Source mask at level 0, then dilated upwards (any child inside).
         let (mut sw, mut sh) = match p.source {
             PasteSource::Terrain => level_size(self.width, self.height, 0),
@@ -375,6 +377,40 @@ impl Session<'_> {
         let mut mask: Vec<bool> = (0..sw * sh)
             .map(|k| inside(&p.lasso, (k % sw) as f64 + 0.5, (k / sw) as f64 + 0.5))
             .collect();
+        if let (Lift::Ground, Some(last)) = (p.lift, frames.levels[0].last()) {
+            let (w0, h0) = level_size(self.width, self.height, 0);
+            let r0 = &db.level(0).layout.rects;
+            let source = |x: usize, y: usize| match p.source {
+                PasteSource::Terrain => (last.coords[y * sw + x], last.offsets[y * sw + x]),
+                PasteSource::Exemplar(e) => {
+                    (Coord::from_texel(r0[e].x0 as i32 + x as i32, y as i32), 0)
+                }
+            };
+            let target_of = |x: usize, y: usize| {
+                let (tx, ty) = (x as i64 + p.offset.0, y as i64 + p.offset.1);
+                (tx >= 0 && ty >= 0 && tx < w0 as i64 && ty < h0 as i64)
+                    .then(|| ty as usize * w0 + tx as usize)
+            };
+            let margin = crate::database::layout::MARGIN as usize;
+            let writes = |x: usize, y: usize| {
+                x < sw
+                    && y < sh
+                    && mask[y * sw + x]
+                    && target_of(x, y).is_some()
+                    && match p.source {
+                        PasteSource::Terrain => true,
+                        PasteSource::Exemplar(_) => {
+                            x >= margin && y >= margin && x + margin < sw && y + margin < sh
+                        }
+                    }
+            };
+            let rim = lift::rim((0, 0, sw, sh), writes);
+            let target = |x: usize, y: usize| {
+                let t = target_of(x, y).expect("a rim pixel is written");
+                (last.coords[t], last.offsets[t])
+            };
+            delta += lift::ground_offset(&AtlasLevel::new(db, 0), &rim, source, target);
+        }
         for (level, passes) in frames.levels.iter_mut().enumerate() {
             if level > 0 {
                 let (cw, ch) = (sw, sh);
@@ -398,6 +434,14 @@ impl Session<'_> {
             let (tw, th) = level_size(self.width, self.height, level);
             let shift = |o: i64| o.div_euclid(1 << level);
             let (ox, oy) = (shift(p.offset.0), shift(p.offset.1));
+            let atlas = AtlasLevel::new(db, level);
+            let in_mask = |u: i64, v: i64| {
+                u >= 0
+                    && v >= 0
+                    && u < sw as i64
+                    && v < sh as i64
+                    && mask[v as usize * sw + u as usize]
+            };
             // Read every source value first: source and target may overlap.
             let mut writes = Vec::new();
             for k in (0..sw * sh).filter(|&k| mask[k]) {
@@ -408,7 +452,7 @@ impl Session<'_> {
                 }
                 let t = ty as usize * tw + tx as usize;
                 let delta = p.delta_at(delta, level, x as usize, y as usize);
-                let values: Vec<(Coord, i32)> = match p.source {
+                let mut values: Vec<(Coord, i32)> = match p.source {
                     PasteSource::Terrain => passes
                         .iter()
                         .map(|r| (r.coords[k], r.offsets[k] + delta))
@@ -423,6 +467,13 @@ impl Session<'_> {
                         vec![(c, delta); passes.len()]
                     }
                 };
+                let (x, y) = (x as usize, y as usize);
+                if p.lift == Lift::Ground && lift::near_seam(level, x, y, in_mask) {
+                    let ground = passes.last().map(|r| (r.coords[t], r.offsets[t]));
+                    if let Some(g) = ground {
+                        lift::seam(&atlas, &mut values, g, p.depth(level, x, y));
+                    }
+                }
                 writes.push((t, values));
             }
             for (t, values) in writes {

@@ -47,7 +47,7 @@ pub const N: usize = 64;
 
 /// The document a new session of [`serve`]`(N, None, _)` shows.
 pub fn doc() -> Value {
-    json!({"version": 1, "size": [N, N], "seed": 3, "points": [], "curves": []})
+    json!({"version": 2, "size": [N, N], "seed": 3, "points": [], "curves": []})
 }
 
 /// A new session: its id and first frame.

@@ -153,7 +153,7 @@ export class Panel {
       out.push(
         this.num('to x', () => P.to[0], (v) => (P.to[0] = v), only),
         this.num('to y', () => P.to[1], (v) => (P.to[1] = v), only),
-        this.num('δ height (m)', () => P.delta_m, (v) => (P.delta_m = v), only),
+        this.num('δ above the ground (m)', () => P.delta_m, (v) => (P.delta_m = v), only),
         h('div', { class: 'buttons' }, h('button', { id: 'apply-paste', onclick: () => t.applyPaste() }, 'Paste (Enter)'), h('button', { onclick: () => t.cancel() }, 'Cancel (Esc)')),
       );
     } else {
@@ -278,7 +278,7 @@ export class Panel {
         h('p', { class: 'note' }, `from ${p.source === 'terrain' ? 'this terrain' : `exemplar ${ed.info.database.exemplars[p.exemplar].name}`}. Pastes are permanent in a session: changing or deleting one re-synthesizes the terrain from scratch.`),
         this.num('to x', () => p.to[0], (v) => (p.to[0] = v), { kind: 'paste' }),
         this.num('to y', () => p.to[1], (v) => (p.to[1] = v), { kind: 'paste' }),
-        this.num('δ height (m)', () => p.delta_m || 0, (v) => (p.delta_m = v), { kind: 'paste' }),
+        this.num((p.lift || (doc.version === 2 ? 'ground' : 'source')) === 'ground' ? 'δ above the ground (m)' : 'δ above its source (m)', () => p.delta_m || 0, (v) => (p.delta_m = v), { kind: 'paste' }),
         del('Delete paste')];
     }
     return [];

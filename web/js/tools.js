@@ -408,7 +408,8 @@ export class Tools {
     const P = this.pending;
     if (!P) return;
     this.pending = null;
-    const item = { id: C.newId(this.ed.doc, 'paste'), source: P.source, lasso: P.lasso, to: P.to, delta_m: P.delta_m };
+    // Explicit, so that a paste added to a version-1 scene lands on the ground too.
+    const item = { id: C.newId(this.ed.doc, 'paste'), source: P.source, lasso: P.lasso, to: P.to, delta_m: P.delta_m, lift: 'ground' };
     if (P.source === 'exemplar') item.exemplar = P.exemplar;
     this.ed.change((d) => (d.pastes = (d.pastes || []).concat([item])), { kind: 'paste' });
     this.sel = { kind: 'paste', index: this.ed.doc.pastes.length - 1 };

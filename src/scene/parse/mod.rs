@@ -34,11 +34,13 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
             "pastes",
         ],
     )?;
-    if let Some(v) = m.get("version")
-        && v.as_u64() != Some(1)
-    {
-        return Err(r.invalid("version", v, "1"));
-    }
+    let version = match m.get("version") {
+        None => 1,
+        Some(v) => match v.as_u64() {
+            Some(n @ 1..=2) => n,
+            _ => return Err(r.invalid("version", v, "1 or 2")),
+        },
+    };
     let database = match m.get("database") {
         None | Some(Value::Null) => None,
         Some(v) => Some(r.path_value(v, "database")?),
@@ -90,6 +92,7 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         r: &r,
         m,
         size: (fw, fh),
+        version,
     };
     let points = constraints::points(&d, &mut ids)?;
     let curves = constraints::curves(&d, &mut ids)?;
@@ -117,12 +120,14 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
 }
 
 /// What each section of a document is read with: the reader, the
-/// document's top-level object, and the terrain size in pixels (the bound
-/// of every `[x, y]` on the terrain).
+/// document's top-level object, the terrain size in pixels (the bound
+/// of every `[x, y]` on the terrain) and the format version.
 struct Doc<'a> {
     r: &'a Reader<'a>,
     m: &'a Map<String, Value>,
     size: (f64, f64),
+    /// The format version (1 when absent): it sets defaults that changed.
+    version: u64,
 }
 
 impl Doc<'_> {

@@ -93,7 +93,7 @@ pub(super) fn pastes(d: &Doc, ids: &mut Vec<String>) -> R<Vec<PasteSpec>> {
     d.items(
         "pastes",
         "pastes",
-        &["id", "source", "exemplar", "lasso", "to", "delta_m"],
+        &["id", "source", "exemplar", "lasso", "to", "delta_m", "lift"],
         |path, o| {
             let id = r.id(o, path, path.to_string(), ids)?;
             let sp = join(path, "source");
@@ -135,12 +135,23 @@ pub(super) fn pastes(d: &Doc, ids: &mut Vec<String>) -> R<Vec<PasteSpec>> {
                 Some(v) => r.height(v, &join(path, "delta_m"))?,
                 None => 0.0,
             };
+            // Version 1 had only the source's own heights.
+            let lift = match (o.get("lift"), d.version) {
+                (None, 1) => Lift::Source,
+                (None, _) => Lift::Ground,
+                (Some(v), _) => match v.as_str() {
+                    Some("ground") => Lift::Ground,
+                    Some("source") => Lift::Source,
+                    _ => return Err(r.invalid(&join(path, "lift"), v, "\"ground\" or \"source\"")),
+                },
+            };
             Ok(PasteSpec {
                 id,
                 source,
                 lasso,
                 to,
                 delta_m,
+                lift,
             })
         },
     )

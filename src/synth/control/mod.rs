@@ -13,9 +13,11 @@
 
 pub mod blend;
 pub mod curve;
+pub mod lift;
 pub mod point;
 
 pub use blend::{Blend, Targets};
+pub use lift::Lift;
 pub use point::PointConstraint;
 
 use thiserror::Error;
@@ -119,13 +121,15 @@ pub enum PasteSource {
 
 /// A copy-paste (paper §5.3, Fig. 8): the region inside `lasso` (a closed
 /// polygon, in output pixels for the terrain or level-0 exemplar pixels for
-/// an exemplar) moved by `offset` output pixels and raised by `delta_m`.
+/// an exemplar) moved by `offset` output pixels and raised by `delta_m`
+/// from where `lift` says.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Paste {
     pub source: PasteSource,
     pub lasso: Vec<(f64, f64)>,
     pub offset: (i64, i64),
     pub delta_m: f64,
+    pub lift: Lift,
 }
 
 /// Everything the user controls, in memory (a scene file converts to this).
@@ -142,13 +146,16 @@ pub struct Controls {
     pub pastes: Vec<Paste>,
 }
 
-/// Width of a paste's height feather, output pixels: δ rises from 0 at the
-/// lasso to its full value this far inside ([`Paste::delta_at`]).
+/// Width of a [`Lift::Source`] paste's height feather, output pixels: δ
+/// rises from 0 at the lasso to its full value this far inside
+/// ([`Paste::delta_at`]). A [`Lift::Ground`] paste has none.
 pub const PASTE_FEATHER: f64 = 16.0;
 
 impl Paste {
-    /// The height offset (database units; `delta` is δ in units) that the
-    /// paste adds at source pixel (x, y) of level `level`: δ·w with w a
+    /// The height offset (database units; `delta` is δ in units, with the
+    /// ground lift for [`Lift::Ground`]) that the paste adds at source
+    /// pixel (x, y) of level `level`: for [`Lift::Ground`], `delta` at every
+    /// pixel it writes; for [`Lift::Source`], δ·w with w a
     /// smoothstep of the pixel centre's distance inside the lasso over
     /// [`PASTE_FEATHER`] (0 outside it — coarse levels' masks take any
     /// pixel with a child inside).
@@ -160,14 +167,25 @@ impl Paste {
     /// the offset comes in over a slope like a real rise. Host-side f64,
     /// one function for sessions and windows, so both write the same V.
     pub fn delta_at(&self, delta: i32, level: usize, x: usize, y: usize) -> i32 {
-        let s = (1u64 << level) as f64;
-        let (px, py) = ((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
-        if delta == 0 || !inside(&self.lasso, px, py) {
+        if self.lift == Lift::Ground {
+            return delta;
+        }
+        if delta == 0 {
             return 0;
         }
-        let d = distance_to_polygon(&self.lasso, px, py);
-        let t = (d / PASTE_FEATHER).min(1.0);
+        let t = (self.depth(level, x, y) / PASTE_FEATHER).min(1.0);
         (f64::from(delta) * t * t * (3.0 - 2.0 * t)).round() as i32
+    }
+
+    /// How far inside the lasso the centre of level-`level` source pixel
+    /// (x, y) lies, output pixels (0 outside it).
+    pub fn depth(&self, level: usize, x: usize, y: usize) -> f64 {
+        let s = (1u64 << level) as f64;
+        let (px, py) = ((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
+        match inside(&self.lasso, px, py) {
+            true => distance_to_polygon(&self.lasso, px, py),
+            false => 0.0,
+        }
     }
 }
 

@@ -89,7 +89,7 @@ impl Synthesizer<'_> {
         let mut hf = one.heightfield;
         if let Some(mut frames) = frames {
             let regions: Vec<Rect> = (0..=last).map(|i| first.region(i)).collect();
-            paste::write(&pastes, &mut frames, &regions);
+            paste::write(&pastes, db, &mut frames, &regions);
             let prev = Frames {
                 levels: (frames.levels.iter().enumerate())
                     .map(|(i, passes)| {

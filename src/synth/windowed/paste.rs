@@ -8,14 +8,17 @@
 //! an earlier one wrote. Its support is bounded, though: the lasso's
 //! bounding box at every level. A window therefore also synthesizes the
 //! first frame over the sources of every terrain paste whose target reaches
-//! its cone — transitively, walking the pastes backwards ([`needs`]).
+//! its cone — transitively, walking the pastes backwards ([`needs`]) —
+//! and, for a paste that lands on the ground ([`Lift::Ground`]), its whole
+//! source and target at level 0, whose rim sets its lift.
 
 use crate::database::Database;
 use crate::database::layout::MARGIN;
+use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::level_size;
 use crate::synth::cone::Rect;
-use crate::synth::control::{Paste, PasteSource, inside};
+use crate::synth::control::{Lift, Paste, PasteSource, inside, lift};
 use crate::synth::{Frames, PassResult};
 
 /// One paste at one level.
@@ -146,6 +149,57 @@ impl PasteGeometry {
         Some((sx, sy))
     }
 
+    /// Whether level-`i` source pixel (x, y) is in the source mask.
+    fn in_mask(&self, i: usize, x: i64, y: i64) -> bool {
+        let l = &self.levels[i];
+        let b = l.bbox;
+        (b.x0 as i64..b.x1 as i64).contains(&x)
+            && (b.y0 as i64..b.y1 as i64).contains(&y)
+            && l.mask[(y as usize - b.y0) * b.width() + x as usize - b.x0]
+    }
+
+    /// The lift of a [`Lift::Ground`] paste ([`lift::ground_offset`]),
+    /// from a first frame's last pass at level 0 over `region`; `None` when
+    /// the rim (its targets, a terrain source's pixels) is not all inside.
+    /// That happens only where the paste writes nothing the window reads:
+    /// [`needs`] puts the whole of every paste that reaches it there.
+    fn ground_offset(
+        &self,
+        atlas: &AtlasLevel<'_>,
+        last: &PassResult,
+        region: Rect,
+    ) -> Option<i32> {
+        let at = |x: i64, y: i64| {
+            let inside = (region.x0 as i64..region.x1 as i64).contains(&x)
+                && (region.y0 as i64..region.y1 as i64).contains(&y);
+            inside.then(|| {
+                let k = (y as usize - region.y0) * region.width() + x as usize - region.x0;
+                (last.coords[k], last.offsets[k])
+            })
+        };
+        let l = &self.levels[0];
+        let b = l.bbox;
+        let writes = |x: usize, y: usize| {
+            let (tx, ty) = (x as i64 + l.off.0, y as i64 + l.off.1);
+            tx >= 0 && ty >= 0 && self.source_of(0, tx as usize, ty as usize).is_some()
+        };
+        let rim = lift::rim((b.x0, b.y0, b.x1, b.y1), writes);
+        let whole = rim.iter().all(|&(x, y)| {
+            at(x as i64 + l.off.0, y as i64 + l.off.1).is_some()
+                && (l.exemplar.is_some() || at(x as i64, y as i64).is_some())
+        });
+        if !whole {
+            return None;
+        }
+        let source = |x: usize, y: usize| match l.exemplar {
+            Some((x0, _, _)) => (Coord::from_texel(x0 as i32 + x as i32, y as i32), 0),
+            None => at(x as i64, y as i64).expect("checked"),
+        };
+        let target =
+            |x: usize, y: usize| at(x as i64 + l.off.0, y as i64 + l.off.1).expect("checked");
+        Some(lift::ground_offset(atlas, &rim, source, target))
+    }
+
     /// Bounding box of the level-`i` pixels the paste writes, if any.
     fn targets(&self, i: usize) -> Option<Rect> {
         let l = &self.levels[i];
@@ -177,7 +231,19 @@ fn meet(a: Rect, b: Rect) -> Option<Rect> {
 /// what is needed so far (bounding boxes).
 pub(super) fn needs(pastes: &[PasteGeometry], regions: &[Rect]) -> Vec<Option<Rect>> {
     let mut need: Vec<Rect> = regions.to_vec();
-    for p in pastes.iter().rev().filter(|p| p.terrain) {
+    for p in pastes.iter().rev() {
+        let reaches = (need.iter().enumerate().take(p.levels.len()))
+            .any(|(i, n)| p.targets(i).and_then(|t| meet(t, *n)).is_some());
+        if p.paste.lift == Lift::Ground && reaches {
+            // Its lift reads the whole rim: every target at level 0 (and,
+            // below, a terrain source's pixels for them).
+            if let Some(t) = p.targets(0) {
+                need[0] = need[0].union(t);
+            }
+        }
+        if !p.terrain {
+            continue;
+        }
         for (i, n) in need.iter_mut().enumerate().take(p.levels.len()) {
             if let Some(t) = p.targets(i).and_then(|t| meet(t, *n)) {
                 let l = &p.levels[i];
@@ -218,15 +284,28 @@ pub(super) fn pasted(pastes: &[PasteGeometry], i: usize, rect: Rect) -> Vec<bool
 /// (a terrain source read from the frame itself, every source read before
 /// any write of that paste and level). Targets whose source lies outside
 /// the region are left alone: they lie outside what [`needs`] asked for.
-pub(super) fn write(pastes: &[PasteGeometry], frames: &mut Frames, regions: &[Rect]) {
+pub(super) fn write(
+    pastes: &[PasteGeometry],
+    db: &Database,
+    frames: &mut Frames,
+    regions: &[Rect],
+) {
     // The kept final states no longer match the results written here.
     frames.states.clear();
+    let atlas0 = AtlasLevel::new(db, 0);
     for p in pastes {
+        let delta = match (p.paste.lift, frames.levels[0].last()) {
+            (Lift::Ground, Some(last)) => {
+                p.delta + p.ground_offset(&atlas0, last, regions[0]).unwrap_or(0)
+            }
+            _ => p.delta,
+        };
         for (i, passes) in frames.levels.iter_mut().enumerate() {
             let r = regions[i];
             let Some(t) = p.targets(i).and_then(|t| meet(t, r)) else {
                 continue;
             };
+            let atlas = AtlasLevel::new(db, i);
             let index = |x: usize, y: usize| (y - r.y0) * r.width() + x - r.x0;
             let mut writes = Vec::new();
             for y in t.y0..t.y1 {
@@ -234,8 +313,8 @@ pub(super) fn write(pastes: &[PasteGeometry], frames: &mut Frames, regions: &[Re
                     let Some((sx, sy)) = p.source_of(i, x, y) else {
                         continue;
                     };
-                    let delta = p.paste.delta_at(p.delta, i, sx, sy);
-                    let values: Vec<(Coord, i32)> = match p.levels[i].exemplar {
+                    let delta = p.paste.delta_at(delta, i, sx, sy);
+                    let mut values: Vec<(Coord, i32)> = match p.levels[i].exemplar {
                         None => {
                             if !(r.x0..r.x1).contains(&sx) || !(r.y0..r.y1).contains(&sy) {
                                 continue;
@@ -251,6 +330,15 @@ pub(super) fn write(pastes: &[PasteGeometry], frames: &mut Frames, regions: &[Re
                             vec![(c, delta); passes.len()]
                         }
                     };
+                    if p.paste.lift == Lift::Ground
+                        && lift::near_seam(i, sx, sy, |u, v| p.in_mask(i, u, v))
+                    {
+                        let k = index(x, y);
+                        let ground = passes.last().map(|q| (q.coords[k], q.offsets[k]));
+                        if let Some(g) = ground {
+                            lift::seam(&atlas, &mut values, g, p.paste.depth(i, sx, sy));
+                        }
+                    }
                     writes.push((index(x, y), values));
                 }
             }
