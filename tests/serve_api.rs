@@ -286,20 +286,27 @@ fn previews_tiles_heights_and_exports() {
         hf[70]
     );
 
+    // Download names: every file distinct, each sidecar named as the reader
+    // looks for it beside its heights (`io::sidecar_path`).
+    let file = |r: &http::Response| {
+        let d = r.header("content-disposition").unwrap().to_string();
+        assert!(d.starts_with("attachment; filename=\""), "{d}");
+        d["attachment; filename=\"".len()..d.len() - 1].to_string()
+    };
+    let mut names = std::collections::BTreeSet::new();
     for f in Format::ALL.iter().filter(|f| f.can_write()) {
         let r = http::get(a, &format!("/api/sessions/{id}/export?format={}", f.name()));
         assert_eq!(r.status, 200, "{f}");
-        assert!(
-            r.header("content-disposition")
-                .unwrap()
-                .contains("attachment")
-        );
+        assert!(names.insert(file(&r)), "{f}: {} downloaded twice", file(&r));
         let sidecar = f.uses_sidecar().then(|| {
             let s = http::get(
                 a,
                 &format!("/api/sessions/{id}/export?format={}&sidecar=true", f.name()),
             );
             assert_eq!(s.status, 200, "{f} sidecar");
+            let want = io::sidecar_path(std::path::Path::new(&file(&r)));
+            assert_eq!(std::path::PathBuf::from(file(&s)), want, "{f} sidecar");
+            assert!(names.insert(file(&s)), "{f}: {} downloaded twice", file(&s));
             s.body
         });
         let opts = ReadOptions {

@@ -200,11 +200,18 @@ pub async fn export(
             .await
             .map_err(|e| ApiError::Internal(e.to_string()))?
             .map_err(|e| ApiError::Internal(format!("encoding {format} failed: {e}")))?;
+    // A format with a sidecar names both files after itself: the reader
+    // finds `X.json` beside `X.png`, and the png16, r16 and r32 sidecars of
+    // one terrain, downloaded to one folder, no longer overwrite each other.
+    let base = match format.uses_sidecar() {
+        true => format!("{stem}-terrain-{}", format.name()),
+        false => format!("{stem}-terrain"),
+    };
     let (bytes, file, mime) = match (sidecar, enc.sidecar) {
-        (true, Some(sc)) => (sc, format!("{stem}-terrain.json"), "application/json"),
+        (true, Some(sc)) => (sc, format!("{base}.json"), "application/json"),
         _ => (
             enc.bytes,
-            format!("{stem}-terrain.{}", extension(format)),
+            format!("{base}.{}", extension(format)),
             "application/octet-stream",
         ),
     };

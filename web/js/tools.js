@@ -93,9 +93,9 @@ export class Tools {
       const c = doc.curves[s.index], w = c.widgets[s.widget];
       if (w) {
         const f = C.widgetFrame(ed, c, s.index, w);
-        if (onBar(f.at, w.height_m, C.barRange(ed))) return { kind: 'widget-height', ...s };
+        if (onBar(f.at, w.height_m, C.barRange(ed))) return { ...s, kind: 'widget-height' };
         for (const [side, sign] of [[0, 1], [1, -1]]) {
-          if (near(g.add(f.at, g.scale(f.left, sign * w.reach_px[side])))) return { kind: 'widget-reach', side, ...s };
+          if (near(g.add(f.at, g.scale(f.left, sign * w.reach_px[side])))) return { ...s, kind: 'widget-reach', side };
         }
       }
     }
