@@ -35,6 +35,7 @@ pub mod size;
 pub mod stages;
 pub mod synth;
 pub mod tiles;
+pub mod water;
 
 pub use error::{Error, Result};
 pub use heightfield::{Georef, Heightfield, Stats};

@@ -17,6 +17,7 @@ mod sketch;
 mod suite;
 mod synth;
 mod tiles;
+mod water;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -40,6 +41,9 @@ enum Command {
     Convert(convert::Args),
     /// Write slope, flow accumulation, terrain-type and splat masks of a heightfield.
     Masks(masks::Args),
+    /// Fill depressions and route water: filled surface, lakes (water
+    /// depth), flow accumulation, rivers (raster and GeoJSON lines).
+    Water(water::Args),
     /// Time synthesis: median ms per size, level and stage, and memory per pixel.
     Bench(bench::Args),
     /// Build or inspect an exemplar database.
@@ -85,6 +89,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Masks(a) => masks::run(a),
+        Command::Water(a) => water::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),

@@ -1,0 +1,192 @@
+//! Flat resolution (Barnes, Lehman & Mulla 2014, "An efficient assignment
+//! of drainage direction over flat surfaces in raster digital elevation
+//! models"): on the filled surface every lake is level, and D8 alone gives
+//! its cells no direction. This builds the paper's drainage gradient over
+//! each flat — towards lower terrain (weight 2) and away from higher
+//! terrain — which [`super::d8`] uses as the second key of its slope
+//! comparison, so flow crosses a lake from its inflows to its outlet along
+//! the middle of the flat instead of hugging one shore, and every cell
+//! drains.
+//!
+//! Definitions as pysheds implements the paper (its `resolve_flats`), so
+//! the two route the same way:
+//! - a **flat** cell is an interior cell with no lower neighbour and at
+//!   least one neighbour at its height (border and sea cells never are);
+//! - a **low edge** is a cell that drains (a lower neighbour, the border or
+//!   the sea) next to a flat cell of its height;
+//! - a **high edge** is a flat cell with a higher neighbour;
+//! - `towards_lower` = 1 on low edges, +1 per 8-connected step into the flat;
+//!   `from_higher` = 1 on high edges, +1 per step, then inverted within
+//!   each flat (its largest value minus it; unreached cells keep 0);
+//! - gradient = 2 × towards_lower + from_higher (low edges: 2).
+
+use super::d8::CLOCKWISE;
+use crate::procedural::grid::neighbour;
+use rayon::prelude::*;
+
+const FLAT: u8 = 1;
+const DRAINS: u8 = 2;
+const HIGHER: u8 = 4;
+
+/// Calls `f(k)` for every neighbour `k` of cell `i`.
+#[inline]
+fn each_neighbour(i: usize, w: usize, h: usize, mut f: impl FnMut(usize)) {
+    let (x, y) = (i % w, i / w);
+    for &(dx, dy, _) in &CLOCKWISE {
+        if let Some(k) = neighbour(x, y, dx, dy, w, h) {
+            f(k);
+        }
+    }
+}
+
+/// The drainage gradient of every cell of a filled surface (`sea` cells
+/// drain, like the border); `None` when the surface has no flat.
+pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Option<Vec<u32>> {
+    let mut class = vec![0u8; w * h];
+    class.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, c) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            if x == 0 || y == 0 || x == w - 1 || y == h - 1 || sea.is_some_and(|m| m[i]) {
+                *c = DRAINS;
+                continue;
+            }
+            let z = filled[i];
+            let (mut lower, mut equal, mut higher) = (false, false, false);
+            each_neighbour(i, w, h, |k| {
+                let zk = filled[k];
+                lower |= zk < z;
+                equal |= zk == z;
+                higher |= zk > z;
+            });
+            *c = if lower {
+                DRAINS
+            } else if equal {
+                FLAT
+            } else {
+                0
+            } | if higher { HIGHER } else { 0 };
+        }
+    });
+    let flats: Vec<u32> = class
+        .par_iter()
+        .enumerate()
+        .filter(|(_, c)| **c & FLAT != 0)
+        .map(|(i, _)| i as u32)
+        .collect();
+    if flats.is_empty() {
+        return None;
+    }
+    // Label the flats (8-connected; adjacent flat cells share a height, or
+    // the higher one would have a lower neighbour).
+    let mut label = vec![0u32; w * h];
+    let mut labels = 0u32;
+    let mut stack = Vec::new();
+    for &f in &flats {
+        if label[f as usize] != 0 {
+            continue;
+        }
+        labels += 1;
+        label[f as usize] = labels;
+        stack.push(f as usize);
+        while let Some(c) = stack.pop() {
+            each_neighbour(c, w, h, |k| {
+                if class[k] & FLAT != 0 && label[k] == 0 {
+                    label[k] = labels;
+                    stack.push(k);
+                }
+            });
+        }
+    }
+    // Towards lower terrain: breadth-first from the low edges.
+    let mut grad = vec![0u32; w * h];
+    let mut ring: Vec<usize> = Vec::new();
+    for &f in &flats {
+        let f = f as usize;
+        each_neighbour(f, w, h, |k| {
+            if class[k] & DRAINS != 0 && filled[k] == filled[f] && grad[k] == 0 {
+                grad[k] = 1;
+                ring.push(k);
+            }
+        });
+    }
+    let is_flat = |k: usize| class[k] & FLAT != 0;
+    let mut step = 1;
+    let mut next = Vec::new();
+    while !ring.is_empty() {
+        step += 1;
+        for &c in &ring {
+            each_neighbour(c, w, h, |k| {
+                if is_flat(k) && grad[k] == 0 && filled[k] == filled[c] {
+                    grad[k] = step;
+                    next.push(k);
+                }
+            });
+        }
+        std::mem::swap(&mut ring, &mut next);
+        next.clear();
+    }
+    // Away from higher terrain: breadth-first from the high edges, then
+    // inverted within each flat.
+    let mut higher = vec![0u32; w * h];
+    ring.extend(
+        flats
+            .iter()
+            .map(|&f| f as usize)
+            .filter(|&f| class[f] & HIGHER != 0),
+    );
+    for &c in &ring {
+        higher[c] = 1;
+    }
+    let mut step = 1;
+    while !ring.is_empty() {
+        step += 1;
+        for &c in &ring {
+            each_neighbour(c, w, h, |k| {
+                if is_flat(k) && higher[k] == 0 {
+                    higher[k] = step;
+                    next.push(k);
+                }
+            });
+        }
+        std::mem::swap(&mut ring, &mut next);
+        next.clear();
+    }
+    let mut top = vec![0u32; labels as usize + 1];
+    for &f in &flats {
+        let f = f as usize;
+        let l = label[f] as usize;
+        top[l] = top[l].max(higher[f]);
+    }
+    // Low edges (not flat) keep 2 × 1; flat cells add the inverted climb.
+    for g in grad.iter_mut() {
+        *g *= 2;
+    }
+    for &f in &flats {
+        let f = f as usize;
+        if higher[f] > 0 {
+            grad[f] += top[label[f] as usize] - higher[f];
+        }
+    }
+    Some(grad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_flat_slopes_towards_its_outlet_and_away_from_its_shore() {
+        // 7×3: a level strip at 5 m (row 1, x 1..=5) walled at 9 m, open
+        // to the west border at 5 m: the gradient falls westwards.
+        let (w, h) = (7, 3);
+        let mut z = vec![9.0f32; w * h];
+        for x in 0..6 {
+            z[w + x] = 5.0;
+        }
+        let g = gradient(&z, w, h, None).unwrap();
+        let row: Vec<u32> = (0..w).map(|x| g[w + x]).collect();
+        // The border cell is the low edge (2); towards_lower 2..6 doubled,
+        // from_higher is 1 everywhere (all touch the walls): inverted 0.
+        assert_eq!(row, vec![2, 4, 6, 8, 10, 12, 0]);
+    }
+}
