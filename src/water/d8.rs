@@ -70,6 +70,7 @@ pub struct Surface<'a> {
 pub fn receivers(s: &Surface<'_>, edges: Edges) -> Vec<u32> {
     let (w, h) = (s.width, s.height);
     let grad = |i: usize| s.gradient.map_or(0.0, |g| g[i] as f64);
+    let offsets: [isize; 8] = CLOCKWISE.map(|(dx, dy, _)| dy * w as isize + dx);
     let mut out = vec![OUTLET; w * h];
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, r) in row.iter_mut().enumerate() {
@@ -82,15 +83,23 @@ pub fn receivers(s: &Surface<'_>, edges: Edges) -> Vec<u32> {
             // The slope must beat (0, 0): a real drop, or a level step down
             // the flat gradient.
             let (mut best_dz, mut best_dg) = (0.0, 0.0);
-            for &(dx, dy, dist) in &CLOCKWISE {
-                let Some(k) = neighbour(x, y, dx, dy, w, h) else {
-                    continue;
-                };
+            let mut consider = |k: usize, dist: f64| {
                 let dz = (z - s.heights[k] as f64) / dist;
                 let dg = (g - grad(k)) / dist;
                 if dz > best_dz || (dz == best_dz && dg > best_dg) {
                     (best_dz, best_dg) = (dz, dg);
                     *r = k as u32;
+                }
+            };
+            if edge {
+                for &(dx, dy, dist) in &CLOCKWISE {
+                    if let Some(k) = neighbour(x, y, dx, dy, w, h) {
+                        consider(k, dist);
+                    }
+                }
+            } else {
+                for (o, &(_, _, dist)) in offsets.iter().zip(&CLOCKWISE) {
+                    consider(i.wrapping_add_signed(*o), dist);
                 }
             }
         }

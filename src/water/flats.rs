@@ -28,20 +28,136 @@ const FLAT: u8 = 1;
 const DRAINS: u8 = 2;
 const HIGHER: u8 = 4;
 
-/// Calls `f(k)` for every neighbour `k` of cell `i`.
-#[inline]
-fn each_neighbour(i: usize, w: usize, h: usize, mut f: impl FnMut(usize)) {
-    let (x, y) = (i % w, i / w);
-    for &(dx, dy, _) in &CLOCKWISE {
-        if let Some(k) = neighbour(x, y, dx, dy, w, h) {
-            f(k);
+/// A filled surface with its cells classified.
+struct Grid<'a> {
+    filled: &'a [f32],
+    class: &'a [u8],
+    /// Neighbour offsets of interior cells (every flat cell is interior).
+    offsets: [isize; 8],
+    w: usize,
+    h: usize,
+}
+
+impl Grid<'_> {
+    fn is_flat(&self, k: usize) -> bool {
+        self.class[k] & FLAT != 0
+    }
+
+    /// The neighbours of an interior cell.
+    fn around(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        self.offsets.iter().map(move |&o| i.wrapping_add_signed(o))
+    }
+
+    /// Labels of the flats, 8-connected (adjacent flat cells share a
+    /// height, or the higher one would have a lower neighbour), and their
+    /// count.
+    fn label(&self, flats: &[u32]) -> (Vec<u32>, u32) {
+        let mut label = vec![0u32; self.class.len()];
+        let mut labels = 0u32;
+        let mut stack = Vec::new();
+        for &f in flats {
+            if label[f as usize] != 0 {
+                continue;
+            }
+            labels += 1;
+            label[f as usize] = labels;
+            stack.push(f as usize);
+            while let Some(c) = stack.pop() {
+                for k in self.around(c) {
+                    if self.is_flat(k) && label[k] == 0 {
+                        label[k] = labels;
+                        stack.push(k);
+                    }
+                }
+            }
         }
+        (label, labels)
+    }
+
+    /// Steps from the low edges (1 on them), breadth-first into the flats.
+    fn towards_lower(&self, flats: &[u32]) -> Vec<u32> {
+        let mut grad = vec![0u32; self.class.len()];
+        let mut ring: Vec<usize> = Vec::new();
+        for &f in flats {
+            let f = f as usize;
+            for k in self.around(f) {
+                if self.class[k] & DRAINS != 0 && self.filled[k] == self.filled[f] && grad[k] == 0 {
+                    grad[k] = 1;
+                    ring.push(k);
+                }
+            }
+        }
+        // The first ring (low edges) may lie on the border; later rings
+        // are flat cells, interior.
+        let mut next = Vec::new();
+        for &c in &ring {
+            let (x, y) = (c % self.w, c / self.w);
+            for &(dx, dy, _) in &CLOCKWISE {
+                if let Some(k) = neighbour(x, y, dx, dy, self.w, self.h)
+                    && self.is_flat(k)
+                    && grad[k] == 0
+                    && self.filled[k] == self.filled[c]
+                {
+                    grad[k] = 2;
+                    next.push(k);
+                }
+            }
+        }
+        std::mem::swap(&mut ring, &mut next);
+        next.clear();
+        let mut step = 2;
+        while !ring.is_empty() {
+            step += 1;
+            for &c in &ring {
+                for k in self.around(c) {
+                    if self.is_flat(k) && grad[k] == 0 {
+                        grad[k] = step;
+                        next.push(k);
+                    }
+                }
+            }
+            std::mem::swap(&mut ring, &mut next);
+            next.clear();
+        }
+        grad
+    }
+
+    /// Steps from the high edges (1 on them), breadth-first through the
+    /// flats; 0 where none is reached.
+    fn from_higher(&self, flats: &[u32]) -> Vec<u32> {
+        let mut higher = vec![0u32; self.class.len()];
+        let mut ring: Vec<usize> = flats
+            .iter()
+            .map(|&f| f as usize)
+            .filter(|&f| self.class[f] & HIGHER != 0)
+            .collect();
+        for &c in &ring {
+            higher[c] = 1;
+        }
+        let mut next = Vec::new();
+        let mut step = 1;
+        while !ring.is_empty() {
+            step += 1;
+            for &c in &ring {
+                for k in self.around(c) {
+                    if self.is_flat(k) && higher[k] == 0 {
+                        higher[k] = step;
+                        next.push(k);
+                    }
+                }
+            }
+            std::mem::swap(&mut ring, &mut next);
+            next.clear();
+        }
+        higher
     }
 }
 
 /// The drainage gradient of every cell of a filled surface (`sea` cells
 /// drain, like the border); `None` when the surface has no flat.
 pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Option<Vec<u32>> {
+    // Flat cells are interior: their neighbours are at fixed offsets.
+    let offsets: [isize; 8] = CLOCKWISE.map(|(dx, dy, _)| dy * w as isize + dx);
     let mut class = vec![0u8; w * h];
     class.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, c) in row.iter_mut().enumerate() {
@@ -52,12 +168,12 @@ pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Opt
             }
             let z = filled[i];
             let (mut lower, mut equal, mut higher) = (false, false, false);
-            each_neighbour(i, w, h, |k| {
-                let zk = filled[k];
+            for o in offsets {
+                let zk = filled[i.wrapping_add_signed(o)];
                 lower |= zk < z;
                 equal |= zk == z;
                 higher |= zk > z;
-            });
+            }
             *c = if lower {
                 DRAINS
             } else if equal {
@@ -76,81 +192,18 @@ pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Opt
     if flats.is_empty() {
         return None;
     }
-    // Label the flats (8-connected; adjacent flat cells share a height, or
-    // the higher one would have a lower neighbour).
-    let mut label = vec![0u32; w * h];
-    let mut labels = 0u32;
-    let mut stack = Vec::new();
-    for &f in &flats {
-        if label[f as usize] != 0 {
-            continue;
-        }
-        labels += 1;
-        label[f as usize] = labels;
-        stack.push(f as usize);
-        while let Some(c) = stack.pop() {
-            each_neighbour(c, w, h, |k| {
-                if class[k] & FLAT != 0 && label[k] == 0 {
-                    label[k] = labels;
-                    stack.push(k);
-                }
-            });
-        }
-    }
-    // Towards lower terrain: breadth-first from the low edges.
-    let mut grad = vec![0u32; w * h];
-    let mut ring: Vec<usize> = Vec::new();
-    for &f in &flats {
-        let f = f as usize;
-        each_neighbour(f, w, h, |k| {
-            if class[k] & DRAINS != 0 && filled[k] == filled[f] && grad[k] == 0 {
-                grad[k] = 1;
-                ring.push(k);
-            }
-        });
-    }
-    let is_flat = |k: usize| class[k] & FLAT != 0;
-    let mut step = 1;
-    let mut next = Vec::new();
-    while !ring.is_empty() {
-        step += 1;
-        for &c in &ring {
-            each_neighbour(c, w, h, |k| {
-                if is_flat(k) && grad[k] == 0 && filled[k] == filled[c] {
-                    grad[k] = step;
-                    next.push(k);
-                }
-            });
-        }
-        std::mem::swap(&mut ring, &mut next);
-        next.clear();
-    }
-    // Away from higher terrain: breadth-first from the high edges, then
-    // inverted within each flat.
-    let mut higher = vec![0u32; w * h];
-    ring.extend(
-        flats
-            .iter()
-            .map(|&f| f as usize)
-            .filter(|&f| class[f] & HIGHER != 0),
+    let grid = Grid {
+        filled,
+        class: &class,
+        offsets,
+        w,
+        h,
+    };
+    // Three independent sweeps: two cores run them side by side.
+    let ((label, labels), (mut grad, higher)) = rayon::join(
+        || grid.label(&flats),
+        || rayon::join(|| grid.towards_lower(&flats), || grid.from_higher(&flats)),
     );
-    for &c in &ring {
-        higher[c] = 1;
-    }
-    let mut step = 1;
-    while !ring.is_empty() {
-        step += 1;
-        for &c in &ring {
-            each_neighbour(c, w, h, |k| {
-                if is_flat(k) && higher[k] == 0 {
-                    higher[k] = step;
-                    next.push(k);
-                }
-            });
-        }
-        std::mem::swap(&mut ring, &mut next);
-        next.clear();
-    }
     let mut top = vec![0u32; labels as usize + 1];
     for &f in &flats {
         let f = f as usize;

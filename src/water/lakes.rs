@@ -71,6 +71,7 @@ pub fn find(
     }
     let raised = |i: usize| filled[i] > original[i] && !sea.is_some_and(|m| m[i]);
     let mut seen = vec![false; n];
+    let offsets: [isize; 8] = super::d8::CLOCKWISE.map(|(dx, dy, _)| dy * w as isize + dx);
     let (mut lakes, mut below_thresholds) = (Vec::new(), 0);
     let mut body = Vec::new();
     let mut stack = Vec::new();
@@ -84,13 +85,10 @@ pub fn find(
         body.clear();
         while let Some(c) = stack.pop() {
             body.push(c);
-            let (x, y) = (c % w, c / w);
-            for &(dx, dy, _) in &super::d8::CLOCKWISE {
-                if let Some(k) = crate::procedural::grid::neighbour(x, y, dx, dy, w, h)
-                    && !seen[k]
-                    && filled[k] == level
-                    && raised(k)
-                {
+            // Raised cells are interior (the border is never raised).
+            for o in offsets {
+                let k = c.wrapping_add_signed(o);
+                if !seen[k] && filled[k] == level && raised(k) {
                     seen[k] = true;
                     stack.push(k);
                 }
