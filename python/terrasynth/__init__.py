@@ -22,6 +22,7 @@ from ._native import (
     read_heightfield,
     synthesize,
     synthesize_scene,
+    water,
     write_heightfield,
 )
 
@@ -34,5 +35,6 @@ __all__ = [
     "read_heightfield",
     "synthesize",
     "synthesize_scene",
+    "water",
     "write_heightfield",
 ]
