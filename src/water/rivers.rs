@@ -147,6 +147,12 @@ pub fn trace(receivers: &[u32], acc: &[u32], class: &[u8], threshold: u32) -> Ri
             }
             path.push(r as u32);
             if donors[r] != 1 {
+                // A confluence on a border outlet starts no segment of its
+                // own (it would be one cell): the rivers end there.
+                if receivers[r] == OUTLET {
+                    c = r;
+                    break End::Border;
+                }
                 break End::Confluence;
             }
             c = r;
