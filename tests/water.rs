@@ -61,8 +61,8 @@ fn assert_accumulation_sums(w: &Water) {
             expected[r as usize] += w.accumulation[c] as u64;
         }
     }
-    for c in 0..n {
-        assert_eq!(w.accumulation[c] as u64, expected[c], "cell {c}");
+    for (c, (&a, &e)) in w.accumulation.iter().zip(&expected).enumerate() {
+        assert_eq!(a as u64, e, "cell {c}");
     }
     let outlets: u64 = (0..n)
         .filter(|&c| w.receivers[c] == OUTLET)
@@ -83,7 +83,7 @@ fn a_pit_fills_to_its_exact_spill_level() {
         let pit = if r < 10.0 { -20.0 + 2.0 * r } else { 0.0 };
         (100.0 - 0.25 * x as f64 + rim + pit) as f32
     };
-    let mut hf = Heightfield::from_fn(n, n, cell, |x, y| bowl(x, y)).unwrap();
+    let mut hf = Heightfield::from_fn(n, n, cell, bowl).unwrap();
     // The notch: the rim's cells on row 32 east of the bowl drop to just
     // above the plane.
     for x in 42..=45 {

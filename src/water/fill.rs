@@ -1,5 +1,5 @@
 //! Depression filling by priority-flood (Barnes, Lehman & Mulla 2014,
-//! "Priority-Flood", Algorithm 2 with the plain queue for pit cells): the
+//! "Priority-Flood", Algorithm 2 with its own queue for pit cells): the
 //! flood starts from every border cell (and every sea cell), always grows
 //! from the lowest cell of its edge, and raises each cell it reaches below
 //! that level to it. Every cell ends at the lowest level at which water
@@ -20,7 +20,6 @@
 
 use super::d8::CLOCKWISE;
 use crate::procedural::grid::neighbour;
-use std::collections::VecDeque;
 
 /// Order-preserving key of a finite height: `a < b ⇔ key(a) < key(b)`.
 fn key(z: f32) -> u32 {
@@ -154,10 +153,13 @@ pub fn priority_flood(
         seed(y * w + w - 1, BORDER, &z, &mut closed);
     }
     let offsets: [isize; 8] = CLOCKWISE.map(|(dx, dy, _)| dy * w as isize + dx);
-    let mut pit: VecDeque<u32> = VecDeque::new();
+    // Cells raised to the current level. Barnes' queue is FIFO, but every
+    // cell in it has the same level (it empties before the next pop), so
+    // the order is free: a stack keeps the cells just read in cache.
+    let mut pit: Vec<u32> = Vec::new();
     let mut slope: Vec<u32> = Vec::new();
     loop {
-        let entry = match pit.pop_front().or_else(|| slope.pop()) {
+        let entry = match pit.pop().or_else(|| slope.pop()) {
             Some(c) => c,
             None => match open.pop() {
                 Some((_, c)) => {
@@ -179,7 +181,7 @@ pub fn priority_flood(
             let zn = z[nb];
             if zn <= zc {
                 z[nb] = zc;
-                pit.push_back(nb as u32);
+                pit.push(nb as u32);
             } else if offsets.iter().all(|&o| {
                 let m = nb.wrapping_add_signed(o);
                 is_closed(closed, m) || z[m] > zn

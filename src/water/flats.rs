@@ -16,9 +16,9 @@
 //!   the sea) next to a flat cell of its height;
 //! - a **high edge** is a flat cell with a higher neighbour;
 //! - `towards_lower` = 1 on low edges, +1 per 8-connected step into the flat;
-//!   `from_higher` = 1 on high edges, +1 per step, then inverted within
+//!   `away_from_higher` = 1 on high edges, +1 per step, then inverted within
 //!   each flat (its largest value minus it; unreached cells keep 0);
-//! - gradient = 2 × towards_lower + from_higher (low edges: 2).
+//! - gradient = 2 × towards_lower + away_from_higher (low edges: 2).
 
 use super::d8::CLOCKWISE;
 use crate::procedural::grid::neighbour;
@@ -124,7 +124,7 @@ impl Grid<'_> {
 
     /// Steps from the high edges (1 on them), breadth-first through the
     /// flats; 0 where none is reached.
-    fn from_higher(&self, flats: &[u32]) -> Vec<u32> {
+    fn away_from_higher(&self, flats: &[u32]) -> Vec<u32> {
         let mut higher = vec![0u32; self.class.len()];
         let mut ring: Vec<usize> = flats
             .iter()
@@ -202,7 +202,12 @@ pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Opt
     // Three independent sweeps: two cores run them side by side.
     let ((label, labels), (mut grad, higher)) = rayon::join(
         || grid.label(&flats),
-        || rayon::join(|| grid.towards_lower(&flats), || grid.from_higher(&flats)),
+        || {
+            rayon::join(
+                || grid.towards_lower(&flats),
+                || grid.away_from_higher(&flats),
+            )
+        },
     );
     let mut top = vec![0u32; labels as usize + 1];
     for &f in &flats {
@@ -239,7 +244,7 @@ mod tests {
         let g = gradient(&z, w, h, None).unwrap();
         let row: Vec<u32> = (0..w).map(|x| g[w + x]).collect();
         // The border cell is the low edge (2); towards_lower 2..6 doubled,
-        // from_higher is 1 everywhere (all touch the walls): inverted 0.
+        // away_from_higher is 1 everywhere (all touch the walls): inverted 0.
         assert_eq!(row, vec![2, 4, 6, 8, 10, 12, 0]);
     }
 }

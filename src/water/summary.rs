@@ -70,8 +70,7 @@ impl Water {
                 area_km2: cells.len() as f64 * cell_area / 1e6,
                 volume_m3: cells
                     .iter()
-                    .map(|&i| self.bodies.depth[i] as f64 * cell_area)
-                    .sum(),
+                    .fold(0.0, |v, &i| v + self.bodies.depth[i] as f64 * cell_area),
             }
         });
         let lakes = &self.bodies.lakes;
@@ -93,8 +92,9 @@ impl Water {
             sea,
             lakes: Lakes {
                 count: lakes.len(),
-                area_km2: lakes.iter().map(|l| l.area_km2).sum(),
-                volume_m3: lakes.iter().map(|l| l.volume_m3).sum(),
+                // Folds from +0.0: an empty f64 sum is −0.0.
+                area_km2: lakes.iter().fold(0.0, |a, l| a + l.area_km2),
+                volume_m3: lakes.iter().fold(0.0, |v, l| v + l.volume_m3),
                 min_depth_m: self.params.lakes.min_depth_m,
                 min_area_km2: self.params.lakes.min_area_km2,
                 below_thresholds: self.bodies.below_thresholds,
