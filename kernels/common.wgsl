@@ -1,7 +1,7 @@
 // Shared by every kernel: the source of each stage is this file followed by
 // the stage's own (see src/backend/kernels.rs; WGSL has no includes).
 //
-// Mirrors src/hash.rs (stateless PCG hash) and src/synth/fixed.rs (fixed-point
+// Mirrors src/hash.rs (stateless PCG hash) and src/level/fixed.rs (fixed-point
 // coordinates, rounding rules) bit for bit (DESIGN §6). Integer arithmetic
 // only: u32 multiplies and adds wrap as Rust's `wrapping_*` do, `>>` on i32
 // is arithmetic like Rust's, and no shift amount ever reaches 32.
@@ -13,7 +13,7 @@ const ONE: i32 = 256;
 // Texels kept between synthesis coordinates and exemplar edges (layout::MARGIN).
 const MARGIN: i32 = 2;
 
-// Per-column addressing of one atlas level (synth::atlas::Column).
+// Per-column addressing of one atlas level (level::atlas::Column).
 struct Column {
     base: i32,
     stride: u32,

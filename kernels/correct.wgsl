@@ -1,9 +1,9 @@
 // Stage `correct`, one subpass (paper eq. 3–7, and the controls of §5): the
-// mirror of src/synth/stages/correct/scalar.rs (`correct_pixel_guided`),
+// mirror of src/stages/correct/scalar.rs (`correct_pixel_guided`),
 // function for function, one invocation per pixel of the parity class
 // (p.px, p.py). Each control is on when its flag is set; without flags the
 // guide binding is a placeholder and never read. See the Rust module docs of
-// src/synth/stages/correct.rs for the arithmetic (N_S kept ×3, h by floor
+// src/stages/correct.rs for the arithmetic (N_S kept ×3, h by floor
 // division, residuals clamped to ±CLAMP so a κ = 2 score fits a u32, ties
 // keep the earlier candidate).
 //
@@ -67,7 +67,7 @@ const F_COHERENCE: u32 = 4u;
 // default of 8 storage buffers per stage.
 @group(0) @binding(6) var<storage, read> type_data: array<u32>;
 
-// Control inputs per pixel (kernels::GuideCell): the blend::Target
+// Control inputs per pixel (uniform::GuideCell): the nudge::Target
 // (height, tol), R^i, W^i, and the previous frame's S and V.
 struct GuideCell {
     blend_target: vec2<i32>,
@@ -105,7 +105,7 @@ fn parent_offset(x: u32, y: u32) -> i32 {
 }
 
 // correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight;
-// types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; blend::MAX_ERROR.
+// types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; nudge::MAX_ERROR.
 const ALL_TYPES: u32 = 4294967295u;
 const W_FREE: u32 = 4u;
 const SEEDS_PER_ALLOWED_TYPE: u32 = 9u;
@@ -411,7 +411,7 @@ fn phi(x_in: i32, tol: i32) -> i32 {
     return i32(mag);
 }
 
-// blend::nudge.
+// nudge::nudge.
 fn nudge(v: i32, h_c: i32, goal: vec2<i32>) -> i32 {
     if (goal.y < 0) {
         return v;

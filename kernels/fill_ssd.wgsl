@@ -1,12 +1,12 @@
 // Stage `fill_ssd` of the patch engine (round one of hole filling, seed 004
-// §6.2): the mirror of src/patch/costs.rs (`fill_sums`, the sums under
+// §6.2): the mirror of src/stages/fill_ssd.rs (the sums under
 // `fill_ssd_scalar`), one invocation per (candidate, transform). For
 // d = (user − cand) & mask over the cells it writes s = Σd and s2 = Σd².
 // Cells are centred and clamped to ±FILL_CLAMP on the host, so |d| < 2^14,
 // d² < 2^28 and |s| < 2^24 for up to 1024 cells; s2 can pass 2^32, so it is
 // kept as a 64-bit value in two u32 words with an explicit carry. The host
 // finishes the DC-corrected SSD (k·s2 − s²) / k² in 64 bits, as the CPU
-// path does (`costs::dc_ssd`): WGSL has no 64-bit division.
+// path does (`fill_ssd::dc_ssd`): WGSL has no 64-bit division.
 
 struct FillSsdParams {
     // Cells per candidate, (patch / COARSE)².

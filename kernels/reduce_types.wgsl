@@ -1,4 +1,4 @@
-// Stage `reduce_types`: the mirror of src/synth/stages/reduce_types.rs — each
+// Stage `reduce_types`: the mirror of src/stages/reduce_types.rs — each
 // pixel's target set is the union of its 2×2 children's sets, leaving out
 // children whose set is full (ALL_TYPES or every type of the database);
 // no constrained child leaves the pixel unconstrained (ALL_TYPES). Children

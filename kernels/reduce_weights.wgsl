@@ -1,4 +1,4 @@
-// Stage `reduce_weights`: the mirror of src/synth/stages/reduce_weights.rs —
+// Stage `reduce_weights`: the mirror of src/stages/reduce_weights.rs —
 // a pixel is frozen (0) if any of its 2×2 children is, else it takes the
 // most frequent child weight (clamped to 4), ties going to the larger.
 // Children past the child level's edge are absent; a pixel with none gets 4

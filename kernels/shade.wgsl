@@ -1,4 +1,4 @@
-// Stage `shade` (preview): the mirror of src/render/shade/, function for
+// Stage `shade` (preview): the mirror of src/stages/shade.rs, function for
 // function, one invocation per preview pixel. Integer arithmetic on 32-bit
 // values only, with the bounds the Rust side documents and
 // `ShadeParams::validate` checks before any dispatch.

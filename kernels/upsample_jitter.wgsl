@@ -1,5 +1,5 @@
 // Stage `upsample_jitter` (paper eq. 1–2): the mirror of
-// src/synth/stages/upsample_jitter.rs, one invocation per child pixel.
+// src/stages/upsample_jitter.rs, one invocation per child pixel.
 
 // Step kinds (upsample_jitter::Step).
 const STEP_PYRAMID: u32 = 0u;

@@ -40,3 +40,22 @@ pub mod water;
 pub use error::{Error, Result};
 pub use heightfield::{Georef, Heightfield, Stats};
 pub use size::SizeError;
+
+/// The file `name` of the shared DEMs (`../shared/dem`, beside the
+/// repository) for the unit tests that read one; `None`, saying so, when it
+/// is absent — a failure under `TERRASYNTH_REQUIRE_DEM`, as in the
+/// integration tests (`tests/common/dem.rs`), so CI cannot pass by skipping.
+#[cfg(test)]
+pub(crate) fn shared_dem(name: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem")).join(name);
+    if p.exists() {
+        return Some(p);
+    }
+    assert!(
+        std::env::var_os("TERRASYNTH_REQUIRE_DEM").is_none_or(|v| v.is_empty()),
+        "TERRASYNTH_REQUIRE_DEM is set but {} is absent",
+        p.display()
+    );
+    eprintln!("{} not found: skipped", p.display());
+    None
+}

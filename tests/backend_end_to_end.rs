@@ -17,7 +17,7 @@ use terrasynth::synth::{Params, Synthesizer};
 
 mod common;
 use common::db::{PYRENEES_JURA, default_db, two_dems};
-use common::dem::DEM;
+use common::dem;
 
 /// The shared device, or `None` without an adapter (see `common::gpu`).
 fn ctx() -> Option<Arc<Context>> {
@@ -151,11 +151,7 @@ fn sketch_synthesis_matches_end_to_end() {
     }
     let mut src = Vec::new();
     for name in ["pyrenees_andorra", "thuringia_hills"] {
-        let Ok(hf) = terrasynth::io::read(
-            &Path::new(DEM).join(format!("{name}.png")),
-            &Default::default(),
-        ) else {
-            eprintln!("skipping: the shared DEMs are not in {DEM}");
+        let Some(hf) = dem::heights(name, "the real-DEM sketch cross-check") else {
             return;
         };
         src.push((name.to_string(), hf.crop(200, 200, 256, 256).unwrap()));

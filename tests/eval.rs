@@ -160,10 +160,7 @@ const CROP: (&str, (usize, usize, usize, usize)) = ("pyrenees_andorra", (100, 10
 fn crop_db() -> Option<&'static (ExemplarInput, Database)> {
     static DB: OnceLock<Option<(ExemplarInput, Database)>> = OnceLock::new();
     DB.get_or_init(|| {
-        let Some(ex) = dem::exemplar(CROP.0, CROP.1, true) else {
-            eprintln!("skipping: shared DEMs not found in {}", dem::DEM);
-            return None;
-        };
+        let ex = dem::exemplar(CROP.0, CROP.1, true)?;
         let (db, _) = database::build(vec![ex.clone()], &BuildOptions::default(), &Silent).unwrap();
         Some((ex, db))
     })
@@ -199,7 +196,7 @@ fn fbm_like(reference: &Heightfield, seed: u32) -> Heightfield {
 }
 
 #[test]
-fn a_jitter_free_copy_scores_about_one_and_fbm_far_above() {
+fn a_copy_scores_below_one_the_synthesis_meets_the_targets_fbm_fails() {
     let Some((ex, db)) = crop_db() else { return };
     let reference = Reference::new(&ex.heights).unwrap();
     let (w, h) = (ex.heights.width(), ex.heights.height());
@@ -218,15 +215,25 @@ fn a_jitter_free_copy_scores_about_one_and_fbm_far_above() {
         .unwrap()
         .synthesize(w, h, 11)
         .unwrap();
-    let jitter_ratio = reference.compare(&describe(&jittered).unwrap()).ratio;
+    let synth = reference.compare(&describe(&jittered).unwrap());
     let fbm = fbm_like(&ex.heights, 3);
     let c = reference.compare(&describe(&fbm).unwrap());
     eprintln!(
-        "ratios: jitter-0 copy {copy_ratio:.2}, default synthesis {jitter_ratio:.2}, fBm {:.2}",
-        c.ratio
+        "ratios: jitter-0 copy {copy_ratio:.2}, default synthesis {:.2}, fBm {:.2}; \
+         relief kept: synthesis {:.2}, fBm {:.2}; median slope against the exemplar's: \
+         synthesis {:.2}, fBm {:.2}",
+        synth.ratio,
+        c.ratio,
+        synth.relief.ratio,
+        c.relief.ratio,
+        synth.median_slope.ratio,
+        c.median_slope.ratio
     );
-    // Measured: 0.33, 1.05 and 6.44 (2.97 for the synthesis before the
-    // height prior and block start of issue 14).
+    // Measured (seed 11): ratios 0.41, 1.73 and 6.44; relief kept 0.93 and
+    // 1.35, median slope ×0.94 and ×0.56. Over seeds 11–18 the synthesis
+    // scores 1.33–1.94, relief 0.82–0.97, slope ×0.92–0.96: on this small
+    // crop it misses issue 14's ratio target (≤ 1.2), which the README
+    // reports met at the exemplars' full size (0.41–0.96 on 7 of 8).
     assert!(
         copy_ratio <= 1.0,
         "a copy of the exemplar: ratio {copy_ratio}"
@@ -236,6 +243,27 @@ fn a_jitter_free_copy_scores_about_one_and_fbm_far_above() {
         "fBm matched in σ: ratio {} (copy {copy_ratio})",
         c.ratio
     );
+    // The default synthesis is realistic by the bounds below; fBm matched
+    // in mean and σ is not.
+    if let Err(e) = realistic(&synth) {
+        panic!("the default synthesis: {e}");
+    }
+    assert!(realistic(&c).is_err(), "fBm passes for real terrain");
+}
+
+/// Realism bounds from issue 14's targets (README, *Where the engine goes
+/// beyond the paper*): relief (1st–99th percentile) at least 85 % of the
+/// exemplar's, median slope within 10 % of its; and a realism ratio below
+/// 2, nearer the exemplar than another real range scores (2–7, README
+/// *Measuring realism*) — the target of ≤ 1.2 is not met on this crop.
+fn realistic(c: &eval::Comparison) -> Result<(), String> {
+    let (r, relief, slope) = (c.ratio, c.relief.ratio, c.median_slope.ratio);
+    if r >= 2.0 || relief < 0.85 || (slope - 1.0).abs() > 0.1 {
+        return Err(format!(
+            "ratio {r:.2}, relief kept {relief:.2}, median slope ×{slope:.2}"
+        ));
+    }
+    Ok(())
 }
 
 /// The baseline compares the top half with the bottom half: 0 when they
@@ -283,8 +311,8 @@ fn coordinates_maps_are_exact_and_round_trip() {
                 let c = l0.coords[y * l0.width + x];
                 let s = map.sources[y * w + x];
                 let (tx, ty) = (
-                    terrasynth::synth::fixed::round(c.x),
-                    terrasynth::synth::fixed::round(c.y),
+                    terrasynth::level::fixed::round(c.x),
+                    terrasynth::level::fixed::round(c.y),
                 );
                 assert_eq!(
                     (s.exemplar, s.x as i32, s.y as i32),
@@ -426,7 +454,6 @@ fn bad_inputs_get_clear_errors() {
 #[test]
 fn novelty_sees_copies_and_not_real_terrain() {
     let Some(ex) = dem::exemplar("pyrenees_andorra", (0, 0, 888, 888), false) else {
-        eprintln!("skipping: shared DEMs not found in {}", dem::DEM);
         return;
     };
     let p = novelty::Params::default();

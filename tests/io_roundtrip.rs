@@ -115,11 +115,10 @@ proptest! {
 /// writable format and back within that format's precision.
 #[test]
 fn shared_dems_convert_through_every_format() {
-    let dir = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem"));
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        println!("SKIP: {} is absent", dir.display());
+    let Some(dir) = common::dem::dir("the shared-DEM round trips") else {
         return;
     };
+    let entries = std::fs::read_dir(dir).unwrap();
     let mut dems: Vec<_> = entries
         .map(|e| e.unwrap().path())
         .filter(|p| {

@@ -4,21 +4,15 @@
 
 use std::path::Path;
 use terrasynth::Heightfield;
-use terrasynth::io::{self, ReadOptions};
 use terrasynth::patch::sketch::Sketch;
 use terrasynth::patch::{self, Library, Params, cache};
 use terrasynth::progress::Silent;
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
 
 /// A 256² crop of one shared DEM, or None (with a message) without it.
 fn source() -> Option<Vec<(String, Heightfield)>> {
-    let p = Path::new(DEM).join("thuringia_hills.png");
-    if !p.exists() {
-        eprintln!("skipping: {} not found", p.display());
-        return None;
-    }
-    let hf = io::read(&p, &ReadOptions::default()).unwrap();
+    let hf = common::dem::heights("thuringia_hills", "the patch cache tests")?;
     Some(vec![(
         "thuringia_hills".to_string(),
         hf.crop(100, 100, 256, 256).unwrap(),

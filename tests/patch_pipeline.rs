@@ -5,23 +5,17 @@
 
 use std::path::Path;
 use terrasynth::Heightfield;
-use terrasynth::io::{self, ReadOptions};
 use terrasynth::patch::sketch::{Kind, Sketch, SketchError};
 use terrasynth::patch::{self, Library, Params};
 use terrasynth::progress::Silent;
 
-const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");
+mod common;
 
 /// 256² crops of two DEMs, or None (with a message) without ../shared/dem.
 fn sources() -> Option<Vec<(String, Heightfield)>> {
     let mut out = Vec::new();
     for name in ["pyrenees_andorra", "thuringia_hills"] {
-        let p = Path::new(DEM).join(format!("{name}.png"));
-        if !p.exists() {
-            eprintln!("skipping: {} not found", p.display());
-            return None;
-        }
-        let hf = io::read(&p, &ReadOptions::default()).unwrap();
+        let hf = common::dem::heights(name, "the patch pipeline tests")?;
         out.push((name.to_string(), hf.crop(200, 200, 256, 256).unwrap()));
     }
     Some(out)

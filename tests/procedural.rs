@@ -12,6 +12,8 @@ use terrasynth::procedural::types::TerrainType;
 use terrasynth::procedural::*;
 use terrasynth::progress::Silent;
 
+mod common;
+
 /// A rough test terrain: fBm in metres on a `n`² grid of `cell` metres.
 fn terrain(n: usize, cell: f64, relief: f64, seed: u32) -> Heightfield {
     let f = Fractal {
@@ -313,6 +315,17 @@ fn hydraulic_erosion_moves_material_downhill() {
     assert!(((total(&hf) - total(&before)) / total(&before).abs()).abs() < 1e-6);
     let (lo, hi) = (before.stats().unwrap(), hf.stats().unwrap());
     assert!(hi.max <= lo.max, "erosion must not raise the highest peak");
+    // Downhill: the change falls with the height it started at; the
+    // highest tenth of the ground loses height, the lowest tenth gains.
+    let mut dh: Vec<(f64, f64)> = (before.data().iter().zip(hf.data()))
+        .map(|(&a, &b)| (a as f64, (b - a) as f64))
+        .collect();
+    dh.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mean = |s: &[(f64, f64)]| s.iter().map(|p| p.1).sum::<f64>() / s.len() as f64;
+    let (t, r) = (dh.len() / 10, common::correlation(&dh));
+    let (low, high) = (mean(&dh[..t]), mean(&dh[dh.len() - t..]));
+    println!("corr(h, Δh) {r:.3}; Δh: lowest tenth {low:+.3} m, highest {high:+.3} m");
+    assert!(r < 0.0 && high < 0.0 && low > 0.0, "{r} {high} {low}");
 }
 
 #[test]

@@ -11,13 +11,7 @@ use terrasynth::Heightfield;
 use terrasynth::render::{Grid, RenderOptions, TypeMask, TypeOverlay, render};
 
 fn dem_dir() -> Option<PathBuf> {
-    let d = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem"));
-    if d.is_dir() {
-        Some(d.to_path_buf())
-    } else {
-        eprintln!("skipping: {} is absent", d.display());
-        None
-    }
+    common::dem::dir("the shared-DEM previews").map(Path::to_path_buf)
 }
 
 #[test]

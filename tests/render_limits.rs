@@ -8,11 +8,11 @@ use common::render::plain;
 use proptest::prelude::*;
 use terrasynth::Heightfield;
 use terrasynth::render::prepare::UNITS_PER_M;
-use terrasynth::render::shade::{self, flags};
 use terrasynth::render::{
     Contours, Grid, Lighting, RenderError, RenderOptions, Sea, TypeMask, TypeOverlay, prepare,
     render,
 };
+use terrasynth::stages::shade::{self, flags};
 
 #[test]
 fn type_mask_must_match_the_heightfield() {

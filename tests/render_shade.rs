@@ -7,11 +7,11 @@ mod common;
 use common::render::{GREY, plain, px, west_light};
 use terrasynth::Heightfield;
 use terrasynth::render::prepare::{NODATA_COLOUR, NODATA_HATCH, RANGE_COLOUR, UNITS_PER_M};
-use terrasynth::render::shade::{self, ShadeParams};
 use terrasynth::render::tint::{WATER_SHALLOW, pack};
 use terrasynth::render::{
     Contours, Grid, RenderError, RenderOptions, Sea, TypeMask, TypeOverlay, prepare, render,
 };
+use terrasynth::stages::shade::{self, ShadeParams};
 
 #[test]
 fn params_layout_suits_a_wgsl_uniform() {

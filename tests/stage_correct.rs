@@ -193,40 +193,48 @@ fn random_guide_inputs(
     (targets, prev, weights, allowed, window)
 }
 
+/// Cases of the two guided proptests below, each of which runs all 16
+/// combinations of the guides on every case (drawn once per case, as they
+/// were, 24 cases left each combination a (15/16)^24 ≈ 21 % chance never
+/// to run).
+const COMBINATION_CASES: u32 = 6;
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(24))]
+    #![proptest_config(ProptestConfig::with_cases(COMBINATION_CASES))]
 
     /// Geometric targets, coherence, type sets and windows over the
-    /// default database, every subpass at every prior.
+    /// default database — each of the 16 combinations of them on each
+    /// case — every subpass at every prior.
     #[test]
     fn guided_correct_agrees_at_every_prior(
         level in 0usize..3,
         w in 2usize..70,
         h in 2usize..40,
         seed in any::<u64>(),
-        which in 0u8..16,
     ) {
         let rig = rig(default_db());
         let atlas = &rig.atlas[level];
         let st = patchy_state(atlas, w, h, seed);
         let (targets, prev, weights, allowed, window) = random_guide_inputs(atlas, w, h, seed);
         let (coords, offsets) = (prev.coords(), prev.offsets());
-        let g = Guide {
-            level: level as u32,
-            targets: (which & 1 != 0).then_some(&targets[..]),
-            coherence: (which & 2 != 0).then_some(Coherence {
-                coords: &coords,
-                offsets: &offsets,
-                weights: &weights,
-            }),
-            allowed: (which & 4 != 0).then_some(&allowed[..]),
-            window: (which & 8 != 0).then_some(window),
-            // Windowed synthesis: type seeding hashes absolute coordinates.
-            origin: [(seed as u32 % 4096) * 2, (seed >> 32) as u32 % 4096 * 2],
-        };
         let parent = patchy_parent(atlas, w, h, seed);
-        let what = format!("guided {which:04b} {w}x{h} at level {level}");
-        rig.correct_at_every_prior(level, (&st, Some(&parent)), Some(&g), &what);
+        for which in 0u8..16 {
+            let g = Guide {
+                level: level as u32,
+                targets: (which & 1 != 0).then_some(&targets[..]),
+                coherence: (which & 2 != 0).then_some(Coherence {
+                    coords: &coords,
+                    offsets: &offsets,
+                    weights: &weights,
+                }),
+                allowed: (which & 4 != 0).then_some(&allowed[..]),
+                window: (which & 8 != 0).then_some(window),
+                // Windowed synthesis: type seeding hashes absolute coordinates.
+                origin: [(seed as u32 % 4096) * 2, (seed >> 32) as u32 % 4096 * 2],
+            };
+            let what = format!("guided {which:04b} {w}x{h} at level {level}");
+            rig.correct_at_every_prior(level, (&st, Some(&parent)), Some(&g), &what);
+        }
     }
 
     /// Random states, targets (some unconstrained, tolerances 0..MAX_TOL,
@@ -236,7 +244,6 @@ proptest! {
     #[test]
     fn guided_correct_agrees_on_random_guides_of_shared_dems(
         w in 2usize..40, h in 2usize..40, level_pick in 0usize..8, sub in 0usize..4,
-        flags in 0u32..8, windowed in any::<bool>(),
         bits in prop::collection::vec(any::<u32>(), 64),
     ) {
         let Some(db) = two_dems(RIVIERA_PYRENEES, "random-guide correct cross-checks") else {
@@ -264,27 +271,31 @@ proptest! {
         }).collect();
         let weights: Vec<u8> = (0..w * h).map(|i| (b(i, 5) % 6) as u8).collect();
         let (coords, offsets) = (prev.coords(), prev.offsets());
-        let window = windowed.then(|| {
-            let (x0, y0) = (b(0, 6) as usize % w, b(0, 7) as usize % h);
-            [x0, y0, x0 + 1 + b(0, 8) as usize % w, y0 + 1 + b(0, 9) as usize % h]
-        });
-        let g = Guide {
-            level: level as u32,
-            targets: (flags & 1 != 0).then_some(&targets[..]),
-            allowed: (flags & 2 != 0).then_some(&allowed[..]),
-            coherence: (flags & 4 != 0).then_some(Coherence { coords: &coords, offsets: &offsets, weights: &weights }),
-            window,
-            // Windowed synthesis: type seeding hashes absolute coordinates.
-            origin: [b(0, 10) % 65536 * 2, b(0, 11) % 65536 * 2],
-        };
         let (px, py) = SUBPASSES[sub];
         let parent = random_state(a, w.div_ceil(2), h.div_ceil(2), &bits, 0x5EED);
         let prior = PRIORS[bits[5] as usize % PRIORS.len()];
         let similar = bits[5] >> 16 & 1 == 1;
         let p = CorrectParams { px, py, prior, similar };
-        let runs = rig.correct(level, (&st, Some(&parent)), &p, Some(&g));
-        let what = format!("random {w}×{h} level {level} flags {flags} prior {prior} C₂ {similar}");
-        assert_agree(&runs, &what);
+        // Targets, types, coherence (flags' bits 0–2) and a window (bit 3):
+        // all 16 combinations on each case.
+        for flags in 0u32..16 {
+            let window = (flags & 8 != 0).then(|| {
+                let (x0, y0) = (b(0, 6) as usize % w, b(0, 7) as usize % h);
+                [x0, y0, x0 + 1 + b(0, 8) as usize % w, y0 + 1 + b(0, 9) as usize % h]
+            });
+            let g = Guide {
+                level: level as u32,
+                targets: (flags & 1 != 0).then_some(&targets[..]),
+                allowed: (flags & 2 != 0).then_some(&allowed[..]),
+                coherence: (flags & 4 != 0).then_some(Coherence { coords: &coords, offsets: &offsets, weights: &weights }),
+                window,
+                // Windowed synthesis: type seeding hashes absolute coordinates.
+                origin: [b(0, 10) % 65536 * 2, b(0, 11) % 65536 * 2],
+            };
+            let runs = rig.correct(level, (&st, Some(&parent)), &p, Some(&g));
+            let what = format!("random {w}×{h} level {level} flags {flags:04b} prior {prior} C₂ {similar}");
+            assert_agree(&runs, &what);
+        }
     }
 }
 

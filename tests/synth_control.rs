@@ -16,16 +16,17 @@ use terrasynth::synth::session::{Edit, Session};
 
 mod common;
 use common::db::{PYRENEES_CATALAN, two_dems};
-use common::dem::{self, DEM};
+use common::dem;
 /// The output side, the crops' side.
 const N: usize = PYRENEES_CATALAN.side;
 /// Least slope across sloped points (median and least of the twenty sites
 /// of `point_constraint_sets_height_and_slope`, degrees; 20° asked).
 /// Measured on ten of them: 16.2° and 13.5° since a sloped point holds its
 /// plane over its whole reach, 11.4° and 4.3° under the paper's level cap;
-/// on the twenty with the Z-ordered coarse start, 15.9° and 13.4°.
-const SLOPE_MEDIAN_MIN: f64 = 14.0;
-const SLOPE_MIN: f64 = 10.0;
+/// on the twenty with the Z-ordered coarse start, 15.9° and 13.4°; with
+/// the pieces of issue 46, 17.3° and 14.1° (the bounds keep ~2° of room).
+const SLOPE_MEDIAN_MIN: f64 = 15.0;
+const SLOPE_MIN: f64 = 12.0;
 
 fn db() -> Option<&'static Database> {
     two_dems(PYRENEES_CATALAN, "control tests on real DEMs")
@@ -83,9 +84,9 @@ fn point_constraint_sets_height_and_slope() {
     // are closer (1.59 → 1.42 %), so ten sites were too few to judge by.
     // Since pixels held hard take their whole error (`nudge::phi`, t = 0:
     // a site's own coarse pixel), mean 1.13 %, and the worst site (a
-    // target 2285 m high, seed 7) 3.56 % where it was 2.85 %: the bound on
-    // the worst is 4 % (it was 3.5 %; over the 144 points of the Pyrenees
-    // probe, mean and worst did not move).
+    // target 2285 m high, seed 7) 3.56 % where it was 2.85 %; with the
+    // coarse start's pieces (issue 46) mean 1.24 %, worst 2.65 % (seed 12,
+    // the raised point), and the bound on the worst is 3.5 % again.
     let Some(db) = db() else { return };
     let rel = relief(db);
     let mut errors = Vec::new();
@@ -151,7 +152,7 @@ fn point_constraint_sets_height_and_slope() {
         mean * 100.0
     );
     assert!(
-        worst <= 0.04,
+        worst <= 0.035,
         "a site height off by {:.2}% of relief",
         worst * 100.0
     );
@@ -182,7 +183,7 @@ fn painted_types_take_their_coordinates_from_that_type() {
     let share = |s: &Session<'_>| {
         let f = s.frames().unwrap();
         let lvl = db.level(2);
-        let atlas = terrasynth::synth::atlas::AtlasLevel::new(db, 2);
+        let atlas = terrasynth::level::atlas::AtlasLevel::new(db, 2);
         let last = f.levels()[2].last().unwrap();
         let w = N / 4;
         let (mut inside, mut ok) = (0, 0);
@@ -500,6 +501,9 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
         "paste: {n} pixels exact; {:.2}% of far pixels moved > 1% of relief",
         far * 100.0
     );
+    // Coherence holds the rest of the frame (as for a new point, see
+    // `coherence_keeps_a_new_point_local`). Measured: 0.00 %.
+    assert!(far < 0.005, "{:.2}% of far pixels moved", far * 100.0);
 }
 
 /// Distance from (x, y) to the nearest edge of a closed polygon.
@@ -557,10 +561,6 @@ fn yosemite() -> Option<&'static Database> {
         Some(database::build(vec![input], &opts, &Silent).unwrap().0)
     })
     .as_ref()
-    .or_else(|| {
-        eprintln!("{DEM} not found: control tests on real DEMs skipped");
-        None
-    })
 }
 
 /// RMS of the 3×3 high-pass (height − its 3×3 mean) over the pixels within

@@ -340,20 +340,17 @@ mod tests {
 
     /// A 128² crop of a real DEM when ../shared is present, else synthetic.
     fn exemplar_128() -> Grid {
-        let p = std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/dem/pyrenees_andorra.png"
-        ));
-        match crate::io::read(p, &Default::default()) {
-            Ok(hf) => Grid {
+        match crate::shared_dem("pyrenees_andorra.png") {
+            Some(p) => Grid {
                 width: 128,
                 height: 128,
-                data: hf.crop(300, 300, 128, 128).unwrap().into_vec(),
+                data: crate::io::read(&p, &Default::default())
+                    .unwrap()
+                    .crop(300, 300, 128, 128)
+                    .unwrap()
+                    .into_vec(),
             },
-            Err(_) => {
-                eprintln!("{} not found: using a synthetic exemplar", p.display());
-                exemplar(128, 128, 7)
-            }
+            None => exemplar(128, 128, 7),
         }
     }
 

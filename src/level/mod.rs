@@ -4,7 +4,7 @@
 //!
 //! The leaf below `stages` and the drivers: the stages (CPU and GPU) and
 //! `synth` both work on these types, so they live under neither; `synth`
-//! re-exports them under their old paths (`synth::fixed`, …).
+//! re-exports them under their old paths (`level::fixed`, …).
 
 pub mod atlas;
 pub mod fixed;

@@ -1,8 +1,8 @@
 //! Errors of the preview renderer.
 
-use super::shade::ParamsError;
 use crate::io::IoError;
 use crate::size::SizeError;
+use crate::stages::shade::ParamsError;
 use std::path::PathBuf;
 use thiserror::Error;
 

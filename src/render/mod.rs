@@ -26,8 +26,6 @@ pub mod preview_size;
 pub mod tint;
 pub mod types;
 
-pub use crate::stages::shade;
-
 pub use compose::side_by_side;
 pub use contours::Contours;
 pub use coords::coords_preview;
@@ -38,6 +36,7 @@ pub use tint::Palette;
 pub use types::{TypeMask, TypeOverlay};
 
 use crate::heightfield::Heightfield;
+use crate::stages::shade;
 use image::RgbaImage;
 use std::path::Path;
 

@@ -8,11 +8,11 @@
 //! ([`shade::MAX_ABS_HEIGHT`]) covers the Earth with room to spare.
 
 use super::contours::{self, Contours};
-use super::shade::{self, ShadeBuffers, ShadeParams, flags};
 use super::tint::{self, pack};
 use super::types::TypeOverlay;
 use super::{Grid, Lighting, RenderError, RenderOptions, Sea, preview_size};
 use crate::heightfield::Heightfield;
+use crate::stages::shade::{self, ShadeBuffers, ShadeParams, flags};
 use rayon::prelude::*;
 
 /// Kernel height units per metre (millimetres).

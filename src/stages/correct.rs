@@ -334,7 +334,10 @@ pub struct Coherence<'a> {
     pub weights: &'a [u8],
 }
 
-/// W = 1 (unweighted) in quarters.
+/// The coherence weights W^i, in quarters (paper §5.3): 0 frozen,
+/// 1 coherent (0.25), 4 unweighted (1).
+pub const W_FROZEN: u8 = 0;
+pub const W_COHERENT: u8 = 1;
 pub const W_FREE: u8 = 4;
 
 /// Coherence cost `⌊score · w / 4⌋` without leaving 32 bits (w ≤ 4).

@@ -33,10 +33,10 @@
 //! L's hashed pieces, or the exemplar centre) is a pure function of
 //! absolute position and is computed over the top region only.
 
-use super::stages::correct::SUBPASSES;
-use super::stages::reconstruct::REACH as RECONSTRUCT_REACH;
-use super::state::{State, level_size};
 use super::window::REACH_PER_SUBPASS;
+use crate::level::state::{State, level_size};
+use crate::stages::correct::SUBPASSES;
+use crate::stages::reconstruct::REACH as RECONSTRUCT_REACH;
 
 /// A half-open rectangle `[x0, x1) × [y0, y1)` of one level's pixels, in
 /// absolute coordinates of that level.

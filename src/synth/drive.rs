@@ -5,11 +5,11 @@
 
 use super::cone::Cone;
 use super::restricted::LevelBuffers;
-use super::state::top_level;
 use super::window::{REACH_PER_SUBPASS, widen};
 use super::{Control, Frames, LevelMaps, LevelTiming, SynthError, Synthesis, Synthesizer, Timings};
 use crate::backend::{Backend, Stage};
 use crate::heightfield::Heightfield;
+use crate::level::state::top_level;
 use crate::stages::correct::SUBPASSES;
 use crate::stages::reconstruct::{self, HEIGHT_FRAC_BITS};
 use std::time::{Duration, Instant};

@@ -25,19 +25,16 @@ pub mod source_map;
 mod window;
 mod windowed;
 
-pub use crate::level::{atlas, fixed, state};
-pub use crate::stages;
-
 use crate::backend::{Backend, Choice, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
-use atlas::AtlasLevel;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::FRAC_BITS;
+use crate::level::state::{State, level_size, top_level};
+use crate::stages::correct::CorrectParams;
+use crate::stages::upsample_jitter::{Step, UpsampleParams};
 use coarse::Start;
 use cone::{Cone, Rect};
-use fixed::FRAC_BITS;
-use stages::correct::CorrectParams;
-use stages::upsample_jitter::{Step, UpsampleParams};
-use state::{State, level_size, top_level};
 use std::cell::RefCell;
 use std::sync::OnceLock;
 
@@ -81,7 +78,7 @@ impl<'db> Synthesizer<'db> {
         if params.passes > 16 {
             return Err(SynthError::Passes(params.passes));
         }
-        if !stages::correct::PRIORS.contains(&params.prior) {
+        if !crate::stages::correct::PRIORS.contains(&params.prior) {
             return Err(SynthError::Prior(params.prior));
         }
         let count = db.meta().exemplars.len();

@@ -1,10 +1,10 @@
 //! What a synthesis takes and gives: its settings, the control inputs per
 //! level, the errors it reports, and its result with per-level timings.
 
-use super::control::Target;
-use super::fixed::Coord;
 use crate::backend::BackendError;
 use crate::heightfield::Heightfield;
+use crate::level::fixed::Coord;
+use crate::stages::correct::nudge::Target;
 use std::time::Duration;
 use thiserror::Error;
 
@@ -31,7 +31,7 @@ pub struct Params {
     /// them again and again).
     pub piece_size: usize,
     /// Height prior weight P of the correction (one of
-    /// `super::stages::correct::PRIORS`; 0 is the paper's pure relative height
+    /// `crate::stages::correct::PRIORS`; 0 is the paper's pure relative height
     /// matching). See the `correct` stage's module docs.
     pub prior: u32,
     /// The finest level at which each source u also offers its most
@@ -59,7 +59,7 @@ impl Default for Params {
             passes: 2,
             start_exemplar: None,
             piece_size: DEFAULT_PIECE_SIZE,
-            prior: super::stages::correct::DEFAULT_PRIOR,
+            prior: crate::stages::correct::DEFAULT_PRIOR,
             similar_from: 1,
             keep_levels: false,
         }
@@ -81,7 +81,7 @@ pub enum SynthError {
     Jitter(f64),
     #[error("passes {0} is invalid: expected 0..=16")]
     Passes(u32),
-    #[error("height prior {0} is invalid: expected one of {list:?}", list = super::stages::correct::PRIORS)]
+    #[error("height prior {0} is invalid: expected one of {list:?}", list = crate::stages::correct::PRIORS)]
     Prior(u32),
     #[error("start exemplar {index} does not exist: the database has {count} (0..={max})", max = count - 1)]
     StartExemplar { index: usize, count: usize },

@@ -30,10 +30,10 @@
 //! [`correct::keep_outside`]: crate::stages::correct::keep_outside
 
 use super::cone::{Rect, crop, parent_view};
-use super::fixed::Coord;
 use super::window::{REACH_PER_SUBPASS, changed_bounds, double, row_bounds, union, widen};
 use super::{Control, Frames, PassResult, SynthError, Synthesizer};
 use crate::backend::Backend;
+use crate::level::fixed::Coord;
 use crate::level::state::State;
 use crate::stages::correct::{Coherence, Guide, SUBPASSES};
 

@@ -12,23 +12,19 @@
 use super::control::{
     Blend, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED, inside,
 };
-use super::fixed::Coord;
-use super::state::{level_size, top_level};
 use super::window::row_bounds;
 use super::{Frames, Guides, Params, SynthError, Synthesizer, union};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
+use crate::level::fixed::Coord;
+use crate::level::state::{level_size, top_level};
+use crate::stages::correct::{W_COHERENT, W_FREE, W_FROZEN};
 use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Duration;
 use thiserror::Error;
 
 mod guides;
-
-/// Weights in quarters (paper §5.3).
-pub const W_FROZEN: u8 = 0;
-pub const W_COHERENT: u8 = 1;
-pub use super::stages::correct::W_FREE;
 
 /// Pixels around a paste left unweighted in its step, so it blends in.
 pub const PASTE_MARGIN: f64 = 8.0;

@@ -2,9 +2,9 @@
 //! every output pixel was drawn from (`synth --coords`; `eval` reads it back
 //! for type usage).
 
-use super::fixed::{Coord, round};
 use crate::database::Database;
 use crate::io::coords_map::{CoordsMap, NO_EXEMPLAR, Source};
+use crate::level::fixed::{Coord, round};
 
 /// The sources of the `width × height` output from level-0 coordinates
 /// (`stride` pixels per row, as [`super::LevelMaps`] and

@@ -2,7 +2,7 @@
 //! changed since it: restricted re-synthesis corrects only the window those
 //! bounds, widened by how far subpasses carry a change, can reach.
 
-use super::fixed::Coord;
+use crate::level::fixed::Coord;
 use crate::level::state::State;
 
 /// Subpass reads reach two pixels (DESIGN §5), so within one level a change

@@ -3,6 +3,7 @@
 //! for every test binary instead of a copy in each.
 
 use std::sync::{Mutex, OnceLock};
+use terrasynth::Heightfield;
 use terrasynth::database::{self, BuildOptions, Database, default};
 use terrasynth::io::{self, Format};
 use terrasynth::procedural::Style;
@@ -28,19 +29,7 @@ pub fn default_db() -> &'static Database {
 pub fn coast_db() -> &'static (Database, f32) {
     static DB: OnceLock<(Database, f32)> = OnceLock::new();
     DB.get_or_init(|| {
-        let (hills, _) = Style::Hills
-            .generate(DEFAULT_SIZE, DEFAULT_SEED, &Silent)
-            .unwrap();
-        // As `generate` writes it: 16-bit PNG heights.
-        let png = io::encode(&hills, Format::Png16, &Default::default()).unwrap();
-        let hills = io::decode(
-            &png.bytes,
-            Format::Png16,
-            png.sidecar.as_deref(),
-            &Default::default(),
-        )
-        .unwrap();
-        let mut heights = hills.crop(0, 0, 256, 256).unwrap();
+        let mut heights = hills().crop(0, 0, 256, 256).unwrap();
         let mut sorted = heights.data().to_vec();
         sorted.sort_by(f32::total_cmp);
         let sea = sorted[sorted.len() * 3 / 10];
@@ -54,6 +43,54 @@ pub fn coast_db() -> &'static (Database, f32) {
         };
         let (db, _) = database::build(vec![input], &BuildOptions::default(), &Silent).unwrap();
         (db, sea)
+    })
+}
+
+/// The procedural hills (`generate --style hills` at its defaults, pinned
+/// by `tests/procedural.rs`) as `generate` writes them: 16-bit PNG heights.
+fn hills() -> &'static Heightfield {
+    static HILLS: OnceLock<Heightfield> = OnceLock::new();
+    HILLS.get_or_init(|| {
+        let (hills, _) = Style::Hills
+            .generate(DEFAULT_SIZE, DEFAULT_SEED, &Silent)
+            .unwrap();
+        let png = io::encode(&hills, Format::Png16, &Default::default()).unwrap();
+        io::decode(
+            &png.bytes,
+            Format::Png16,
+            png.sidecar.as_deref(),
+            &Default::default(),
+        )
+        .unwrap()
+    })
+}
+
+/// The `(x, y, width, height)` crops of the procedural hills in
+/// [`unequal_db`]: interiors in the ratio of about 5 : 2 : 1 at level 2,
+/// so that an exemplar's share of uniform draws (⅓ each) is far from its
+/// share of the area.
+pub const UNEQUAL_CROPS: [(usize, usize, usize, usize); 3] =
+    [(0, 0, 256, 256), (256, 0, 192, 128), (256, 256, 96, 160)];
+
+/// Three crops of the procedural hills of unequal sizes ([`UNEQUAL_CROPS`]),
+/// untyped, four levels: for what must follow each exemplar's area.
+pub fn unequal_db() -> &'static Database {
+    static DB: OnceLock<Database> = OnceLock::new();
+    DB.get_or_init(|| {
+        let inputs = UNEQUAL_CROPS
+            .iter()
+            .enumerate()
+            .map(|(k, &(x, y, w, h))| database::ExemplarInput {
+                name: format!("hills{k}"),
+                heights: hills().crop(x, y, w, h).unwrap(),
+                types: None,
+            })
+            .collect();
+        let opts = BuildOptions {
+            levels: 4,
+            ..Default::default()
+        };
+        database::build(inputs, &opts, &Silent).unwrap().0
     })
 }
 

@@ -137,3 +137,16 @@ pub fn have_gdal() -> bool {
     }
     ok
 }
+
+/// Pearson's correlation of pairs.
+pub fn correlation(p: &[(f64, f64)]) -> f64 {
+    let n = p.len() as f64;
+    let (ma, mb) = (
+        p.iter().map(|q| q.0).sum::<f64>() / n,
+        p.iter().map(|q| q.1).sum::<f64>() / n,
+    );
+    let cov: f64 = p.iter().map(|q| (q.0 - ma) * (q.1 - mb)).sum();
+    let va: f64 = p.iter().map(|q| (q.0 - ma).powi(2)).sum();
+    let vb: f64 = p.iter().map(|q| (q.1 - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}

@@ -149,7 +149,7 @@ pub struct SynthesisArgs {
     /// Height prior P of the correction: 0 (the paper's pure relative
     /// height matching), 1, 2, 4 or 8. Higher keeps candidates nearer the
     /// altitude the coarser level chose (more relief, less drift).
-    #[arg(long, default_value_t = terrasynth::synth::stages::correct::DEFAULT_PRIOR)]
+    #[arg(long, default_value_t = terrasynth::stages::correct::DEFAULT_PRIOR)]
     pub height_prior: u32,
     /// The finest level whose correction also scores each source's most
     /// similar texel C₂ (k = 2); finer levels score C₁ alone. 0 is the

@@ -134,7 +134,7 @@ pub fn run(a: Args) -> CliResult {
         let n_levels = timings[0].levels.len();
         let levels = (0..n_levels)
             .map(|l| {
-                let (lw, lh) = terrasynth::synth::state::level_size(w, h, l);
+                let (lw, lh) = terrasynth::level::state::level_size(w, h, l);
                 LevelReport {
                     level: l,
                     width: lw,

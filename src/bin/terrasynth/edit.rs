@@ -100,7 +100,7 @@ pub fn synth_scene(
             .and_then(|f| f.levels().first())
             .and_then(|l| l.last())
             .ok_or("no level-0 coordinates: the scene runs 0 correction passes")?;
-        let stride = terrasynth::synth::state::level_size(scene.width, scene.height, 0).0;
+        let stride = terrasynth::level::state::level_size(scene.width, scene.height, 0).0;
         let map = source_map(&l0.coords, stride, scene.width, scene.height, &db);
         crate::synth::write_coords(&map, &db, coords)?;
     }

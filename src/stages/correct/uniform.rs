@@ -45,7 +45,7 @@ pub struct CorrectUniform {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, Pod, Zeroable)]
 pub struct GuideCell {
-    /// `blend::Target` (height, tol).
+    /// [`Target`](super::nudge::Target) (height, tol).
     pub blend_target: [i32; 2],
     /// R^i (`correct::Guide::allowed`).
     pub allowed: u32,

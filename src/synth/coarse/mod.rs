@@ -39,10 +39,10 @@ mod pool;
 pub use pieces::pieces;
 pub use pool::Pool;
 
-use crate::synth::atlas::AtlasLevel;
+use crate::level::atlas::AtlasLevel;
+use crate::level::fixed::{Coord, FRAC_BITS};
+use crate::level::state::{State, level_size};
 use crate::synth::cone::Rect;
-use crate::synth::fixed::{Coord, FRAC_BITS};
-use crate::synth::state::{State, level_size};
 
 /// What the pieces draw from: the database level L of `atlas` and its
 /// [`Pool`] (of one exemplar or all).

@@ -3,10 +3,10 @@
 use super::{Source, guide};
 use crate::database::layout::MARGIN;
 use crate::hash::{below, hash4};
+use crate::level::fixed::{Coord, FRAC_BITS};
+use crate::level::state::State;
+use crate::stages::upsample_jitter;
 use crate::synth::cone::Rect;
-use crate::synth::fixed::{Coord, FRAC_BITS};
-use crate::synth::stages::upsample_jitter;
-use crate::synth::state::State;
 use rayon::prelude::*;
 
 /// Hash salt of the draw within a piece's band (kept apart from the

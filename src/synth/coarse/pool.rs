@@ -3,8 +3,8 @@
 //! surroundings.
 
 use crate::database::layout::MARGIN;
+use crate::level::atlas::AtlasLevel;
 use crate::stages::correct::scalar::texel_height;
-use crate::synth::atlas::AtlasLevel;
 use rayon::prelude::*;
 
 /// Radius, in output pixels, of the surroundings whose mean altitude ranks

@@ -90,7 +90,7 @@ use crate::synth::window::row_bounds;
 use rayon::prelude::*;
 use std::ops::Range;
 
-pub use crate::stages::correct::nudge::{MAX_TOL, Target};
+use crate::stages::correct::nudge::{MAX_TOL, Target};
 
 /// The tolerance slope s (eq. 8) of points: ¼ where the paper has ½.
 ///
@@ -177,7 +177,7 @@ impl Blend {
     pub fn new(width: usize, height: usize, last: usize, q: Quantization) -> Blend {
         let regions: Vec<Rect> = (0..=last)
             .map(|i| {
-                let (w, h) = crate::synth::state::level_size(width, height, i);
+                let (w, h) = crate::level::state::level_size(width, height, i);
                 Rect::new(0, 0, w, h)
             })
             .collect();

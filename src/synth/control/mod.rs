@@ -15,7 +15,7 @@ pub mod blend;
 pub mod curve;
 pub mod point;
 
-pub use blend::{Blend, Target, Targets};
+pub use blend::{Blend, Targets};
 pub use point::PointConstraint;
 
 use thiserror::Error;

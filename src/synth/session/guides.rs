@@ -8,14 +8,16 @@
 //! they are not compared pixel by pixel either. At 1024² re-deriving and
 //! comparing every level's targets took ~14 ms of a ~50 ms edit.
 
-use super::super::control::{Target, UNCONSTRAINED};
-use super::super::stages::correct::ALL_TYPES;
-use super::super::stages::reduce_types::reduce_types;
-use super::super::stages::reduce_weights::reduce_weights;
-use super::super::state::level_size;
 use super::super::window::row_bounds;
 use super::super::{Guides, LevelGuide, union};
-use super::{FIRST_LEVEL, Session, W_FREE, W_FROZEN};
+use super::{FIRST_LEVEL, Session};
+use crate::level::state::level_size;
+use crate::stages::correct::ALL_TYPES;
+use crate::stages::correct::nudge::Target;
+use crate::stages::correct::{W_FREE, W_FROZEN};
+use crate::stages::reduce_types::reduce_types;
+use crate::stages::reduce_weights::reduce_weights;
+use crate::synth::control::UNCONSTRAINED;
 use rayon::prelude::*;
 use std::ops::Range;
 

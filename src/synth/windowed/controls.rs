@@ -26,10 +26,11 @@ use super::paste::{self, PasteGeometry};
 use super::pyramid::{footprints, type_sets, weight_sets};
 use super::{WindowError, check_window};
 use crate::heightfield::Heightfield;
+use crate::level::state::{level_size, top_level};
+use crate::stages::correct::{W_COHERENT, W_FREE, W_FROZEN};
 use crate::synth::cone::{Cone, Rect, crop};
 use crate::synth::control::{Blend, Constraint, FIRST_LEVEL, Paste, UNCONSTRAINED};
-use crate::synth::session::{PASTE_MARGIN, W_COHERENT, W_FREE, W_FROZEN};
-use crate::synth::state::{level_size, top_level};
+use crate::synth::session::PASTE_MARGIN;
 use crate::synth::{Frames, Guides, LevelGuide, PassResult, SynthError, Synthesizer};
 use std::sync::Arc;
 

@@ -12,10 +12,10 @@
 
 use crate::database::Database;
 use crate::database::layout::MARGIN;
+use crate::level::fixed::Coord;
+use crate::level::state::level_size;
 use crate::synth::cone::Rect;
 use crate::synth::control::{Paste, PasteSource, inside};
-use crate::synth::fixed::Coord;
-use crate::synth::state::level_size;
 use crate::synth::{Frames, PassResult};
 
 /// One paste at one level.

@@ -6,12 +6,12 @@
 //! over a footprint is the whole level's; each level's guide is then the
 //! cone region cropped out of its footprint.
 
+use crate::level::state::level_size;
+use crate::stages::correct::ALL_TYPES;
+use crate::stages::reduce_types::reduce_types;
+use crate::stages::reduce_weights::reduce_weights;
 use crate::synth::cone::{Cone, Rect};
 use crate::synth::control::UNCONSTRAINED;
-use crate::synth::stages::correct::ALL_TYPES;
-use crate::synth::stages::reduce_types::reduce_types;
-use crate::synth::stages::reduce_weights::reduce_weights;
-use crate::synth::state::level_size;
 
 /// Footprints of levels `0..=last` (index = level): the cone's region at
 /// `last`, then the children of each footprint, clipped to the world.
@@ -84,7 +84,7 @@ pub(super) fn weight_sets(w0: Vec<u8>, fp: &[Rect], pasted: &[Vec<bool>]) -> Vec
         let mut next = reduce_weights(&out[i - 1], c.width(), c.height(), p.width(), p.height());
         for (w, &frozen) in next.iter_mut().zip(&pasted[i]) {
             if frozen {
-                *w = crate::synth::session::W_FROZEN;
+                *w = crate::stages::correct::W_FROZEN;
             }
         }
         out.push(next);
