@@ -108,12 +108,20 @@ pub fn receivers(s: &Surface<'_>, edges: Edges) -> Vec<u32> {
 }
 
 /// Flow accumulation in cells (the cell itself included) from D8
-/// receivers: each cell passes its total on once every donor has passed
-/// theirs. Receivers must form no cycle (heights, then the gradient,
+/// receivers. Receivers must form no cycle (heights, then the gradient,
 /// strictly fall along the flow, so those of [`receivers`] do not).
-/// Sequential and O(n): the walk follows the network, which no row split
-/// divides.
 pub fn accumulate(receivers: &[u32]) -> Vec<u32> {
+    let mut acc = vec![1u32; receivers.len()];
+    accumulate_into(receivers, &mut acc);
+    acc
+}
+
+/// Flow accumulation of weights: `acc` holds each cell's own weight on
+/// entry (1 for its own area, more where flow enters from elsewhere) and
+/// its upstream total on return; each cell passes its total on once every
+/// donor has passed theirs. Sequential and O(n): the walk follows the
+/// network, which no row split divides.
+pub fn accumulate_into<T: Copy + std::ops::AddAssign>(receivers: &[u32], acc: &mut [T]) {
     let n = receivers.len();
     // Donor counts; at most 8, and u8::MAX marks a cell already passed on.
     let mut pending = vec![0u8; n];
@@ -122,7 +130,6 @@ pub fn accumulate(receivers: &[u32]) -> Vec<u32> {
             pending[r as usize] += 1;
         }
     }
-    let mut acc = vec![1u32; n];
     for start in 0..n {
         if pending[start] != 0 {
             continue;
@@ -134,7 +141,8 @@ pub fn accumulate(receivers: &[u32]) -> Vec<u32> {
                 break;
             }
             let r = r as usize;
-            acc[r] += acc[c];
+            let a = acc[c];
+            acc[r] += a;
             pending[r] -= 1;
             if pending[r] != 0 {
                 break;
@@ -143,7 +151,6 @@ pub fn accumulate(receivers: &[u32]) -> Vec<u32> {
             c = r;
         }
     }
-    acc
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ use super::d8::CLOCKWISE;
 use crate::procedural::grid::neighbour;
 
 /// Order-preserving key of a finite height: `a < b ⇔ key(a) < key(b)`.
-fn key(z: f32) -> u32 {
+pub(super) fn key(z: f32) -> u32 {
     let b = z.to_bits();
     if b & 0x8000_0000 != 0 {
         !b
@@ -34,13 +34,13 @@ fn key(z: f32) -> u32 {
 /// A monotone min-queue of (key, cell): every pushed key is at least the
 /// last popped one. Bucket `i` holds keys whose highest bit differing from
 /// `last` is bit `i − 1` (bucket 0: equal to `last`).
-struct RadixHeap {
+pub(super) struct RadixHeap {
     last: u32,
     buckets: [Vec<(u32, u32)>; 33],
 }
 
 impl RadixHeap {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         RadixHeap {
             last: 0,
             buckets: std::array::from_fn(|_| Vec::new()),
@@ -51,7 +51,7 @@ impl RadixHeap {
         (32 - (k ^ last).leading_zeros()) as usize
     }
 
-    fn push(&mut self, k: u32, cell: u32) {
+    pub(super) fn push(&mut self, k: u32, cell: u32) {
         debug_assert!(k >= self.last, "radix heap keys must not decrease");
         self.buckets[Self::bucket(k, self.last)].push((k, cell));
     }
@@ -62,7 +62,7 @@ impl RadixHeap {
         b.len().checked_sub(ahead + 1).map(|i| b[i].1)
     }
 
-    fn pop(&mut self) -> Option<(u32, u32)> {
+    pub(super) fn pop(&mut self) -> Option<(u32, u32)> {
         if self.buckets[0].is_empty() {
             let i = (1..33).find(|&i| !self.buckets[i].is_empty())?;
             let moved = std::mem::take(&mut self.buckets[i]);

@@ -24,9 +24,9 @@ use super::d8::CLOCKWISE;
 use crate::procedural::grid::neighbour;
 use rayon::prelude::*;
 
-const FLAT: u8 = 1;
-const DRAINS: u8 = 2;
-const HIGHER: u8 = 4;
+pub(super) const FLAT: u8 = 1;
+pub(super) const DRAINS: u8 = 2;
+pub(super) const HIGHER: u8 = 4;
 
 /// A filled surface with its cells classified.
 struct Grid<'a> {
@@ -153,6 +153,24 @@ impl Grid<'_> {
     }
 }
 
+/// The class of an interior cell at height `z` (not the sea) from its
+/// eight neighbours' heights.
+pub(super) fn classify(z: f32, around: [f32; 8]) -> u8 {
+    let (mut lower, mut equal, mut higher) = (false, false, false);
+    for zk in around {
+        lower |= zk < z;
+        equal |= zk == z;
+        higher |= zk > z;
+    }
+    (if lower {
+        DRAINS
+    } else if equal {
+        FLAT
+    } else {
+        0
+    }) | if higher { HIGHER } else { 0 }
+}
+
 /// The drainage gradient of every cell of a filled surface (`sea` cells
 /// drain, like the border); `None` when the surface has no flat.
 pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Option<Vec<u32>> {
@@ -166,21 +184,7 @@ pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Opt
                 *c = DRAINS;
                 continue;
             }
-            let z = filled[i];
-            let (mut lower, mut equal, mut higher) = (false, false, false);
-            for o in offsets {
-                let zk = filled[i.wrapping_add_signed(o)];
-                lower |= zk < z;
-                equal |= zk == z;
-                higher |= zk > z;
-            }
-            *c = if lower {
-                DRAINS
-            } else if equal {
-                FLAT
-            } else {
-                0
-            } | if higher { HIGHER } else { 0 };
+            *c = classify(filled[i], offsets.map(|o| filled[i.wrapping_add_signed(o)]));
         }
     });
     let flats: Vec<u32> = class

@@ -27,6 +27,7 @@ pub mod preview;
 pub mod rivers;
 pub mod sea;
 mod summary;
+pub mod tiled;
 
 pub use lakes::{Lake, Thresholds};
 pub use summary::Summary;
@@ -50,7 +51,7 @@ pub enum WaterError {
         expected: &'static str,
     },
     #[error(transparent)]
-    Memory(#[from] crate::io::IoError),
+    Io(#[from] crate::io::IoError),
 }
 
 /// What to compute.

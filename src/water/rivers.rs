@@ -68,27 +68,34 @@ pub struct Rivers {
     pub segments: Vec<Segment>,
 }
 
-/// Traces the rivers: channel cells drain at least `threshold` cells.
-pub fn trace(receivers: &[u32], acc: &[u32], class: &[u8], threshold: u32) -> Rivers {
-    let n = receivers.len();
-    let channel = |i: usize| acc[i] >= threshold && class[i] != SEA;
-    let downstream = |i: usize| {
-        let r = receivers[i];
-        (r != OUTLET && channel(r as usize)).then_some(r as usize)
-    };
-    let cells: Vec<usize> = (0..n).filter(|&i| channel(i)).collect();
-    // Strahler order in topological order: a cell is done once every
-    // channel donor is.
+/// Counts a donor of Strahler order `o` into a cell's highest donor order
+/// `top` and how many donors have it, `ties`.
+pub(super) fn join(top: &mut u8, ties: &mut u8, o: u8) {
+    if o > *top {
+        (*top, *ties) = (o, 1);
+    } else if o == *top {
+        *ties = ties.saturating_add(1);
+    }
+}
+
+/// Strahler order of the channel `cells` (0 elsewhere), in topological
+/// order: a cell is done once every channel donor is. `top` and `ties`
+/// ([`join`]) start with what flows in from elsewhere (zero: nothing).
+pub(super) fn strahler(
+    cells: &[usize],
+    downstream: impl Fn(usize) -> Option<usize>,
+    mut top: Vec<u8>,
+    mut ties: Vec<u8>,
+) -> Vec<u8> {
+    let n = top.len();
     let mut pending = vec![0u8; n];
-    for &c in &cells {
+    for &c in cells {
         if let Some(r) = downstream(c) {
             pending[r] += 1;
         }
     }
     let mut order = vec![0u8; n];
-    let mut top = vec![0u8; n];
-    let mut ties = vec![0u8; n];
-    for &start in &cells {
+    for &start in cells {
         if pending[start] != 0 {
             continue;
         }
@@ -100,11 +107,7 @@ pub fn trace(receivers: &[u32], acc: &[u32], class: &[u8], threshold: u32) -> Ri
                 (t, _) => t,
             };
             let Some(r) = downstream(c) else { break };
-            if order[c] > top[r] {
-                (top[r], ties[r]) = (order[c], 1);
-            } else if order[c] == top[r] {
-                ties[r] = ties[r].saturating_add(1);
-            }
+            join(&mut top[r], &mut ties[r], order[c]);
             pending[r] -= 1;
             if pending[r] != 0 {
                 break;
@@ -113,12 +116,22 @@ pub fn trace(receivers: &[u32], acc: &[u32], class: &[u8], threshold: u32) -> Ri
             c = r;
         }
     }
-    drop(top);
-    drop(ties);
+    order
+}
+
+/// Traces the rivers: channel cells drain at least `threshold` cells.
+pub fn trace(receivers: &[u32], acc: &[u32], class: &[u8], threshold: u32) -> Rivers {
+    let n = receivers.len();
+    let channel = |i: usize| acc[i] >= threshold && class[i] != SEA;
+    let downstream = |i: usize| {
+        let r = receivers[i];
+        (r != OUTLET && channel(r as usize)).then_some(r as usize)
+    };
+    let cells: Vec<usize> = (0..n).filter(|&i| channel(i)).collect();
+    let mut order = strahler(&cells, downstream, vec![0; n], vec![0; n]);
     // Rivers: channel cells on land; their river donors decide the heads.
     let river = |i: usize| channel(i) && class[i] == LAND;
-    let mut donors = pending;
-    donors.fill(0);
+    let mut donors = vec![0u8; n];
     for &c in cells.iter().filter(|&&c| river(c)) {
         if let Some(r) = downstream(c).filter(|&r| river(r)) {
             donors[r] += 1;
