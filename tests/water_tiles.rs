@@ -140,3 +140,119 @@ fn lakes_spills_and_flats_that_cross_many_tiles() {
     };
     assert_same(&hf, 8, &sea);
 }
+
+/// `terrasynth tiles` with `args` into `dir`: (success, stderr).
+fn tiles_cli(dir: &std::path::Path, args: &[&str]) -> (bool, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_terrasynth"))
+        .args(["tiles", "--size", "301x233", "--seed", "12", "--tile", "76"])
+        .arg("--out-dir")
+        .arg(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// A raster of the world from tile files `tile_<c>_<r><suffix>`, each
+/// holding `core` (x, y, w, h) at `offset` (x, y) in the file.
+fn mosaic(dir: &std::path::Path, suffix: &str, cores: &[([usize; 4], [usize; 2])]) -> Vec<f32> {
+    let (w, h) = (301, 233);
+    let mut out = vec![f32::NAN; w * h];
+    for &([cx, cy, cw, ch], [ox, oy]) in cores {
+        let name = format!("tile_{}_{}{suffix}", cx / 76, cy / 76);
+        let hf = terrasynth::io::read(&dir.join(name), &Default::default()).unwrap();
+        for y in 0..ch {
+            for x in 0..cw {
+                out[(cy + y) * w + cx + x] = hf.get(ox + x, oy + y);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_cli_writes_water_tiles_equal_to_the_whole_worlds_water() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("world");
+    let (ok, err) = tiles_cli(&out, &["--sea-level", "300"]);
+    assert!(!ok && err.contains("need --water"), "{err}");
+    let (ok, err) = tiles_cli(&out, &["--water", "--river-area", "0"]);
+    assert!(
+        !ok && err.contains("river area") && !err.contains("panicked"),
+        "{err}"
+    );
+    assert!(
+        !out.join("manifest.json").exists(),
+        "refused before any tile"
+    );
+    let knobs = ["--water", "--overlap", "3", "--river-area", "0.5"];
+    let (ok, err) = tiles_cli(&out, &knobs);
+    assert!(ok, "{err}");
+    assert!(err.contains("water:"), "{err}");
+    let m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    let records = m["tiles"].as_array().unwrap();
+    assert_eq!(records.len(), 16, "4 x 4 tiles");
+    let ints = |v: &serde_json::Value| -> Vec<usize> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_u64().unwrap() as usize)
+            .collect()
+    };
+    let heights: Vec<_> = records
+        .iter()
+        .map(|r| {
+            let (c, e) = (ints(&r["core"]), ints(&r["extent"]));
+            ([c[0], c[1], c[2], c[3]], [c[0] - e[0], c[1] - e[1]])
+        })
+        .collect();
+    let cores: Vec<_> = heights.iter().map(|&(c, _)| (c, [0, 0])).collect();
+    let z = mosaic(&out, ".tif", &heights);
+    let cell = m["cell_size_m"].as_f64().unwrap();
+    let hf = Heightfield::from_vec(301, 233, cell, z).unwrap();
+    let params = Params {
+        river_area_km2: 0.5,
+        ..Params::default()
+    };
+    let whole = water::compute(&hf, &params).unwrap();
+    assert!(!whole.bodies.lakes.is_empty() && !whole.rivers.segments.is_empty());
+    let acc: Vec<f32> = whole.accumulation.iter().map(|&a| a as f32).collect();
+    let order: Vec<f32> = whole.rivers.order.iter().map(|&o| o as f32).collect();
+    for (raster, want) in [
+        ("filled", &whole.filled),
+        ("lakes", &whole.bodies.depth),
+        ("flow", &acc),
+        ("rivers", &order),
+    ] {
+        let got = mosaic(&out, &format!(".{raster}.tif"), &cores);
+        let same = got
+            .iter()
+            .zip(want.iter())
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{raster} tiles differ from the whole world's water");
+        assert!(out.join(format!("{raster}.vrt")).exists());
+    }
+    assert_eq!(m["water"]["lakes"], whole.bodies.lakes.len());
+    assert!(!out.join(".water-scratch").exists());
+    if !common::have_gdal() {
+        return;
+    }
+    // GDAL reads the water mosaic as the whole world's flow.
+    let raw = dir.path().join("flow.bin");
+    let o = std::process::Command::new("gdal_translate")
+        .args(["-q", "-of", "ENVI"])
+        .arg(out.join("flow.vrt"))
+        .arg(&raw)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let want: Vec<u8> = acc.iter().flat_map(|v| v.to_le_bytes()).collect();
+    assert!(
+        std::fs::read(&raw).unwrap() == want,
+        "GDAL's flow mosaic differs"
+    );
+}

@@ -83,7 +83,9 @@ impl Default for Params {
 }
 
 impl Params {
-    fn check(&self) -> Result<(), WaterError> {
+    /// Refuses a non-finite sea level, negative or non-finite lake
+    /// thresholds and a river area that is not positive.
+    pub fn check(&self) -> Result<(), WaterError> {
         let bad = |name, value: f64, expected| WaterError::Param {
             name,
             value,

@@ -34,20 +34,8 @@ pub struct Args {
     /// rivers.geojson (created if missing).
     #[arg(long)]
     out_dir: PathBuf,
-    /// Cells joined to the border at or below this height (metres) are sea:
-    /// rivers end there. Default: no sea.
-    #[arg(long, value_name = "M", allow_hyphen_values = true)]
-    sea_level: Option<f32>,
-    /// Upstream area from which a flow line is a river, km².
-    #[arg(long, value_name = "KM2", default_value_t = Params::default().river_area_km2)]
-    river_area: f64,
-    /// A filled depression is a lake only this deep (metres, its deepest
-    /// cell) ...
-    #[arg(long, value_name = "M", default_value_t = Params::default().lakes.min_depth_m)]
-    lake_min_depth: f64,
-    /// ... and this large (km²); smaller ones are still filled for flow.
-    #[arg(long, value_name = "KM2", default_value_t = Params::default().lakes.min_area_km2)]
-    lake_min_area: f64,
+    #[command(flatten)]
+    params: Knobs,
     /// Print the summary (lakes, sea, river length by order) as JSON.
     #[arg(long)]
     json: bool,
@@ -74,16 +62,51 @@ fn guard(path: &Path, input: &Path) -> Result<(), String> {
     }
 }
 
+/// The water parameters `water` and `tiles --water` share.
+#[derive(clap::Args)]
+pub struct Knobs {
+    /// Cells joined to the border at or below this height (metres) are sea:
+    /// rivers end there. Default: no sea.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    sea_level: Option<f32>,
+    /// Upstream area from which a flow line is a river, km² [default: 5].
+    #[arg(long, value_name = "KM2")]
+    river_area: Option<f64>,
+    /// A filled depression is a lake only this deep (metres, its deepest
+    /// cell) [default: 2] ...
+    #[arg(long, value_name = "M")]
+    lake_min_depth: Option<f64>,
+    /// ... and this large (km²) [default: 0.1]; smaller ones are still
+    /// filled for flow.
+    #[arg(long, value_name = "KM2")]
+    lake_min_area: Option<f64>,
+}
+
+impl Knobs {
+    pub fn params(&self) -> Params {
+        let d = Params::default();
+        Params {
+            sea_level: self.sea_level,
+            lakes: Thresholds {
+                min_depth_m: self.lake_min_depth.unwrap_or(d.lakes.min_depth_m),
+                min_area_km2: self.lake_min_area.unwrap_or(d.lakes.min_area_km2),
+            },
+            river_area_km2: self.river_area.unwrap_or(d.river_area_km2),
+        }
+    }
+
+    /// Whether any was given.
+    pub fn any(&self) -> bool {
+        self.sea_level.is_some()
+            || self.river_area.is_some()
+            || self.lake_min_depth.is_some()
+            || self.lake_min_area.is_some()
+    }
+}
+
 pub fn run(a: Args) -> CliResult {
     let hf = a.read.read(&a.input)?;
-    let params = Params {
-        sea_level: a.sea_level,
-        lakes: Thresholds {
-            min_depth_m: a.lake_min_depth,
-            min_area_km2: a.lake_min_area,
-        },
-        river_area_km2: a.river_area,
-    };
+    let params = a.params.params();
     let name = a.input.display().to_string();
     let w = water::compute(&hf, &params).map_err(|e| format!("{name}: {e}"))?;
     std::fs::create_dir_all(&a.out_dir)

@@ -41,6 +41,11 @@ use unions::{Components, NONE, Unions};
 /// the padded surface and its classes, the sweeps, components, receivers).
 pub const BYTES_PER_CELL: u64 = 64;
 
+/// Bytes per ring cell of the whole world held throughout: the rings'
+/// published values (about 40 bytes) and, while it is solved, the spill
+/// graph's adjacency.
+pub const BYTES_PER_RING_CELL: u64 = 256;
+
 /// One tile's water, its core's cells row-major.
 #[derive(Debug, Clone)]
 pub struct TileWater {
