@@ -99,15 +99,17 @@ impl Scratch {
     }
 }
 
-/// Runs `run` on every tile, then on the neighbours of every tile whose
-/// published ring changed (`publish` says), until none changes: a Jacobi
-/// iteration over tiles. Returns the rounds.
+/// Runs `run` on every tile, then on every tile beside a ring cell whose
+/// published value changed (`publish` returns the changed cells' ring
+/// indices), until none changes: a Jacobi iteration over tiles. Returns
+/// the rounds.
 fn settle<S: Sync, O: Send>(
     layout: &Layout,
     state: &mut S,
     run: impl Fn(&S, usize) -> Result<O, WaterError> + Sync,
-    publish: impl Fn(&mut S, usize, O) -> bool,
+    publish: impl Fn(&mut S, usize, O) -> Vec<usize>,
 ) -> Result<usize, WaterError> {
+    let (ww, wh) = layout.world;
     let mut todo: Vec<usize> = (0..layout.count()).collect();
     let mut rounds = 0;
     while !todo.is_empty() {
@@ -118,8 +120,17 @@ fn settle<S: Sync, O: Send>(
             .collect::<Result<_, WaterError>>()?;
         let mut next = vec![false; layout.count()];
         for (&t, o) in todo.iter().zip(out) {
-            if publish(state, t, o) {
-                layout.around(t).for_each(|u| next[u] = true);
+            let c = layout.core(t);
+            let cells = ring_cells(c.w, c.h);
+            for r in publish(state, t, o) {
+                let (gx, gy) = (c.x0 + cells[r].0, c.y0 + cells[r].1);
+                for &(dx, dy, _) in &CLOCKWISE {
+                    if let Some(k) = crate::procedural::grid::neighbour(gx, gy, dx, dy, ww, wh)
+                        && layout.tile_of(k % ww, k / ww) != t
+                    {
+                        next[layout.tile_of(k % ww, k / ww)] = true;
+                    }
+                }
             }
         }
         todo = (0..layout.count()).filter(|&t| next[t]).collect();
@@ -127,11 +138,19 @@ fn settle<S: Sync, O: Send>(
     Ok(rounds)
 }
 
-/// Replaces tile `t`'s ring values, saying whether any changed.
-fn replace<T: Copy + PartialEq>(rings: &mut Rings<T>, t: usize, v: &[T]) -> bool {
-    let r = rings.tile_mut(t);
-    let changed = r != v;
-    r.copy_from_slice(v);
+/// Replaces tile `t`'s ring values with `v` and `w`, returning the ring
+/// indices where either changed.
+fn replace<T: Copy + PartialEq, U: Copy + PartialEq>(
+    (a, b): (&mut Rings<T>, &mut Rings<U>),
+    t: usize,
+    (v, w): (&[T], &[U]),
+) -> Vec<usize> {
+    let (ra, rb) = (a.tile_mut(t), b.tile_mut(t));
+    let changed = (0..v.len())
+        .filter(|&r| ra[r] != v[r] || rb[r] != w[r])
+        .collect();
+    ra.copy_from_slice(v);
+    rb.copy_from_slice(w);
     changed
 }
 
@@ -404,8 +423,7 @@ fn run(
         },
         |sw, t, (tl, hi, open)| {
             sw.tops[t] = open;
-            let a = replace(&mut sw.tl, t, &tl);
-            replace(&mut sw.hi, t, &hi) | a
+            replace((&mut sw.tl, &mut sw.hi), t, (&tl, &hi))
         },
     )?;
     let mut flat_top = vec![0u32; flat_base[n]];
@@ -499,10 +517,7 @@ fn run(
             let c = layout.core(t);
             Ok((on_ring(&f.acc, c.w, c.h), on_ring(&f.order, c.w, c.h)))
         },
-        |fl, t, (acc, order)| {
-            let a = replace(&mut fl.0, t, &acc);
-            replace(&mut fl.1, t, &order) | a
-        },
+        |fl, t, (acc, order)| replace((&mut fl.0, &mut fl.1), t, (&acc, &order)),
     )?;
     // Pass 4: lakes and the rasters.
     let counts: Vec<(usize, u64)> = (0..n)

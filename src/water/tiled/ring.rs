@@ -52,19 +52,6 @@ impl Layout {
     pub fn tile_of(&self, x: usize, y: usize) -> usize {
         (y / self.tile) * self.size().0 + x / self.tile
     }
-
-    /// The tiles around `t` (8-connected), itself excluded.
-    pub fn around(&self, t: usize) -> impl Iterator<Item = usize> {
-        let (cols, rows) = self.size();
-        let (c, r) = ((t % cols) as isize, (t / cols) as isize);
-        super::super::d8::CLOCKWISE
-            .iter()
-            .filter_map(move |&(dx, dy, _)| {
-                let (nc, nr) = (c + dx, r + dy);
-                ((0..cols as isize).contains(&nc) && (0..rows as isize).contains(&nr))
-                    .then_some(nr as usize * cols + nc as usize)
-            })
-    }
 }
 
 /// Ring cells of a `w × h` core.
