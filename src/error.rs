@@ -22,6 +22,8 @@ pub enum Error {
     Poisson(#[from] crate::poisson::PoissonError),
     #[error(transparent)]
     Water(#[from] crate::water::WaterError),
+    #[error(transparent)]
+    Erode(#[from] crate::erode::ErodeError),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -11,6 +11,7 @@
 pub mod backend;
 pub mod blend;
 pub mod database;
+pub mod erode;
 pub mod error;
 pub mod eval;
 pub mod georef;

@@ -98,3 +98,11 @@ def water(
     lake_min_area_km2: float = 0.1,
 ) -> Dict[str, Any]:
     """`terrasynth water`: filled, depth, accumulation, receivers, rivers (arrays) and summary."""
+
+def erode(
+    heights: Union[npt.NDArray[np.float32], npt.NDArray[np.float64]],
+    cell_size: float,
+    *,
+    strength: float = 1.0,
+) -> npt.NDArray[np.float32]:
+    """`terrasynth erode`: the heights after the local erosion filter."""

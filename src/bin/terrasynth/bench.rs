@@ -1,5 +1,5 @@
 //! `terrasynth bench`: median synthesis times per size, level and stage,
-//! and median `water` times per size and stage.
+//! median `water` times per size and stage, and median `erode` times.
 //!
 //! Timings come from the synthesizer's own stage clocks ([`Timings`]), so
 //! the numbers are the same ones a library user sees; each size is run
@@ -42,7 +42,12 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_parser = parse_size,
           default_value = "4096x4096")]
     water_sizes: Vec<(usize, usize)>,
-    /// Time only synthesis or only water.
+    /// Sizes to time `erode` (the default strength) on, each on a
+    /// synthesis of that size.
+    #[arg(long, value_delimiter = ',', value_parser = parse_size,
+          default_value = "1024x1024")]
+    erode_sizes: Vec<(usize, usize)>,
+    /// Time only synthesis, only water or only erode.
     #[arg(long, value_enum)]
     only: Option<Only>,
 }
@@ -51,6 +56,17 @@ pub struct Args {
 enum Only {
     Synth,
     Water,
+    Erode,
+}
+
+/// One size's median `erode` time.
+#[derive(Serialize)]
+struct ErodeReport {
+    size: String,
+    runs: u32,
+    threads: usize,
+    strength: f32,
+    total_ms: f64,
 }
 
 /// One size's water medians, in milliseconds.
@@ -97,6 +113,7 @@ struct LevelReport {
 struct Report {
     sizes: Vec<SizeReport>,
     water: Vec<WaterReport>,
+    erode: Vec<ErodeReport>,
 }
 
 fn ms(d: Duration) -> f64 {
@@ -119,7 +136,7 @@ pub fn run(a: Args) -> CliResult {
     let mut synth = Synthesizer::new(&db, Params::default())?;
     select_backend(&mut synth, a.backend)?;
     let mut sizes = Vec::new();
-    let synth_sizes: &[(usize, usize)] = if a.only == Some(Only::Water) {
+    let synth_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Synth) {
         &[]
     } else {
         &a.sizes
@@ -177,7 +194,7 @@ pub fn run(a: Args) -> CliResult {
         sizes.push(report);
     }
     let mut water = Vec::new();
-    let water_sizes: &[(usize, usize)] = if a.only == Some(Only::Synth) {
+    let water_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Water) {
         &[]
     } else {
         &a.water_sizes
@@ -225,10 +242,45 @@ pub fn run(a: Args) -> CliResult {
         }
         water.push(report);
     }
+    let mut erode = Vec::new();
+    let erode_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Erode) {
+        &[]
+    } else {
+        &a.erode_sizes
+    };
+    for &(w, h) in erode_sizes {
+        let hf = synth.run(w, h, a.seed)?.heightfield;
+        let strength = terrasynth::erode::DEFAULT_STRENGTH;
+        terrasynth::erode::erode(&hf, strength)?; // warm-up
+        let times: Vec<f64> = (0..a.runs)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                terrasynth::erode::erode(&hf, strength).map(|_| ms(t.elapsed()))
+            })
+            .collect::<Result<_, _>>()?;
+        let report = ErodeReport {
+            size: format!("{w}x{h}"),
+            runs: a.runs,
+            threads: rayon::current_num_threads(),
+            strength,
+            total_ms: median(times),
+        };
+        if !a.json {
+            println!(
+                "erode {} (synthesis seed {}, strength {}): {:.1} ms median of {} runs on {} threads",
+                report.size, a.seed, strength, report.total_ms, report.runs, report.threads
+            );
+        }
+        erode.push(report);
+    }
     if a.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&Report { sizes, water })?
+            serde_json::to_string_pretty(&Report {
+                sizes,
+                water,
+                erode
+            })?
         );
     }
     Ok(())

@@ -5,6 +5,7 @@ mod bench;
 mod convert;
 mod db;
 mod edit;
+mod erode;
 mod eval;
 mod generate;
 mod info;
@@ -44,6 +45,9 @@ enum Command {
     /// Fill depressions and route water: filled surface, lakes (water
     /// depth), flow accumulation, rivers (raster and GeoJSON lines).
     Water(water::Args),
+    /// Erode a heightfield: a few local steps of stream-power incision and
+    /// hillslope creep (windows of a world erode like crops of it).
+    Erode(erode::Args),
     /// Time synthesis: median ms per size, level and stage, and memory per pixel.
     Bench(bench::Args),
     /// Build or inspect an exemplar database.
@@ -90,6 +94,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => convert::run(a),
         Command::Masks(a) => masks::run(a),
         Command::Water(a) => water::run(a),
+        Command::Erode(a) => erode::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),
