@@ -96,3 +96,26 @@ def test_every_cell_drains_and_accumulation_counts_it():
     assert w["summary"]["lakes"]["count"] == 1
     with pytest.raises(terrasynth.TerrasynthError, match="nodata"):
         terrasynth.water(np.full((4, 4), np.nan, np.float32), 30.0)
+
+
+def test_erode_matches_its_crops_and_refuses_bad_input():
+    # A window eroded from its halo (33 cells) is the crop of the whole
+    # eroded; strength 0 leaves the heights; bad input raises.
+    n = 160
+    y, x = np.mgrid[0:n, 0:n].astype(np.float64)
+    z = (300.0 + 2.0 * x + 25.0 * np.sin(y / 11.0) * np.cos(x / 17.0)).astype(np.float32)
+    whole = terrasynth.erode(z, 30.0, strength=2.0)
+    assert whole.dtype == np.float32 and whole.shape == z.shape
+    assert not np.array_equal(whole, z)
+    halo = 33
+    win = (70, 60, 20, 30)  # x, y, w, h
+    x0, y0 = win[0] - halo, win[1] - halo
+    part = terrasynth.erode(z[y0 : win[1] + win[3] + halo, x0 : win[0] + win[2] + halo], 30.0, strength=2.0)
+    crop = part[halo : halo + win[3], halo : halo + win[2]]
+    assert np.array_equal(crop.view(np.uint32), whole[60:90, 70:90].view(np.uint32))
+    assert np.array_equal(terrasynth.erode(z, 30.0, strength=0.0), z)
+    with pytest.raises(terrasynth.TerrasynthError, match="strength"):
+        terrasynth.erode(z, 30.0, strength=11.0)
+    z[3, 4] = np.nan
+    with pytest.raises(terrasynth.TerrasynthError, match="nodata"):
+        terrasynth.erode(z, 30.0)

@@ -16,8 +16,6 @@
 use super::super::flats::{DRAINS, FLAT, HIGHER, classify};
 use super::ring::{Layout, Pad, Rings};
 use super::unions::{Components, NONE};
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// One tile's filled surface, padded, with its cells classified.
 pub struct Surface {
@@ -72,33 +70,45 @@ impl Surface {
     /// Steps from `seeds` (padded index, distance) into the core's flats:
     /// a flat cell is one step from a flat neighbour, or from a non-flat
     /// one of its level (a low edge). 0 where none reaches (padded).
-    fn spread(&self, seeds: Vec<(u32, usize)>) -> Vec<u32> {
-        let mut dist = vec![0u32; self.pad.len()];
-        let mut open = BinaryHeap::new();
-        for (d, p) in seeds {
-            if dist[p] == 0 || d < dist[p] {
-                dist[p] = d;
-                open.push(Reverse((d, p)));
-            }
-        }
+    fn spread(&self, mut seeds: Vec<(u32, usize)>) -> Vec<u32> {
+        let mut dist = vec![0u32; self.pad.cells()];
+        // Breadth-first by rings of equal distance, the seeds joining at
+        // their own distance.
+        seeds.sort_unstable();
         let offsets = self.pad.offsets();
-        while let Some(Reverse((d, p))) = open.pop() {
-            if d != dist[p] {
-                continue;
+        let (mut ring, mut next) = (Vec::new(), Vec::new());
+        let mut s = 0;
+        let mut d = seeds.first().map_or(0, |x| x.0);
+        while s < seeds.len() || !ring.is_empty() {
+            if ring.is_empty() {
+                d = d.max(seeds[s].0);
             }
-            for o in offsets {
-                let k = p.wrapping_add_signed(o);
-                if self.pad.to_core(k).is_none()
-                    || !self.flat(k)
-                    || (!self.flat(p) && self.f[k] != self.f[p])
-                {
-                    continue;
+            while s < seeds.len() && seeds[s].0 == d {
+                let p = seeds[s].1;
+                if dist[p] == 0 || d < dist[p] {
+                    dist[p] = d;
+                    ring.push(p);
                 }
-                if dist[k] == 0 || d + 1 < dist[k] {
-                    dist[k] = d + 1;
-                    open.push(Reverse((d + 1, k)));
+                s += 1;
+            }
+            for &p in &ring {
+                for o in offsets {
+                    let k = p.wrapping_add_signed(o);
+                    if self.pad.to_core(k).is_none()
+                        || !self.flat(k)
+                        || (!self.flat(p) && self.f[k] != self.f[p])
+                    {
+                        continue;
+                    }
+                    if dist[k] == 0 || d + 1 < dist[k] {
+                        dist[k] = d + 1;
+                        next.push(k);
+                    }
                 }
             }
+            std::mem::swap(&mut ring, &mut next);
+            next.clear();
+            d += 1;
         }
         dist
     }

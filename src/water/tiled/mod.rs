@@ -444,7 +444,7 @@ fn run(
             let (tl, hi) = s.sweeps(layout, &sw.tl, &sw.hi);
             let fl = s.flats();
             let tops = flats::tops(&fl, &hi, &p);
-            let mut grad = vec![0u32; p.len()];
+            let mut grad = vec![0u32; p.cells()];
             for (i, &c) in fl.id.iter().enumerate() {
                 let q = p.at(i % p.core.w, i / p.core.w);
                 let top = match c {

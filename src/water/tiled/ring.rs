@@ -146,7 +146,7 @@ impl Pad {
         self.core.w + 2
     }
 
-    pub fn len(&self) -> usize {
+    pub fn cells(&self) -> usize {
         self.pw() * (self.core.h + 2)
     }
 
@@ -199,7 +199,7 @@ impl Pad {
         outside: T,
     ) -> Vec<T> {
         let c = self.core;
-        let mut v = vec![outside; self.len()];
+        let mut v = vec![outside; self.cells()];
         for y in 0..c.h {
             let p = self.at(0, y);
             v[p..p + c.w].copy_from_slice(&core[y * c.w..(y + 1) * c.w]);
