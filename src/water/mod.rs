@@ -13,6 +13,9 @@
 //! on this project's shared two cores, half of it the sequential fill
 //! (README, `water`).
 //!
+//! [`tiled`] computes the same rasters on a world cut into tiles, bit for
+//! bit, holding a few tiles at a time (`terrasynth tiles --water`).
+//!
 //! Every cell drains: the fill leaves no pit, [`flats`] gives every level
 //! cell a way down to its flat's outlet, and D8 ([`d8`]) follows heights
 //! then that gradient, so following receivers from any cell ends at a
