@@ -20,6 +20,10 @@ pub enum Error {
     Synth(#[from] crate::synth::SynthError),
     #[error(transparent)]
     Poisson(#[from] crate::poisson::PoissonError),
+    #[error(transparent)]
+    Water(#[from] crate::water::WaterError),
+    #[error(transparent)]
+    Erode(#[from] crate::erode::ErodeError),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

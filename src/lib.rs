@@ -11,6 +11,7 @@
 pub mod backend;
 pub mod blend;
 pub mod database;
+pub mod erode;
 pub mod error;
 pub mod eval;
 pub mod georef;
@@ -35,6 +36,7 @@ pub mod size;
 pub mod stages;
 pub mod synth;
 pub mod tiles;
+pub mod water;
 
 pub use error::{Error, Result};
 pub use heightfield::{Georef, Heightfield, Stats};

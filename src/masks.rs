@@ -6,11 +6,10 @@
 //! - **slope**: degrees from the steepest of the central differences
 //!   (Horn's 3×3 would smooth more; central differences keep single-cell
 //!   gullies), `value = round(degrees × 255 / 90)`;
-//! - **flow accumulation**: D8 (O'Callaghan & Mark 1984; the one `eval`
-//!   measures drainage with, [`crate::eval::drainage::d8_area`]): every cell
-//!   sends itself and what it received to its steepest lower neighbour (drop
-//!   over distance, diagonals at √2 cells); pits keep their water (no
-//!   depression filling); edge cells drain into the grid like any other.
+//! - **flow accumulation**: `water`'s ([`crate::water::route`]): D8 on
+//!   the depression-filled surface with flats resolved, so flow crosses
+//!   pits and lakes instead of stopping in them; edge cells drain into the
+//!   grid like any other.
 //!   `value = round(255 × ln(cells) / ln(all cells))`, so a single cell is
 //!   0 and a river draining the whole grid 255;
 //! - **types**: [`crate::procedural::types::TypeMask::classify`] (ridge,
@@ -22,8 +21,8 @@
 //!   the relief where not rock, A wet ground where flow accumulation is in
 //!   its top quarter.
 
-use crate::eval::drainage::{Edges, d8_area};
 use crate::heightfield::Heightfield;
+use crate::water::{self, WaterError};
 use rayon::prelude::*;
 
 /// Slope in degrees, per cell.
@@ -58,10 +57,11 @@ pub struct Masks {
     pub splat: Option<Vec<[u8; 4]>>,
 }
 
-/// Computes slope, flow and (when asked) splat masks.
-pub fn compute(hf: &Heightfield, splat: bool) -> Masks {
+/// Computes slope, flow and (when asked) splat masks; flow needs every
+/// height (no nodata).
+pub fn compute(hf: &Heightfield, splat: bool) -> Result<Masks, WaterError> {
     let slope = slope_degrees(hf);
-    let acc = d8_area(hf, Edges::Inside);
+    let acc = water::route(hf)?.accumulation;
     let log_all = ((hf.len() as f32).ln()).max(f32::MIN_POSITIVE);
     let flow_f: Vec<f32> = acc.iter().map(|&a| (a as f32).ln() / log_all).collect();
     let to_u8 = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -90,11 +90,11 @@ pub fn compute(hf: &Heightfield, splat: bool) -> Masks {
             })
             .collect()
     });
-    Masks {
+    Ok(Masks {
         slope: slope.iter().map(|&d| to_u8(d / 90.0)).collect(),
         flow: flow_f.iter().map(|&f| to_u8(f)).collect(),
         splat,
-    }
+    })
 }
 
 /// An 8-bit PNG of `channels` samples per pixel (1 grey, 4 RGBA).
@@ -133,10 +133,10 @@ mod tests {
             (x as f32 - 4.0).abs() * 2.0 + (9 - y) as f32 * 0.1
         })
         .unwrap();
-        let acc = d8_area(&v, Edges::Inside);
+        let acc = water::route(&v).unwrap().accumulation;
         assert_eq!(acc[9 * 9 + 4], 90, "the outlet drains the whole grid");
         assert_eq!(acc[0], 1, "a corner receives nothing");
-        let m = compute(&v, true);
+        let m = compute(&v, true).unwrap();
         assert_eq!(m.flow[9 * 9 + 4], 255);
         assert_eq!(m.flow[0], 0);
         for p in m.splat.unwrap() {

@@ -9,13 +9,14 @@ use common::dem;
 use std::sync::OnceLock;
 use terrasynth::Heightfield;
 use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
-use terrasynth::eval::drainage::{Edges, d8_area};
+use terrasynth::eval::drainage::d8_area;
 use terrasynth::eval::{self, Reference, Value, describe, id, novelty};
 use terrasynth::io::CoordsMap;
 use terrasynth::io::coords_map::{NO_EXEMPLAR, Source};
 use terrasynth::progress::Silent;
 use terrasynth::synth::source_map::source_map;
 use terrasynth::synth::{Params, Synthesizer};
+use terrasynth::water::d8::Edges;
 
 fn values(hf: &Heightfield, i: usize) -> Vec<f32> {
     match &describe(hf).unwrap().values[i] {

@@ -8,6 +8,8 @@
 //! is released while the engine works, so threads (and Dask's threaded
 //! workers) run syntheses side by side.
 
+mod terrain;
+
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::{PyException, PyTypeError, PyValueError};
@@ -517,6 +519,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_heightfield, m)?)?;
     m.add_function(wrap_pyfunction!(eval, m)?)?;
     m.add_function(wrap_pyfunction!(novelty, m)?)?;
+    m.add_function(wrap_pyfunction!(terrain::water, m)?)?;
+    m.add_function(wrap_pyfunction!(terrain::erode, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

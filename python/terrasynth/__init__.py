@@ -17,11 +17,13 @@ from ._native import (
     Database,
     TerrasynthError,
     __version__,
+    erode,
     eval,
     novelty,
     read_heightfield,
     synthesize,
     synthesize_scene,
+    water,
     write_heightfield,
 )
 
@@ -29,10 +31,12 @@ __all__ = [
     "Database",
     "TerrasynthError",
     "__version__",
+    "erode",
     "eval",
     "novelty",
     "read_heightfield",
     "synthesize",
     "synthesize_scene",
+    "water",
     "write_heightfield",
 ]

@@ -87,3 +87,22 @@ def novelty(
     max_windows: int = 150,
 ) -> Dict[str, Any]:
     """Copy share against the exemplars, their halves' baseline, self-repetition."""
+
+def water(
+    heights: Union[npt.NDArray[np.float32], npt.NDArray[np.float64]],
+    cell_size: float,
+    *,
+    sea_level: Optional[float] = None,
+    river_area_km2: float = 5.0,
+    lake_min_depth: float = 2.0,
+    lake_min_area_km2: float = 0.1,
+) -> Dict[str, Any]:
+    """`terrasynth water`: filled, depth, accumulation, receivers, rivers (arrays) and summary."""
+
+def erode(
+    heights: Union[npt.NDArray[np.float32], npt.NDArray[np.float64]],
+    cell_size: float,
+    *,
+    strength: float = 1.0,
+) -> npt.NDArray[np.float32]:
+    """`terrasynth erode`: the heights after the local erosion filter."""

@@ -61,8 +61,29 @@ pub struct Manifest {
     /// The GDAL mosaic (`world.vrt`), once every tile is written; none for
     /// formats GDAL cannot open (r16).
     pub vrt: Option<String>,
+    /// The water rasters beside the tiles (`tiles --water`), when made.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub water: Option<WaterEntry>,
     /// Finished tiles, row by row.
     pub tiles: Vec<Record>,
+}
+
+/// The water of a tile directory (`tiles --water`, [`super::water`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WaterEntry {
+    pub sea_level_m: Option<f32>,
+    pub river_area_km2: f64,
+    pub lake_min_depth_m: f64,
+    pub lake_min_area_km2: f64,
+    /// How the tiles' water files are named.
+    pub tile_files: String,
+    /// The rasters' suffixes in those names.
+    pub rasters: Vec<String>,
+    /// One GDAL mosaic per raster.
+    pub vrts: Vec<String>,
+    /// Lakes in the whole world.
+    pub lakes: usize,
 }
 
 impl Manifest {

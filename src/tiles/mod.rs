@@ -15,6 +15,8 @@
 //!   file still has its CRC, and makes the rest. The manifest is rewritten
 //!   at most every [`SAVE_EVERY`] (and at the end), so an interrupted run
 //!   loses at most that much work.
+//! - With water (`tiles --water`, [`water`]): per-tile lakes, flow and
+//!   rivers equal to the whole world's, written after the height tiles.
 //! - 16-bit formats share one height mapping across tiles (game engines
 //!   import tiled heightmaps with one height scale, and the mosaic needs
 //!   one): the caller's range, or the database's widened by a quarter on
@@ -23,6 +25,7 @@
 pub mod grid;
 pub mod manifest;
 pub mod vrt;
+pub mod water;
 
 use crate::heightfield::Heightfield;
 use crate::io::{self, Format, HeightMapping, IoError};
@@ -98,6 +101,8 @@ pub enum TilesError {
     },
     #[error(transparent)]
     Io(#[from] IoError),
+    #[error(transparent)]
+    Water(#[from] crate::water::WaterError),
 }
 
 /// The identity a tiling writes into its manifest.
@@ -227,6 +232,7 @@ pub fn write(
             identity,
             grid: [cols, rows],
             vrt: None,
+            water: None,
             tiles: Vec::new(),
         },
         done,

@@ -1,4 +1,5 @@
-//! `terrasynth bench`: median synthesis times per size, level and stage.
+//! `terrasynth bench`: median synthesis times per size, level and stage,
+//! median `water` times per size and stage, and median `erode` times.
 //!
 //! Timings come from the synthesizer's own stage clocks ([`Timings`]), so
 //! the numbers are the same ones a library user sees; each size is run
@@ -36,6 +37,48 @@ pub struct Args {
     /// them, else wall clock until the device is idle.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     backend: BackendArg,
+    /// Sizes to time `water` on (fill, flats, D8, accumulation, lakes,
+    /// rivers), each on a synthesis of that size (made once, not timed).
+    #[arg(long, value_delimiter = ',', value_parser = parse_size,
+          default_value = "4096x4096")]
+    water_sizes: Vec<(usize, usize)>,
+    /// Sizes to time `erode` (the default strength) on, each on a
+    /// synthesis of that size.
+    #[arg(long, value_delimiter = ',', value_parser = parse_size,
+          default_value = "1024x1024")]
+    erode_sizes: Vec<(usize, usize)>,
+    /// Time only synthesis, only water or only erode.
+    #[arg(long, value_enum)]
+    only: Option<Only>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Only {
+    Synth,
+    Water,
+    Erode,
+}
+
+/// One size's median `erode` time.
+#[derive(Serialize)]
+struct ErodeReport {
+    size: String,
+    runs: u32,
+    threads: usize,
+    strength: f32,
+    total_ms: f64,
+}
+
+/// One size's water medians, in milliseconds.
+#[derive(Serialize)]
+struct WaterReport {
+    size: String,
+    runs: u32,
+    threads: usize,
+    total_ms: f64,
+    stages: BTreeMap<&'static str, f64>,
+    lakes: usize,
+    river_segments: usize,
 }
 
 /// One size's medians, in milliseconds.
@@ -69,6 +112,8 @@ struct LevelReport {
 #[derive(Serialize)]
 struct Report {
     sizes: Vec<SizeReport>,
+    water: Vec<WaterReport>,
+    erode: Vec<ErodeReport>,
 }
 
 fn ms(d: Duration) -> f64 {
@@ -91,7 +136,12 @@ pub fn run(a: Args) -> CliResult {
     let mut synth = Synthesizer::new(&db, Params::default())?;
     select_backend(&mut synth, a.backend)?;
     let mut sizes = Vec::new();
-    for &(w, h) in &a.sizes {
+    let synth_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Synth) {
+        &[]
+    } else {
+        &a.sizes
+    };
+    for &(w, h) in synth_sizes {
         synth.run(w, h, a.seed)?; // warm-up: page in the database, spin up threads
         let timings: Vec<Timings> = (0..a.runs)
             .map(|k| synth.run(w, h, a.seed.wrapping_add(k)).map(|s| s.timings))
@@ -143,8 +193,95 @@ pub fn run(a: Args) -> CliResult {
         }
         sizes.push(report);
     }
+    let mut water = Vec::new();
+    let water_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Water) {
+        &[]
+    } else {
+        &a.water_sizes
+    };
+    for &(w, h) in water_sizes {
+        let hf = synth.run(w, h, a.seed)?.heightfield;
+        let params = terrasynth::water::Params::default();
+        let first = terrasynth::water::compute(&hf, &params)?; // warm-up
+        let timings: Vec<terrasynth::water::Timings> = (0..a.runs)
+            .map(|_| terrasynth::water::compute(&hf, &params).map(|w| w.timings))
+            .collect::<Result<_, _>>()?;
+        let med = |f: &dyn Fn(&terrasynth::water::Timings) -> Duration| {
+            median(timings.iter().map(|t| ms(f(t))).collect())
+        };
+        let report = WaterReport {
+            size: format!("{w}x{h}"),
+            runs: a.runs,
+            threads: rayon::current_num_threads(),
+            total_ms: med(&|t| t.total()),
+            stages: BTreeMap::from([
+                ("fill", med(&|t| t.fill)),
+                ("flats", med(&|t| t.flats)),
+                ("d8", med(&|t| t.d8)),
+                ("accumulate", med(&|t| t.accumulate)),
+                ("lakes", med(&|t| t.lakes)),
+                ("rivers", med(&|t| t.rivers)),
+            ]),
+            lakes: first.bodies.lakes.len(),
+            river_segments: first.rivers.segments.len(),
+        };
+        if !a.json {
+            println!(
+                "water {} (synthesis seed {}): {:.1} ms median of {} runs on {} threads; {} lakes, {} river segments",
+                report.size,
+                a.seed,
+                report.total_ms,
+                report.runs,
+                report.threads,
+                report.lakes,
+                report.river_segments
+            );
+            for (name, t) in &report.stages {
+                println!("  {name:<16} {t:>8.1} ms");
+            }
+        }
+        water.push(report);
+    }
+    let mut erode = Vec::new();
+    let erode_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Erode) {
+        &[]
+    } else {
+        &a.erode_sizes
+    };
+    for &(w, h) in erode_sizes {
+        let hf = synth.run(w, h, a.seed)?.heightfield;
+        let strength = terrasynth::erode::DEFAULT_STRENGTH;
+        terrasynth::erode::erode(&hf, strength)?; // warm-up
+        let times: Vec<f64> = (0..a.runs)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                terrasynth::erode::erode(&hf, strength).map(|_| ms(t.elapsed()))
+            })
+            .collect::<Result<_, _>>()?;
+        let report = ErodeReport {
+            size: format!("{w}x{h}"),
+            runs: a.runs,
+            threads: rayon::current_num_threads(),
+            strength,
+            total_ms: median(times),
+        };
+        if !a.json {
+            println!(
+                "erode {} (synthesis seed {}, strength {}): {:.1} ms median of {} runs on {} threads",
+                report.size, a.seed, strength, report.total_ms, report.runs, report.threads
+            );
+        }
+        erode.push(report);
+    }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&Report { sizes })?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&Report {
+                sizes,
+                water,
+                erode
+            })?
+        );
     }
     Ok(())
 }

@@ -5,6 +5,7 @@ mod bench;
 mod convert;
 mod db;
 mod edit;
+mod erode;
 mod eval;
 mod generate;
 mod info;
@@ -17,6 +18,7 @@ mod sketch;
 mod suite;
 mod synth;
 mod tiles;
+mod water;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -40,6 +42,12 @@ enum Command {
     Convert(convert::Args),
     /// Write slope, flow accumulation, terrain-type and splat masks of a heightfield.
     Masks(masks::Args),
+    /// Fill depressions and route water: filled surface, lakes (water
+    /// depth), flow accumulation, rivers (raster and GeoJSON lines).
+    Water(water::Args),
+    /// Erode a heightfield: a few local steps of stream-power incision and
+    /// hillslope creep (windows of a world erode like crops of it).
+    Erode(erode::Args),
     /// Time synthesis: median ms per size, level and stage, and memory per pixel.
     Bench(bench::Args),
     /// Build or inspect an exemplar database.
@@ -85,6 +93,8 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Masks(a) => masks::run(a),
+        Command::Water(a) => water::run(a),
+        Command::Erode(a) => erode::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Db(c) => db::run(c),
         Command::Render(a) => render::run(a),

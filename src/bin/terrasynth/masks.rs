@@ -36,7 +36,7 @@ pub fn run(a: Args) -> CliResult {
     std::fs::create_dir_all(&a.out_dir)
         .map_err(|e| format!("cannot create {}: {e}", a.out_dir.display()))?;
     let (w, h) = (hf.width(), hf.height());
-    let m = masks::compute(&hf, a.splat);
+    let m = masks::compute(&hf, a.splat)?;
     let types = TypeMask::classify(&hf);
     let name = a.input.display().to_string();
     let mut files = vec![
@@ -57,7 +57,7 @@ pub fn run(a: Args) -> CliResult {
         "height": h,
         "cell_size_m": hf.cell_size(),
         "slope.png": "slope in degrees = value x 90 / 255",
-        "flow.png": "D8 flow accumulation: cells = exp(value / 255 x ln(width x height))",
+        "flow.png": "D8 flow accumulation on the depression-filled surface (as terrasynth water): cells = exp(value / 255 x ln(width x height))",
         "types.png": "terrain type index, names in types.json",
         "splat.png": if a.splat { "RGBA weights summing to 255: R grass, G rock (slope > 30 deg), B snow (top 15 % of the relief), A wet (top quarter of log flow)" } else { "not written (--splat)" },
     });

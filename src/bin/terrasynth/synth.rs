@@ -65,6 +65,11 @@ pub struct Args {
     /// (see `convert --for`).
     #[arg(long = "for", value_enum)]
     engine: Option<EngineArg>,
+    /// Erode the result with this strength (0-10, as `terrasynth erode
+    /// --strength`); a --window erodes to the same bytes as the same crop
+    /// of the whole world eroded.
+    #[arg(long, value_name = "S", value_parser = crate::erode::parse_strength, conflicts_with = "scene")]
+    erode: Option<f32>,
 }
 
 /// Refuses outputs that would replace an input, before any work is done.
@@ -132,10 +137,14 @@ pub fn run(a: Args) -> CliResult {
         .params(a.coords.is_some() || a.coords_preview.is_some());
     let mut synth = Synthesizer::new(&db, params)?;
     select_backend(&mut synth, a.backend)?;
-    let (result, what) = match a.window {
-        None => (synth.run(w, h, a.seed)?, format!("{w} x {h}")),
-        Some(win) => {
-            let cone = synth.window_cone((w, h), win).map_err(window_error(win))?;
+    // With erosion, a window is synthesized with the halo its erosion reads.
+    let extent = a.window.map(|win| match a.erode {
+        Some(_) => terrasynth::erode::extent((w, h), win),
+        None => win,
+    });
+    let (mut result, what) = match (a.window, extent) {
+        (Some(win), Some(ext)) => {
+            let cone = synth.window_cone((w, h), ext).map_err(window_error(win))?;
             let what = format!(
                 "a {}x{} window of a {w}x{h} world",
                 win.width(),
@@ -149,9 +158,22 @@ pub fn run(a: Args) -> CliResult {
                 win.x0,
                 win.y0
             );
-            (synth.run_window((w, h), win, a.seed)?, what)
+            (synth.run_window((w, h), ext, a.seed)?, what)
         }
+        _ => (synth.run(w, h, a.seed)?, format!("{w} x {h}")),
     };
+    if let Some(strength) = a.erode {
+        let t = std::time::Instant::now();
+        let hf = &result.heightfield;
+        result.heightfield = match (a.window, extent) {
+            (Some(win), Some(ext)) => terrasynth::erode::window(hf, ext, win, strength)?,
+            _ => terrasynth::erode::erode(hf, strength)?,
+        };
+        eprintln!(
+            "eroded (strength {strength}) in {:.0} ms",
+            t.elapsed().as_secs_f64() * 1e3
+        );
+    }
     // The heightfield's encoder runs on one core: the preview is drawn
     // meanwhile.
     let (written, drawn) = rayon::join(

@@ -52,6 +52,14 @@ pub struct Args {
     /// Where the stages run: cpu, gpu or auto. Same tiles on each.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     backend: BackendArg,
+    /// Also the world's water, bit for bit `terrasynth water` on the whole
+    /// world: per tile tile_<col>_<row>.{filled,lakes,flow,rivers}.tif (its
+    /// core), and filled.vrt, lakes.vrt, flow.vrt, rivers.vrt. Computed
+    /// again on every run.
+    #[arg(long)]
+    water: bool,
+    #[command(flatten)]
+    water_params: crate::water::Knobs,
 }
 
 /// `--format`.
@@ -100,6 +108,13 @@ enum World {
 }
 
 pub fn run(a: Args) -> CliResult {
+    if a.water_params.any() && !a.water {
+        return Err(
+            "--sea-level, --river-area, --lake-min-depth and --lake-min-area need --water".into(),
+        );
+    }
+    let water_params = a.water_params.params();
+    water_params.check()?;
     let scene = a.scene.as_deref().map(Scene::read).transpose()?;
     let db_path = match &scene {
         Some(s) => s.database.clone(),
@@ -146,6 +161,15 @@ pub fn run(a: Args) -> CliResult {
         &format!("{threads} tiles of {tw}x{th} in parallel"),
         cone.bytes() * threads * factor,
     )?;
+    if a.water {
+        let (cw, ch) = (a.tile.min(w), a.tile.min(h));
+        let rings = (w.div_ceil(a.tile) * h.div_ceil(a.tile) * 2 * (cw + ch)) as u64;
+        io::check_memory(
+            &format!("water of {threads} tiles of {cw}x{ch} in parallel"),
+            terrasynth::water::tiled::BYTES_PER_CELL * (cw * ch) as u64 * threads
+                + rings * terrasynth::water::tiled::BYTES_PER_RING_CELL,
+        )?;
+    }
     let height_range_m = matches!(format, Format::Png16 | Format::R16).then(|| {
         a.height_range
             .unwrap_or_else(|| tiles::default_height_range(db.quantization()))
@@ -203,6 +227,22 @@ pub fn run(a: Args) -> CliResult {
         eprintln!(
             "note: {} samples lay outside the height range {lo:.1}..{hi:.1} m and were clamped (widen it with --height-range)",
             s.clamped
+        );
+    }
+    if a.water {
+        let t = Instant::now();
+        let r = tiles::water::write(
+            &tiling,
+            &a.out_dir,
+            &water_params,
+            &crate::progress::Bar::new(),
+        )?;
+        eprintln!(
+            "water: {} lakes; flats settled in {} rounds, flow in {}; {:.1} s (filled.vrt, lakes.vrt, flow.vrt, rivers.vrt)",
+            r.lakes,
+            r.flat_rounds,
+            r.flow_rounds,
+            t.elapsed().as_secs_f64()
         );
     }
     eprintln!("wrote {}", s.manifest.display());

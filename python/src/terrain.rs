@@ -1,0 +1,99 @@
+//! Water and erosion on heightfields: `terrasynth.water`, `terrasynth.erode`.
+
+use super::{err, heightfield};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Water on a heightfield (``terrasynth water``): depressions filled by
+/// priority-flood, flats resolved (Barnes et al. 2014), D8 flow on the
+/// filled surface, lakes, the sea and rivers.
+///
+/// ``heights``: float32/float64 (rows, columns), metres, no NaN;
+/// ``cell_size`` in metres. ``sea_level``: cells joined to the border at or
+/// below it are sea. A filled depression is a lake when at least
+/// ``lake_min_depth`` metres deep and ``lake_min_area_km2`` large; rivers
+/// drain at least ``river_area_km2``.
+///
+/// Returns a dict of (rows, columns) arrays — ``filled`` (float32: the
+/// water surface), ``depth`` (float32: lake and sea water depth),
+/// ``accumulation`` (uint32: D8 upstream area in cells), ``receivers``
+/// (int64: the flat index each cell drains to, -1 at outlets), ``rivers``
+/// (uint8: Strahler order of river cells) — and ``summary`` (the dict
+/// ``terrasynth water --json`` prints).
+#[pyfunction]
+#[pyo3(signature = (heights, cell_size, *, sea_level=None, river_area_km2=5.0, lake_min_depth=2.0, lake_min_area_km2=0.1))]
+pub fn water<'py>(
+    py: Python<'py>,
+    heights: &Bound<'py, PyAny>,
+    cell_size: f64,
+    sea_level: Option<f32>,
+    river_area_km2: f64,
+    lake_min_depth: f64,
+    lake_min_area_km2: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use terrasynth::water::{self, Params, Thresholds};
+    let hf = heightfield(heights, cell_size, "heights")?;
+    let params = Params {
+        sea_level,
+        lakes: Thresholds {
+            min_depth_m: lake_min_depth,
+            min_area_km2: lake_min_area_km2,
+        },
+        river_area_km2,
+    };
+    let (w, summary) = py
+        .allow_threads(|| -> Result<_, String> {
+            let w = water::compute(&hf, &params).map_err(|e| e.to_string())?;
+            let s = serde_json::to_string(&w.summary()).map_err(|e| e.to_string())?;
+            Ok((w, s))
+        })
+        .map_err(err)?;
+    let shape = (w.height, w.width);
+    let out = PyDict::new(py);
+    fn grid<T>(shape: (usize, usize), v: Vec<T>) -> Array2<T> {
+        Array2::from_shape_vec(shape, v).expect("one value per cell")
+    }
+    out.set_item("filled", grid(shape, w.filled).into_pyarray(py))?;
+    out.set_item("depth", grid(shape, w.bodies.depth).into_pyarray(py))?;
+    out.set_item("accumulation", grid(shape, w.accumulation).into_pyarray(py))?;
+    let receivers: Vec<i64> = w
+        .receivers
+        .iter()
+        .map(|&r| if r == water::d8::OUTLET { -1 } else { r as i64 })
+        .collect();
+    out.set_item("receivers", grid(shape, receivers).into_pyarray(py))?;
+    out.set_item("rivers", grid(shape, w.rivers.order).into_pyarray(py))?;
+    out.set_item(
+        "summary",
+        py.import("json")?.call_method1("loads", (summary,))?,
+    )?;
+    Ok(out)
+}
+
+/// The local erosion filter (``terrasynth erode``): a few steps of
+/// stream-power incision and hillslope creep, each local, so a window of a
+/// world erodes like the same crop of the whole world eroded (with
+/// ``terrasynth synth --erode``).
+///
+/// ``heights``: float32/float64 (rows, columns), metres, no NaN;
+/// ``cell_size`` in metres; ``strength`` 0 (unchanged) to 10. Returns the
+/// eroded heights, float32, of the same shape.
+#[pyfunction]
+#[pyo3(signature = (heights, cell_size, *, strength=terrasynth::erode::DEFAULT_STRENGTH))]
+pub fn erode<'py>(
+    py: Python<'py>,
+    heights: &Bound<'py, PyAny>,
+    cell_size: f64,
+    strength: f32,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let hf = heightfield(heights, cell_size, "heights")?;
+    let out = py
+        .allow_threads(|| terrasynth::erode::erode(&hf, strength))
+        .map_err(err)?;
+    let shape = (out.height(), out.width());
+    Ok(Array2::from_shape_vec(shape, out.into_vec())
+        .expect("one value per cell")
+        .into_pyarray(py))
+}
