@@ -394,3 +394,43 @@ fn save_writes_only_the_scene_file_and_a_restart_reloads_it() {
     let (_, f) = create(s.addr);
     assert_eq!(f["scene"], d);
 }
+
+/// Two tabs on one scene file (issue 43): a tab opened after another saved
+/// starts from that save, and a tab whose document predates a save cannot
+/// overwrite it unless it says so.
+#[test]
+fn a_save_from_another_tab_is_never_overwritten_silently() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("design.json");
+    let s = serve(N, Some(path.clone()), 3);
+    let a = s.addr;
+    let (one, _) = create(a);
+    let (two, _) = create(a);
+    let save = |id: &str, force: bool| {
+        let q = if force { "?force=true" } else { "" };
+        http::post(a, &format!("/api/sessions/{id}/save{q}"), None)
+    };
+    let mut ridge = doc();
+    ridge["points"] = json!([{"id": "ridge", "at": [20, 20], "height_m": 2500, "radius_px": 6}]);
+    put_scene(a, &one, &ridge, true);
+    assert_eq!(save(&one, false).status, 200);
+    // A tab opened now starts from tab one's save, not the server's start.
+    let (three, f) = create(a);
+    assert_eq!(f["scene"], ridge);
+    // Tab two loaded before that save: its save is refused, the file kept.
+    let mut knoll = doc();
+    knoll["points"] = json!([{"id": "knoll", "at": [40, 40], "height_m": 900, "radius_px": 6}]);
+    put_scene(a, &two, &knoll, true);
+    let e = expect_error(&save(&two, false), 409, "$");
+    assert!(e.contains("another tab"), "{e}");
+    assert_eq!(Scene::read(&path).unwrap().points[0].id, "ridge");
+    // Tab one saves again (its own save is its base); tab three, opened
+    // from the first save, is now behind and refused too.
+    assert_eq!(save(&one, false).status, 200);
+    expect_error(&save(&three, false), 409, "$");
+    // Forced, tab two replaces the file, and is then up to date.
+    assert_eq!(save(&two, true).status, 200);
+    assert_eq!(Scene::read(&path).unwrap().points[0].id, "knoll");
+    assert_eq!(save(&two, false).status, 200);
+    expect_error(&save(&one, false), 409, "$");
+}

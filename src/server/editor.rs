@@ -23,6 +23,7 @@ use crate::scene::Scene;
 use image::RgbaImage;
 use serde_json::{Value, json};
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, RwLock};
 use std::time::{Duration, Instant};
 use tokio::sync::oneshot;
@@ -92,9 +93,23 @@ pub struct Handle {
     /// The whole preview's PNG, encoded on demand, by revision.
     full_png: Mutex<Option<(u64, Arc<Vec<u8>>)>>,
     last_used: Mutex<Instant>,
+    /// The revision of the scene file this session's document stands on
+    /// (`App::saved`): a save from a session whose base is older would
+    /// overwrite another tab's save.
+    base: AtomicU64,
 }
 
 impl Handle {
+    /// The saved revision this session's document stands on.
+    pub fn base(&self) -> u64 {
+        self.base.load(Ordering::Relaxed)
+    }
+
+    /// After this session saved: its document is the saved one.
+    pub fn set_base(&self, revision: u64) {
+        self.base.store(revision, Ordering::Relaxed);
+    }
+
     /// Starts a session's thread on `doc` (already checked by `policy`);
     /// the receiver gets the first frame, or why there is none (then the
     /// session is closed).
@@ -104,6 +119,7 @@ impl Handle {
         style: Arc<Style>,
         doc: Value,
         scene: Scene,
+        base: u64,
     ) -> (Arc<Handle>, oneshot::Receiver<Reply>) {
         let handle = Arc::new(Handle {
             queue: Mutex::new(Queue::default()),
@@ -112,6 +128,7 @@ impl Handle {
             tiles: Mutex::new(VecDeque::new()),
             full_png: Mutex::new(None),
             last_used: Mutex::new(Instant::now()),
+            base: AtomicU64::new(base),
         });
         let (tx, rx) = oneshot::channel();
         let h = handle.clone();

@@ -57,6 +57,11 @@ pub enum ApiError {
         "this server was started without --scene, so it has no file to save to: restart it with --scene PATH, or use Download"
     )]
     NoSavePath,
+    /// Another tab saved after this session's document was loaded (409).
+    #[error(
+        "{path} was saved from another tab after this one opened it: saving now would overwrite that work. Download this design first, or save anyway to replace it"
+    )]
+    SaveConflict { path: String },
     /// A request from another site or host name (403).
     #[error("{0}")]
     Forbidden(String),
@@ -90,7 +95,7 @@ impl ApiError {
             ApiError::Full { .. } | ApiError::Memory { .. } | ApiError::NotReady(_) => {
                 StatusCode::SERVICE_UNAVAILABLE
             }
-            ApiError::NoSavePath => StatusCode::CONFLICT,
+            ApiError::NoSavePath | ApiError::SaveConflict { .. } => StatusCode::CONFLICT,
             ApiError::Forbidden(_) => StatusCode::FORBIDDEN,
             ApiError::Internal(_) => StatusCode::INTERNAL_SERVER_ERROR,
         }

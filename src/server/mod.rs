@@ -149,8 +149,12 @@ pub(crate) struct App {
     progress: LoadProgress,
     style: RwLock<Option<Arc<view::Style>>>,
     policy: Arc<doc::Policy>,
-    /// The document a new tab starts from (the scene file, or a blank one).
-    initial: Value,
+    /// The document a new tab starts from — the scene file as last saved
+    /// (or as the server found it, or a blank one) — and its revision.
+    /// Why the last save and not the file as found: a tab opened after
+    /// another saved started from the server's start and, saved, dropped
+    /// that work (issue 43).
+    saved: tokio::sync::Mutex<Saved>,
     registry: registry::Registry,
     scene_file: Option<PathBuf>,
     max_request_bytes: usize,
@@ -160,6 +164,12 @@ pub(crate) struct App {
     /// This run of the server: a page reloaded while it runs restores its
     /// unsaved document; after a restart the saved scene is loaded.
     instance: String,
+}
+
+/// The scene file's document as last saved, and how many saves it took.
+pub(crate) struct Saved {
+    pub doc: Value,
+    pub revision: u64,
 }
 
 /// A server running on its own threads.
@@ -368,7 +378,10 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
         progress: LoadProgress::default(),
         style: RwLock::new(None),
         policy: Arc::new(policy),
-        initial,
+        saved: tokio::sync::Mutex::new(Saved {
+            doc: initial,
+            revision: 0,
+        }),
         registry: registry::Registry::new(config.max_sessions.max(1), config.idle),
         scene_file: config.scene.clone(),
         max_request_bytes: config.max_request_bytes,
@@ -404,7 +417,7 @@ fn load_database(app: Arc<App>, source: DbSource) {
             Ok(db) => {
                 let checked = app
                     .policy
-                    .check_value(&app.initial)
+                    .check_value(&app.saved.blocking_lock().doc)
                     .and_then(|scene| Ok(SceneEdits::new().edits(&scene, db)?));
                 match checked {
                     Err(e) => DbState::Failed(format!("the scene cannot be edited: {e}")),

@@ -222,16 +222,36 @@ pub async fn export(
     Ok(r)
 }
 
-pub async fn save(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
+/// `POST /api/sessions/{id}/save[?force=true]`: writes the session's
+/// committed document to the scene file — refused (409) when another tab
+/// saved after this session's document was loaded, unless forced.
+pub async fn save(
+    State(app): State<Arc<App>>,
+    PathParam(id): PathParam,
+    RawQuery(raw): RawQuery,
+) -> Api {
+    let q = request::query(raw.as_deref(), &["force"])?;
+    let force = request::flag(&q, "force", false)?;
+    let h = app.registry.get(&id)?;
     let l = latest(&app, &id)?;
     let path = app.scene_file.clone().ok_or(ApiError::NoSavePath)?;
     let text = serde_json::to_string_pretty(&l.committed)
         .map_err(|e| ApiError::Internal(e.to_string()))?;
+    // Held across the write: two saves never interleave.
+    let mut saved = app.saved.lock().await;
+    if !force && h.base() != saved.revision {
+        return Err(ApiError::SaveConflict {
+            path: path.display().to_string(),
+        });
+    }
     let p = path.clone();
     tokio::task::spawn_blocking(move || io::write_atomic(&p, text.as_bytes()))
         .await
         .map_err(|e| ApiError::Internal(e.to_string()))?
         .map_err(|e| ApiError::Internal(format!("saving failed: {e}")))?;
+    saved.doc = l.committed.clone();
+    saved.revision += 1;
+    h.set_base(saved.revision);
     Ok(axum::Json(
         json!({"path": path.display().to_string(), "revision": l.revision}),
     ))

@@ -14,7 +14,7 @@
 //! | `GET /api/sessions/{id}/tile.png?revision=N` | the part of the preview frame N changed (header `x-rect: x0,y0,x1,y1`) |
 //! | `GET /api/sessions/{id}/heights` | binary: u32 width, u32 height, u32 stride, then f32 metres (≤ 512² samples); header `x-revision` |
 //! | `GET /api/sessions/{id}/export?format=exr[&sidecar=true]` | a download (any writable format, or `preview`) |
-//! | `POST /api/sessions/{id}/save` | writes the `--scene` file → `{"path"}` |
+//! | `POST /api/sessions/{id}/save[?force=true]` | writes the `--scene` file → `{"path"}`; 409 when another tab saved after this session's document was loaded (unless forced) |
 //! | `POST /api/sessions/{id}/ping`, `…/close` | keep alive; free the slot |
 //!
 //! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
@@ -220,7 +220,11 @@ async fn create(
 ) -> Api {
     let db = app.ready()?;
     let body = json_body(&headers, body, app.max_request_bytes)?;
-    let doc = request::new_session(&body)?.unwrap_or_else(|| app.initial.clone());
+    let (start, base) = {
+        let saved = app.saved.lock().await;
+        (saved.doc.clone(), saved.revision)
+    };
+    let doc = request::new_session(&body)?.unwrap_or(start);
     // Field paths inside {"scene": …} are the document's own.
     let scene = app.policy.check_value(&doc)?;
     let style = app
@@ -233,7 +237,7 @@ async fn create(
     let (w, h) = (scene.width, scene.height);
     let (id, rx) = app
         .registry
-        .admit(w, h, || Handle::spawn(db, policy, style, doc, scene))?;
+        .admit(w, h, || Handle::spawn(db, policy, style, doc, scene, base))?;
     match reply(rx).await {
         Ok(axum::Json(mut frame)) => {
             frame["session"] = json!(id);

@@ -116,8 +116,9 @@ export class Api {
     return (await check(res)).json();
   }
 
-  async save() {
-    return (await check(await fetch(this.url('/save'), { method: 'POST' }))).json();
+  /** Saves; `force` replaces a file another tab saved since this one loaded. */
+  async save(force = false) {
+    return (await check(await fetch(this.url(force ? '/save?force=true' : '/save'), { method: 'POST' }))).json();
   }
 
   async preview() {

@@ -201,7 +201,15 @@ async function undoRedo(which) {
 async function save() {
   await ed.api.idle();
   try {
-    const r = await ed.api.save();
+    let r;
+    try {
+      r = await ed.api.save();
+    } catch (e) {
+      // Another tab saved since this one loaded: say so, and replace the
+      // file only if the artist says to.
+      if (!(e.status === 409 && e.message.includes('another tab') && confirm(`${e.message}.\n\nReplace the saved file with this tab's design?`))) throw e;
+      r = await ed.api.save(true);
+    }
     $('status-error').textContent = '';
     // Keep the last edit's numbers on the status line beside the news.
     status();
