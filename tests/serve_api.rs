@@ -389,8 +389,14 @@ fn save_writes_only_the_scene_file_and_a_restart_reloads_it() {
     assert_eq!(saved.points[0].id, "peak");
     drop(s);
 
-    // A new server on the same file starts from the saved design.
+    // A new server on the same file starts from the saved design, and
+    // removes what a save killed midway left beside it (not others' files).
+    let orphan = dir.path().join(".design.json.99999999.0.tmp");
+    let other = dir.path().join(".notes.json.99999999.0.tmp");
+    std::fs::write(&orphan, b"{").unwrap();
+    std::fs::write(&other, b"{").unwrap();
     let s = serve(N, Some(path.clone()), 2);
+    assert!(!orphan.exists() && other.exists());
     let (_, f) = create(s.addr);
     assert_eq!(f["scene"], d);
 }

@@ -47,7 +47,7 @@ mod tiff;
 pub mod type_mask;
 pub mod wkt;
 
-pub use atomic::write_atomic;
+pub use atomic::{remove_orphans, write_atomic};
 pub use coords_map::CoordsMap;
 pub use error::{FormatError, IoError};
 pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;

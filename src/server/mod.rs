@@ -229,6 +229,16 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
     crate::size::check_dims(width, height)
         .map_err(|e| ServeError::Size(width, height, e.to_string()))?;
     let (mut app, source) = prepare(&config)?;
+    if let Some(scene) = &config.scene {
+        // Saves a killed server left half-written beside its scene file.
+        let n = crate::io::remove_orphans(scene);
+        if n > 0 {
+            eprintln!(
+                "removed {n} temporary file(s) an interrupted save left beside {}",
+                scene.display()
+            );
+        }
+    }
     let listener = std::net::TcpListener::bind(config.bind).map_err(|source| ServeError::Bind {
         addr: config.bind,
         source,
