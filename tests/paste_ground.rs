@@ -20,6 +20,7 @@ use terrasynth::synth::session::{Edit, Session};
 
 mod common;
 use common::db::{PYRENEES_CATALAN, default_db, two_dems};
+use common::distance_to;
 
 /// How far inside the lasso a pasted height may differ from source + lift:
 /// the seam, and 2 px more (`reconstruct` blends each pixel's smooth
@@ -68,18 +69,6 @@ fn lowest(hf: &Heightfield, side: usize) -> (f64, f64) {
         }
     }
     best.1
-}
-
-/// Distance from (x, y) to the nearest edge of a closed polygon.
-fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
-    let mut best = f64::INFINITY;
-    for (i, &a) in poly.iter().enumerate() {
-        let b = poly[(i + 1) % poly.len()];
-        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
-        let t = (((x - a.0) * ex + (y - a.1) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
-        best = best.min((x - a.0 - t * ex).hypot(y - a.1 - t * ey));
-    }
-    best
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -18,6 +18,7 @@ use terrasynth::synth::session::{Edit, Session};
 mod common;
 use common::db::{PYRENEES_CATALAN, two_dems};
 use common::dem;
+use common::distance_to;
 /// The output side, the crops' side.
 const N: usize = PYRENEES_CATALAN.side;
 /// Least slope across sloped points (median and least of the twenty sites
@@ -508,18 +509,6 @@ fn pasted_region_keeps_its_source_heights_plus_delta() {
     // Coherence holds the rest of the frame (as for a new point, see
     // `coherence_keeps_a_new_point_local`). Measured: 0.00 %.
     assert!(far < 0.005, "{:.2}% of far pixels moved", far * 100.0);
-}
-
-/// Distance from (x, y) to the nearest edge of a closed polygon.
-fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
-    let mut best = f64::INFINITY;
-    for (i, &a) in poly.iter().enumerate() {
-        let b = poly[(i + 1) % poly.len()];
-        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
-        let t = (((x - a.0) * ex + (y - a.1) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
-        best = best.min((x - a.0 - t * ex).hypot(y - a.1 - t * ey));
-    }
-    best
 }
 
 #[test]

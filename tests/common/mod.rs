@@ -150,3 +150,15 @@ pub fn correlation(p: &[(f64, f64)]) -> f64 {
     let vb: f64 = p.iter().map(|q| (q.1 - mb).powi(2)).sum();
     cov / (va * vb).sqrt()
 }
+
+/// Distance from (x, y) to the nearest edge of a closed polygon.
+pub fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
+    let mut best = f64::INFINITY;
+    for (i, &a) in poly.iter().enumerate() {
+        let b = poly[(i + 1) % poly.len()];
+        let (ex, ey) = (b.0 - a.0, b.1 - a.1);
+        let t = (((x - a.0) * ex + (y - a.1) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
+        best = best.min((x - a.0 - t * ex).hypot(y - a.1 - t * ey));
+    }
+    best
+}
