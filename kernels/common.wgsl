@@ -1,8 +1,9 @@
 // Shared by every kernel: the source of each stage is this file followed by
 // the stage's own (see src/backend/kernels.rs; WGSL has no includes).
 //
-// Mirrors src/hash.rs (stateless PCG hash) and src/level/fixed.rs (fixed-point
-// coordinates, rounding rules) bit for bit (DESIGN §6). Integer arithmetic
+// Mirrors src/hash.rs (stateless PCG hash), src/level/fixed.rs (fixed-point
+// coordinates, rounding rules) and src/stages/common.rs (what several stages
+// share) bit for bit (DESIGN §6). Integer arithmetic
 // only: u32 multiplies and adds wrap as Rust's `wrapping_*` do, `>>` on i32
 // is arithmetic like Rust's, and no shift amount ever reaches 32.
 
@@ -12,6 +13,10 @@ const FRAC_BITS: u32 = 8u;
 const ONE: i32 = 256;
 // Texels kept between synthesis coordinates and exemplar edges (layout::MARGIN).
 const MARGIN: i32 = 2;
+// The target set of an unconstrained pixel (stages::common::ALL_TYPES).
+const ALL_TYPES: u32 = 4294967295u;
+// What a texel's packed mode-1 appearance is offset by (appearance::MODE1_BIAS).
+const MODE1_BIAS: i32 = -32768;
 
 // Per-column addressing of one atlas level (level::atlas::Column).
 struct Column {

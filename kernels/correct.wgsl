@@ -104,14 +104,12 @@ fn parent_offset(x: u32, y: u32) -> i32 {
         + parent_v[qy * w + qx] + 8) >> 4u;
 }
 
-// correct::ALL_TYPES, W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight;
-// types::SEEDS_PER_TYPE; appearance::MODE1_BIAS; nudge::MAX_ERROR.
-const ALL_TYPES: u32 = 4294967295u;
+// correct::{W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight};
+// types::SEEDS_PER_TYPE; nudge::MAX_ERROR.
 const W_FREE: u32 = 4u;
 const SEEDS_PER_ALLOWED_TYPE: u32 = 9u;
 const SEED_SALT: u32 = 2120089600u;
 const SEEDS_PER_TYPE: u32 = 64u;
-const MODE1_BIAS: i32 = -32768;
 const MAX_ERROR: i32 = 16777216;
 const FLAT_WEIGHT: i32 = 8;
 
@@ -339,7 +337,7 @@ fn visit(
 
 // The k-coherence candidates of pixel (x, y) admitted by `admit` (the
 // closure `candidates` of scalar::correct_pixel_guided); whether any was.
-// The nine neighbours in correct::DELTAS order (the tie-break order),
+// The nine neighbours in stages::common::DELTAS order (the tie-break order),
 // written out: a loop over an array of them kept its arrays in local memory.
 fn candidates(ns: Hood, x: i32, y: i32, admit: u32, best: ptr<function, Best>) -> bool {
     var seen = Seen(UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN, UNSEEN);

@@ -21,9 +21,6 @@ struct ReconstructParams {
 @group(0) @binding(5) var<storage, read> heights: array<u32>;
 @group(0) @binding(6) var<storage, read_write> blended: array<i32>;
 
-// appearance::MODE1_BIAS.
-const MODE1_BIAS: i32 = -32768;
-
 // AtlasLevel::index.
 fn atlas_index(x: i32, y: i32) -> u32 {
     let c = columns[x];

@@ -19,9 +19,6 @@ struct ReduceTypesParams {
 @group(0) @binding(1) var<storage, read> child: array<u32>;
 @group(0) @binding(2) var<storage, read_write> out: array<u32>;
 
-// correct::ALL_TYPES.
-const ALL_TYPES: u32 = 4294967295u;
-
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= p.width || gid.y >= p.height) {

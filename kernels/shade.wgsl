@@ -97,18 +97,6 @@ fn shr_round(v: i32, k: u32) -> i32 {
     return select(m, -m, v < 0);
 }
 
-// shade::floor_div.
-fn floor_div(a: i32, d: i32) -> i32 {
-    let q = a / d;
-    return select(q, q - 1, a % d < 0);
-}
-
-// shade::floor_mod.
-fn floor_mod(a: i32, d: i32) -> i32 {
-    let r = a % d;
-    return select(r, r + d, r < 0);
-}
-
 // shade::isqrt.
 fn isqrt(n: u32) -> u32 {
     var rem = n;
@@ -265,7 +253,7 @@ struct Level {
 // shade::nearest_level.
 fn nearest_level(h: i32) -> Level {
     let interval = i32(p.contour_interval);
-    let q = floor_div(h - p.contour_base, interval);
+    let q = div_floor(h - p.contour_base, interval);
     let below = p.contour_base + q * interval;
     let r = h - below;
     var level = below;
@@ -277,7 +265,7 @@ fn nearest_level(h: i32) -> Level {
     if ((p.flags & F_SEA) != 0u && level == p.contour_base) {
         return Level(0, 0u, false, false);
     }
-    let index = p.contour_index_every != 0u && floor_mod(k, i32(p.contour_index_every)) == 0;
+    let index = p.contour_index_every != 0u && rem_floor(k, i32(p.contour_index_every)) == 0;
     return Level(level, abs_diff(h, level), index, true);
 }
 
@@ -393,7 +381,7 @@ fn shade_pixel(x: u32, y: u32) -> u32 {
     var cl = Level(0, 0u, false, false);
     if ((p.flags & F_CONTOURS) != 0u) {
         let sum = 4 * h + 2 * (n + s + we + ea) + (nw + ne + sw + se);
-        cl = nearest_level(floor_div(sum, 16));
+        cl = nearest_level(div_floor(sum, 16));
         if (cl.some && !straddles(lo, hi, cl.level)) {
             cl.some = false;
         }

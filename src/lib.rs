@@ -18,6 +18,7 @@ pub mod georef;
 pub mod hash;
 pub mod heightfield;
 pub mod io;
+pub mod isa;
 pub mod level;
 pub mod masks;
 pub mod nodata;

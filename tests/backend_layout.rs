@@ -341,11 +341,10 @@ fn shade_constants_match() {
 
 #[test]
 fn correct_constants_match() {
-    use terrasynth::database::appearance::MODE1_BIAS;
     use terrasynth::database::types::SEEDS_PER_TYPE;
     use terrasynth::stages::correct::nudge::MAX_ERROR;
     use terrasynth::stages::correct::{
-        ALL_TYPES, CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, SEED_SALT,
+        CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, SEED_SALT,
         SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };
     let src = kernels::CORRECT.source;
@@ -353,7 +352,6 @@ fn correct_constants_match() {
         ("F_TARGETS", CORRECT_TARGETS),
         ("F_ALLOWED", CORRECT_ALLOWED),
         ("F_COHERENCE", CORRECT_COHERENCE),
-        ("ALL_TYPES", ALL_TYPES),
         ("W_FREE", W_FREE as u32),
         ("SEEDS_PER_ALLOWED_TYPE", SEEDS_PER_ALLOWED_TYPE),
         ("SEED_SALT", SEED_SALT),
@@ -365,7 +363,6 @@ fn correct_constants_match() {
         );
     }
     for (name, v) in [
-        ("MODE1_BIAS", MODE1_BIAS),
         ("MAX_ERROR", MAX_ERROR),
         ("FLAT_WEIGHT", FLAT.weight as i32),
     ] {
@@ -378,14 +375,7 @@ fn correct_constants_match() {
 
 #[test]
 fn reconstruct_constants_match() {
-    use terrasynth::database::appearance::MODE1_BIAS;
     use terrasynth::stages::repair_extrema::SUPPORT;
-    assert!(
-        kernels::RECONSTRUCT
-            .source
-            .contains(&format!("const MODE1_BIAS: i32 = {MODE1_BIAS};")),
-        "MODE1_BIAS must be {MODE1_BIAS} in reconstruct.wgsl"
-    );
     assert!(
         kernels::REPAIR_EXTREMA
             .source
@@ -394,15 +384,32 @@ fn reconstruct_constants_match() {
     );
 }
 
+/// The constants several kernels share are declared once, in
+/// `common.wgsl`, with the values of their Rust twins — and in no stage's
+/// own file, where a second copy could drift.
 #[test]
-fn all_types_matches_reduce_types() {
-    assert_eq!(terrasynth::stages::correct::ALL_TYPES, u32::MAX);
-    assert!(
-        kernels::REDUCE_TYPES
-            .source
-            .contains("const ALL_TYPES: u32 = 4294967295u;"),
-        "ALL_TYPES must be u32::MAX in reduce_types.wgsl"
-    );
+fn common_constants_match() {
+    use terrasynth::database::appearance::MODE1_BIAS;
+    use terrasynth::stages::common::ALL_TYPES;
+    assert_eq!(ALL_TYPES, u32::MAX);
+    for decl in [
+        format!("const ALL_TYPES: u32 = {ALL_TYPES}u;"),
+        format!("const MODE1_BIAS: i32 = {MODE1_BIAS};"),
+    ] {
+        assert_eq!(
+            kernels::COMMON.matches(&decl).count(),
+            1,
+            "{decl} in common.wgsl"
+        );
+        let name = decl.split(':').next().expect("a declaration");
+        for k in kernels::ALL {
+            assert!(
+                !k.source.contains(name),
+                "{name} declared again in {}.wgsl",
+                k.name
+            );
+        }
+    }
 }
 
 #[test]

@@ -17,9 +17,10 @@ use terrasynth::database::layout;
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::state::{State, level_size};
+use terrasynth::stages::common::ALL_TYPES;
 use terrasynth::stages::correct::nudge::{MAX_TOL, Target};
 use terrasynth::stages::correct::{
-    self, ALL_TYPES, Coherence, CorrectParams, DEFAULT_PRIOR, Guide, PRIORS, SUBPASSES,
+    self, Coherence, CorrectParams, DEFAULT_PRIOR, Guide, PRIORS, SUBPASSES,
 };
 use terrasynth::stages::reduce_types::reduce_types;
 use terrasynth::stages::reduce_weights::reduce_weights;

@@ -13,7 +13,7 @@ use std::path::Path;
 use terrasynth::backend::{Backend, cpu::Cpu};
 use terrasynth::io::type_mask::TypeMask;
 use terrasynth::level::state::level_size;
-use terrasynth::stages::correct::ALL_TYPES;
+use terrasynth::stages::common::ALL_TYPES;
 use terrasynth::synth::control::UNCONSTRAINED;
 
 mod common;

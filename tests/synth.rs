@@ -11,7 +11,7 @@ use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::fixed::{FRAC_BITS, round};
 use terrasynth::level::state::State;
 use terrasynth::progress::Silent;
-use terrasynth::stages::correct::scalar::texel_height;
+use terrasynth::stages::common::texel_height;
 use terrasynth::synth::cone::Rect;
 use terrasynth::synth::{Params, Synthesizer, coarse};
 

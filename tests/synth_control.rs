@@ -1,6 +1,6 @@
 //! User control on real DEMs (issue 5 "Done means"): point accuracy and
-//! slope, painted types, freezing, coherence locality, copy-paste, and
-//! exact restricted re-synthesis. A small database is built from two 256²
+//! slope, painted types, freezing, coherence locality and exact restricted
+//! re-synthesis (copy-paste: `tests/synth_paste.rs`). A small database is built from two 256²
 //! crops of ../shared/dem (with their type masks), a second one from a
 //! Yosemite crop for points at another output size; skipped when absent.
 
@@ -10,15 +10,14 @@ use terrasynth::heightfield::Heightfield;
 use terrasynth::progress::Silent;
 use terrasynth::synth::Params;
 use terrasynth::synth::control::{
-    Constraint, ConstraintId, Lift, PASTE_FEATHER, Paste, PasteSource, PointConstraint,
-    UNCONSTRAINED,
+    Constraint, ConstraintId, Lift, Paste, PasteSource, PointConstraint, UNCONSTRAINED,
 };
 use terrasynth::synth::session::{Edit, Session};
 
 mod common;
-use common::db::{PYRENEES_CATALAN, two_dems};
+use common::db::{PYRENEES_CATALAN, start_relief, two_dems};
 use common::dem;
-use common::distance_to;
+use common::moved_outside;
 /// The output side, the crops' side.
 const N: usize = PYRENEES_CATALAN.side;
 /// Least slope across sloped points (median and least of the twenty sites
@@ -32,12 +31,6 @@ const SLOPE_MIN: f64 = 12.0;
 
 fn db() -> Option<&'static Database> {
     two_dems(PYRENEES_CATALAN, "control tests on real DEMs")
-}
-
-/// Relief (max − min) of the start exemplar, metres.
-fn relief(db: &Database) -> f64 {
-    let e = &db.meta().exemplars[0];
-    e.max_m - e.min_m
 }
 
 fn session(db: &Database) -> Session<'_> {
@@ -90,7 +83,7 @@ fn point_constraint_sets_height_and_slope() {
     // coarse start's pieces (issue 46) mean 1.24 %, worst 2.65 % (seed 12,
     // the raised point), and the bound on the worst is 3.5 % again.
     let Some(db) = db() else { return };
-    let rel = relief(db);
+    let rel = start_relief(db);
     let mut errors = Vec::new();
     let mut slopes = Vec::new();
     for seed in 7..17 {
@@ -242,31 +235,10 @@ fn frozen_pixels_survive_edits_elsewhere_bit_for_bit() {
     assert!(change.pixels > 100, "the point changed nothing");
 }
 
-/// Fraction of pixels farther than `reach` from (x, y) whose height moved
-/// by more than 1% of relief.
-fn moved_outside(
-    a: &Heightfield,
-    b: &Heightfield,
-    (x, y): (f64, f64),
-    reach: f64,
-    rel: f64,
-) -> f64 {
-    let (mut n, mut moved) = (0, 0);
-    for v in 0..N {
-        for u in 0..N {
-            if (u as f64 + 0.5 - x).hypot(v as f64 + 0.5 - y) > reach {
-                n += 1;
-                moved += ((a.get(u, v) - b.get(u, v)).abs() as f64 > 0.01 * rel) as usize;
-            }
-        }
-    }
-    moved as f64 / n as f64
-}
-
 #[test]
 fn coherence_keeps_a_new_point_local() {
     let Some(db) = db() else { return };
-    let rel = relief(db);
+    let rel = start_relief(db);
     let site = (140.0, 100.0);
     let run = |coherence: bool| {
         let mut s = session(db);
@@ -369,149 +341,6 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
 /// that addressed the atlas in other coordinates than the exemplar's (a
 /// pad, an offset) would land other pixels there.
 #[test]
-fn an_exemplar_paste_copies_the_exemplar_pixels() {
-    let Some(db) = db() else { return };
-    let mut s = session(db);
-    s.apply(vec![]).unwrap();
-    let e = 1;
-    let lasso = vec![(3.0, 4.0), (70.0, 3.0), (66.0, 58.0), (4.0, 62.0)];
-    let (ox, oy) = (120i64, 90i64);
-    let out = s
-        .apply(vec![Edit::Paste(Paste {
-            source: PasteSource::Exemplar(e),
-            lasso: lasso.clone(),
-            offset: (ox, oy),
-            delta_m: 0.0,
-            lift: Lift::Source,
-        })])
-        .unwrap()
-        .heightfield;
-    let (q, r) = (db.quantization(), db.level(0).layout.rects[e]);
-    let mut n = 0;
-    for y in 0..r.height {
-        for x in 0..r.width {
-            let within = |dx: f64, dy: f64| {
-                terrasynth::synth::control::inside(&lasso, x as f64 + 0.5 + dx, y as f64 + 0.5 + dy)
-            };
-            if [-1.0, 0.0, 1.0]
-                .iter()
-                .all(|&dy| [-1.0, 0.0, 1.0].iter().all(|&dx| within(dx, dy)))
-            {
-                let want = q.metres(f64::from(db.heights()[r.index(r.x0 + x, y)]));
-                let got = out.get(x as usize + ox as usize, y as usize + oy as usize) as f64;
-                assert!((got - want).abs() < 0.02, "({x}, {y}): {got} vs {want}");
-                n += 1;
-            }
-        }
-    }
-    assert!(n > 3000, "{n} pixels checked");
-}
-
-#[test]
-fn pasted_region_keeps_its_source_heights_plus_delta() {
-    let Some(db) = db() else { return };
-    let mut s = session(db);
-    let base = s.apply(vec![]).unwrap().heightfield;
-    let lasso = vec![(30.0, 30.0), (90.0, 34.0), (80.0, 95.0), (36.0, 80.0)];
-    let (ox, oy, delta) = (130i64, 120i64, 150.0);
-    let out = s
-        .apply(vec![Edit::Paste(Paste {
-            source: PasteSource::Terrain,
-            lasso: lasso.clone(),
-            offset: (ox, oy),
-            delta_m: delta,
-            lift: Lift::Source,
-        })])
-        .unwrap()
-        .heightfield;
-    let q = db.quantization();
-    let units = (delta / q.scale_m).round();
-    // The offset rises from 0 at the lasso to δ at PASTE_FEATHER inside
-    // (a smoothstep of the distance), so the paste stands on a slope, not
-    // on a wall δ high along its outline.
-    let feather = |x: f64, y: f64| {
-        let t = (distance_to(&lasso, x, y) / PASTE_FEATHER).min(1.0);
-        (units * t * t * (3.0 - 2.0 * t)).round() * q.scale_m
-    };
-    let (mut n, mut full, mut rim, mut rim_n, mut repaired) = (0, 0, 0.0, 0, 0);
-    for y in 0..N {
-        for x in 0..N {
-            // Pixels whose 3×3 neighbourhood lies in the paste: reconstruct
-            // blends the one-pixel rim with the terrain around it.
-            let within = |dx: f64, dy: f64| {
-                terrasynth::synth::control::inside(&lasso, x as f64 + 0.5 + dx, y as f64 + 0.5 + dy)
-            };
-            if [-1.0, 0.0, 1.0]
-                .iter()
-                .all(|&dy| [-1.0, 0.0, 1.0].iter().all(|&dx| within(dx, dy)))
-            {
-                let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
-                // Reconstruct averages the 3×3 neighbours' offsets.
-                let mut lift = 0.0;
-                for dy in [-1.0, 0.0, 1.0] {
-                    for dx in [-1.0, 0.0, 1.0] {
-                        lift += feather(cx + dx, cy + dy) / 9.0;
-                    }
-                }
-                let want = base.get(x, y) as f64 + lift;
-                let got = out.get(x + ox as usize, y + oy as usize) as f64;
-                // Where the lift varies within the 5×5 a height depends on
-                // (the feather), a join's pit or peak may be repaired in
-                // one output and not the other (`repair_extrema`): those
-                // few pixels take a neighbour's height instead.
-                if (got - want).abs() >= 0.02 {
-                    let d = distance_to(&lasso, cx, cy);
-                    assert!(
-                        d < PASTE_FEATHER + 3.0,
-                        "({x}, {y}): {got} vs {want}, {d:.1} px in"
-                    );
-                    repaired += 1;
-                }
-                n += 1;
-                full += usize::from(distance_to(&lasso, cx, cy) > PASTE_FEATHER + 1.5);
-                if distance_to(&lasso, cx, cy) < 3.0 {
-                    rim += got - base.get(x, y) as f64;
-                    rim_n += 1;
-                }
-            }
-        }
-    }
-    let rim = rim / rim_n as f64;
-    println!(
-        "paste: {full} pixels lifted by the full δ; the rim within 3 px by {rim:.1} m; \
-         {repaired} of {n} repaired differently"
-    );
-    assert!(
-        n > 2000 && full > 100,
-        "{n} pixels checked, {full} at full δ"
-    );
-    // About the density of join extrema in the feather zone (2 % here).
-    assert!(
-        repaired * 20 <= n,
-        "{repaired} of {n} pixels off base + lift"
-    );
-    assert!(
-        rim < 0.15 * delta,
-        "the rim is lifted by {rim:.1} m of {delta} m"
-    );
-    // Outside the paste and its blend margin, the terrain stays put.
-    let far = moved_outside(
-        &base,
-        &out,
-        (ox as f64 + 60.0, oy as f64 + 60.0),
-        90.0,
-        relief(db),
-    );
-    println!(
-        "paste: {n} pixels exact; {:.2}% of far pixels moved > 1% of relief",
-        far * 100.0
-    );
-    // Coherence holds the rest of the frame (as for a new point, see
-    // `coherence_keeps_a_new_point_local`). Measured: 0.00 %.
-    assert!(far < 0.005, "{:.2}% of far pixels moved", far * 100.0);
-}
-
-#[test]
 fn sessions_are_identical_on_one_and_two_threads() {
     let Some(db) = db() else { return };
     let cell = db.meta().exemplars[0].cell_size_m;
@@ -577,7 +406,7 @@ fn texture(hf: &Heightfield, (x, y): (f64, f64), r: f64) -> f64 {
 fn lowered_and_raised_points_on_a_second_dem_and_size() {
     let Some(db) = yosemite() else { return };
     let (w, h) = (320, 224);
-    let rel = relief(db);
+    let rel = start_relief(db);
     for (k, (site, dir, lift)) in [((110.3, 96.8), 2.4, -0.22), ((214.6, 130.2), -0.9, 0.22)]
         .into_iter()
         .enumerate()

@@ -16,7 +16,7 @@
 
 use super::file::Bytes;
 use super::{Database, Level, layout};
-use crate::stages::isa::prefetch;
+use crate::isa::prefetch;
 use rayon::prelude::*;
 use std::ops::Range;
 

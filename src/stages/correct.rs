@@ -250,19 +250,6 @@ impl Prior {
     }
 }
 
-/// Candidate offsets Δ, in evaluation (and tie-break) order.
-pub const DELTAS: [(i32, i32); 9] = [
-    (0, 0),
-    (-1, -1),
-    (0, -1),
-    (1, -1),
-    (-1, 0),
-    (1, 0),
-    (-1, 1),
-    (0, 1),
-    (1, 1),
-];
-
 /// The four diagonals δ of the neighbourhoods.
 pub const DIAGONALS: [(i32, i32); 4] = [(-1, -1), (1, -1), (-1, 1), (1, 1)];
 
@@ -321,9 +308,6 @@ impl Guide<'_> {
         origin: [0, 0],
     };
 }
-
-/// Target set of an unconstrained pixel.
-pub const ALL_TYPES: u32 = u32::MAX;
 
 /// The previous frame's result of one level and pass, and the weights.
 #[derive(Debug, Clone, Copy)]

@@ -10,9 +10,9 @@
 //! `hash`), never a driver (`synth`, `render`, `patch`) or the backend.
 //! `docs/ARCHITECTURE.md` lists each stage's files, tests and benches.
 
+pub mod common; // what several stages share: texel heights, Δ order, type sets, height bits
 pub mod correct; // one subpass of the correction, under control inputs (paper eq. 3–9)
 pub mod fill_ssd; // round one of the patch engine's hole filling: DC-corrected SSD table
-pub mod isa; // which copy (baseline or AVX2) the run-time-dispatched stages run (not a stage)
 pub mod reconstruct; // level-0 coordinates and offsets → blended fixed-point heights
 pub mod reduce_types; // one level's allowed type sets R^i from the finer level's
 pub mod reduce_weights; // one level's coherence weights W^i from the finer level's

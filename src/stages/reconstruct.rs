@@ -40,18 +40,15 @@
 //! so no level-sized intermediate is needed and the rows in flight stay
 //! in cache.
 
-use super::correct::scalar::texel_height;
-use super::isa::prefetch;
+use super::common::{HEIGHT_FRAC_BITS, Texel, texel_height};
 use super::repair_extrema::{mean, repair};
+use crate::isa::prefetch;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, div_floor, round};
 use crate::level::state::State;
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 use std::sync::atomic::Ordering::Relaxed;
-
-/// Fractional bits of reconstructed heights.
-pub const HEIGHT_FRAC_BITS: u32 = 8;
 
 /// How far from a pixel the S and V its height depends on lie: the blend
 /// reads the 3×3 around it, the repair the blends of the 3×3 around it.
@@ -75,17 +72,6 @@ const AHEAD: usize = 3;
 /// Resolved rows a task keeps: the three a blend reads and the `AHEAD`
 /// ones being prefetched fit (a power of two: the slot is `y % RING`).
 const RING: usize = 8;
-
-/// What a pixel gives its neighbours' predictions: the atlas index of its
-/// rounded texel t(n), its exemplar's row stride and its offset V(n).
-/// S(n) is interior (two texels from every exemplar edge), so the texel one
-/// step away is in its exemplar, at `k − dx − dy·stride`.
-#[derive(Debug, Clone, Copy)]
-pub struct Texel {
-    pub k: i32,
-    pub stride: i32,
-    pub v: i32,
-}
 
 /// The smooth height μ of atlas texel `k`: its appearance mode 1, the
 /// height `correct` attributes to a texel.

@@ -7,7 +7,7 @@
 //! Sets are u32 bit masks of type ids; [`ALL_TYPES`] and `full` (every
 //! type of the database) both count as full.
 
-use crate::stages::correct::ALL_TYPES;
+use crate::stages::common::ALL_TYPES;
 use bytemuck::{Pod, Zeroable};
 use rayon::prelude::*;
 

@@ -29,8 +29,7 @@
 //! `kernels/repair_extrema.wgsl`; the CPU runs it fused with the blend,
 //! row block by row block (see [`super::reconstruct`]).
 
-use super::correct::DELTAS;
-use super::reconstruct::{HEIGHT_FRAC_BITS, Texel};
+use super::common::{DELTAS, HEIGHT_FRAC_BITS, Texel};
 use crate::level::fixed::div_floor;
 
 /// Support (of 8) from which a spurious extremum's texel counts as a hollow

@@ -19,7 +19,8 @@
 //!
 //! # Rounding rules (the same on both sides)
 //! - `a / b` on non-negative values truncates (= floor).
-//! - [`floor_div`]/[`floor_mod`] round toward −∞ for signed values.
+//! - Signed divisions round toward −∞: [`div_floor`](crate::level::fixed::div_floor)
+//!   and `rem_euclid` (`div_floor`/`rem_floor` of `kernels/common.wgsl`).
 //! - [`shr_sym`] shifts the magnitude and restores the sign (rounds toward
 //!   zero), so positive and negative slopes are treated alike;
 //!   [`shr_round`] adds half before shifting the magnitude (round half away
@@ -47,7 +48,7 @@ mod pixel;
 #[cfg(test)]
 mod tests;
 
-pub use arith::{blend, floor_div, floor_mod, isqrt, shr_round, shr_sym};
+pub use arith::{blend, isqrt, shr_round, shr_sym};
 pub use light::hillshade;
 pub use params::{ParamsError, ShadeBuffers, ShadeParams};
 pub use pixel::{shade, shade_pixel};

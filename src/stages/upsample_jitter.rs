@@ -150,7 +150,7 @@ const ROW_CHUNK: usize = 256;
 #[inline]
 fn jitter_row(p: &UpsampleParams, ax: u32, ay: u32, out: &mut [(i32, i32)]) {
     #[cfg(target_arch = "x86_64")]
-    if crate::stages::isa::avx2() {
+    if crate::isa::avx2() {
         // SAFETY: the CPU supports AVX2 (`isa::avx2` checks it), the one
         // feature the function enables.
         unsafe { jitter_row_avx2(p, ax, ay, out) };

@@ -10,8 +10,9 @@ use super::{Control, Frames, LevelMaps, LevelTiming, SynthError, Synthesis, Synt
 use crate::backend::{Backend, Stage};
 use crate::heightfield::Heightfield;
 use crate::level::state::top_level;
+use crate::stages::common::HEIGHT_FRAC_BITS;
 use crate::stages::correct::SUBPASSES;
-use crate::stages::reconstruct::{self, HEIGHT_FRAC_BITS};
+use crate::stages::reconstruct;
 use std::time::{Duration, Instant};
 
 impl Synthesizer<'_> {

@@ -182,3 +182,10 @@ fn build(spec: TwoDems) -> Option<Database> {
     };
     Some(database::build(inputs, &opts, &Silent).unwrap().0)
 }
+
+/// Relief (max − min) of a database's first exemplar, metres: the scale of
+/// the control tests' tolerances.
+pub fn start_relief(db: &Database) -> f64 {
+    let e = &db.meta().exemplars[0];
+    e.max_m - e.min_m
+}

@@ -3,6 +3,7 @@
 
 #[cfg(feature = "serve")]
 pub mod browser;
+pub mod crop;
 pub mod db;
 pub mod dem;
 #[cfg(feature = "serve")]
@@ -161,4 +162,25 @@ pub fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
         best = best.min((x - a.0 - t * ex).hypot(y - a.1 - t * ey));
     }
     best
+}
+
+/// Fraction of pixels farther than `reach` from (x, y) whose height moved
+/// by more than 1% of relief.
+pub fn moved_outside(
+    a: &Heightfield,
+    b: &Heightfield,
+    (x, y): (f64, f64),
+    reach: f64,
+    rel: f64,
+) -> f64 {
+    let (mut n, mut moved) = (0, 0);
+    for v in 0..a.height() {
+        for u in 0..a.width() {
+            if (u as f64 + 0.5 - x).hypot(v as f64 + 0.5 - y) > reach {
+                n += 1;
+                moved += ((a.get(u, v) - b.get(u, v)).abs() as f64 > 0.01 * rel) as usize;
+            }
+        }
+    }
+    moved as f64 / n as f64
 }

@@ -5,15 +5,15 @@
 
 use super::nudge::nudge;
 use super::{
-    ALL_TYPES, CLAMP, CorrectParams, DELTAS, DIAGONALS, Guide, Prior, SEED_SALT,
-    SEEDS_PER_ALLOWED_TYPE, W_FREE, weigh,
+    CLAMP, CorrectParams, DIAGONALS, Guide, Prior, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE, weigh,
 };
-use crate::database::appearance::{MODE1_BIAS, unpack_texel};
+use crate::database::appearance::unpack_texel;
 use crate::database::types::SEEDS_PER_TYPE;
 use crate::hash::{below, hash4};
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
+use crate::stages::common::{ALL_TYPES, DELTAS, texel_height};
 use rayon::prelude::*;
 
 /// Reflects a coordinate at the level border by 2 (keeps parity); the
@@ -89,13 +89,6 @@ fn score_with(
         }
     }
     (s * kappa, h)
-}
-
-/// Height (units, before V) the correction attributes to texel (qx, qy):
-/// its appearance mode 1, the Gaussian-weighted mean height around it.
-#[inline(always)]
-pub fn texel_height(texel: u64) -> i32 {
-    unpack_texel(texel)[0] as i32 - MODE1_BIAS
 }
 
 /// What a neighbour contributes: the texel its coordinate points at (as

@@ -58,11 +58,12 @@ mod grid;
 mod score;
 
 use super::nudge::nudge;
-use super::{ALL_TYPES, DELTAS, Guide, ParentRow, Prior, W_FREE, scalar, weigh};
+use super::{Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::database::c2::Quad;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
+use crate::stages::common::{ALL_TYPES, DELTAS, texel_height};
 use gather::{Pending, Table, gather, per_pixel, source_at};
 use grid::{CHUNK, Grid};
 use score::{Neighbourhood, best_of, column, neighbourhood, score_with};
@@ -113,7 +114,7 @@ pub fn correct_span<const P: u32>(
     // compiler stopped inlining the pair scorer (a call per pair cost
     // level 1 ~8 %).
     #[cfg(target_arch = "x86_64")]
-    if crate::stages::isa::avx2() {
+    if crate::isa::avx2() {
         // SAFETY: the CPU supports AVX2, BMI1, BMI2, LZCNT and POPCNT
         // (`isa::avx2` checks them), the features the function enables.
         unsafe {
@@ -329,7 +330,7 @@ fn decide<const P: u32, const AVX2: bool>(
 fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>) -> i32 {
     match g.targets {
         Some(t) => {
-            let h_c = scalar::texel_height(atlas.level.appearance[idx as usize]) + v;
+            let h_c = texel_height(atlas.level.appearance[idx as usize]) + v;
             nudge(v, h_c, t[pixel])
         }
         None => v,

@@ -48,20 +48,6 @@ pub fn shr_round(v: i32, k: u32) -> i32 {
     if v < 0 { -m } else { m }
 }
 
-/// Floor division for `d > 0` (rounds toward −∞), from truncating division.
-#[inline]
-pub fn floor_div(a: i32, d: i32) -> i32 {
-    let q = a / d;
-    if a % d < 0 { q - 1 } else { q }
-}
-
-/// The remainder of [`floor_div`], in `0..d`.
-#[inline]
-pub fn floor_mod(a: i32, d: i32) -> i32 {
-    let r = a % d;
-    if r < 0 { r + d } else { r }
-}
-
 /// `floor(sqrt(n))`. The WGSL twin works bit by bit (16 fixed steps,
 /// with selects); here the hardware's square root gives the same value in
 /// a few instructions instead of a 16-step dependency chain per pixel:

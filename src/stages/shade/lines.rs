@@ -2,8 +2,9 @@
 //! the coastline) placed by the pixel's distance to a level in pixels,
 //! `|h − L| / |∇h|`, and the grid.
 
-use super::arith::{alpha256, blend, floor_div, floor_mod, isqrt, shr_sym};
+use super::arith::{alpha256, blend, isqrt, shr_sym};
 use super::{FULL, ShadeParams, flags};
+use crate::level::fixed::div_floor;
 
 /// Height gradient magnitude, kept as `(g, k)`: `g · 2^k ≈ |(gx, gy)|` with
 /// `g < 2^16`, where `(gx, gy)` are Horn sums (8 × units per pixel).
@@ -49,7 +50,7 @@ pub(super) struct Level {
 /// where sea level's contour is left to the coastline. One floor division.
 pub(super) fn nearest_level(p: &ShadeParams, h: i32) -> Option<Level> {
     let interval = p.contour_interval as i32;
-    let q = floor_div(h - p.contour_base, interval); // |q·I| ≤ 2^27 + 2^27
+    let q = div_floor(h - p.contour_base, interval); // |q·I| ≤ 2^27 + 2^27
     let below = p.contour_base + q * interval;
     let r = h - below; // 0 ≤ r < I
     let (level, k) = if r <= interval - r {
@@ -63,7 +64,7 @@ pub(super) fn nearest_level(p: &ShadeParams, h: i32) -> Option<Level> {
     Some(Level {
         level,
         dist: h.abs_diff(level),
-        index: p.contour_index_every != 0 && floor_mod(k, p.contour_index_every as i32) == 0,
+        index: p.contour_index_every != 0 && k.rem_euclid(p.contour_index_every as i32) == 0,
     })
 }
 

@@ -2,10 +2,11 @@
 //! docs) and the parallel loop over the image ([`shade`]); the light and
 //! the lines it draws live in their own files.
 
-use super::arith::{alpha256, apply_shade, blend, floor_div, shr_round, shr_sym};
+use super::arith::{alpha256, apply_shade, blend, shr_round, shr_sym};
 use super::hillshade;
 use super::lines::{Gradient, contour, line_coverage, nearest_level, on_grid, straddles};
 use super::{FULL, MAX_SLOPE, NO_TYPE, NODATA, ParamsError, ShadeBuffers, ShadeParams, flags};
+use crate::level::fixed::div_floor;
 use rayon::prelude::*;
 
 /// Shades every pixel into `out` (row-major, packed RGBA), in parallel over
@@ -127,7 +128,7 @@ pub fn shade_pixel(p: &ShadeParams, b: &ShadeBuffers, x: u32, y: u32) -> u32 {
         // as the gradient), so sensor noise on flat ground does not draw
         // a froth of tiny loops. |sum| ≤ 16 · 2^26 = 2^30.
         let sum = 4 * h + 2 * (n + s + we + ea) + (nw + ne + sw + se);
-        nearest_level(p, floor_div(sum, 16)).filter(|l| straddles(lo, hi, l.level))
+        nearest_level(p, div_floor(sum, 16)).filter(|l| straddles(lo, hi, l.level))
     } else {
         None
     };

@@ -4,7 +4,7 @@
 
 use crate::database::layout::MARGIN;
 use crate::level::atlas::AtlasLevel;
-use crate::stages::correct::scalar::texel_height;
+use crate::stages::common::texel_height;
 use rayon::prelude::*;
 
 /// Radius, in output pixels, of the surroundings whose mean altitude ranks

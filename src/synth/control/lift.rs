@@ -15,7 +15,7 @@
 
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, round};
-use crate::stages::correct::scalar::texel_height;
+use crate::stages::common::texel_height;
 
 /// What a paste's δ is added to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

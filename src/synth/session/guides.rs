@@ -12,7 +12,7 @@ use super::super::window::row_bounds;
 use super::super::{Guides, LevelGuide, union};
 use super::{FIRST_LEVEL, Session};
 use crate::level::state::level_size;
-use crate::stages::correct::ALL_TYPES;
+use crate::stages::common::ALL_TYPES;
 use crate::stages::correct::nudge::Target;
 use crate::stages::correct::{W_FREE, W_FROZEN};
 use crate::stages::reduce_types::reduce_types;

@@ -7,7 +7,7 @@
 //! cone region cropped out of its footprint.
 
 use crate::level::state::level_size;
-use crate::stages::correct::ALL_TYPES;
+use crate::stages::common::ALL_TYPES;
 use crate::stages::reduce_types::reduce_types;
 use crate::stages::reduce_weights::reduce_weights;
 use crate::synth::cone::{Cone, Rect};

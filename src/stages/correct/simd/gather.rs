@@ -2,12 +2,12 @@
 //! `u = S(p+Δ) − Δ` of a pixel, listed ahead of scoring with their texels
 //! prefetched.
 
-use super::super::DELTAS;
 use super::super::scalar::{Neighbour, neighbour};
 use super::grid::{CHUNK, Grid, any_edge};
+use crate::isa::prefetch;
 use crate::level::atlas::AtlasLevel;
 use crate::level::state::State;
-use crate::stages::isa::prefetch;
+use crate::stages::common::DELTAS;
 
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2;
@@ -344,7 +344,7 @@ mod tests {
     #[test]
     fn a_chunks_table_holds_each_pixels_sources_and_firsts() {
         #[cfg(target_arch = "x86_64")]
-        if crate::stages::isa::avx2() {
+        if crate::isa::avx2() {
             let mut grid = Grid::new();
             let mut table = super::Table::new();
             let mut h = 0x0BAD_5EEDu32;

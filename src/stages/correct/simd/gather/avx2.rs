@@ -10,9 +10,9 @@
 //! pixel's mask of first occurrences is built in its own lane — ~26
 //! instructions per pixel, off the pixel loop's dependency chains.
 
-use super::super::super::DELTAS;
 use super::super::grid::{GRID_COLS, Grid};
 use super::Table;
+use crate::stages::common::DELTAS;
 use core::arch::x86_64::*;
 
 /// Elements `b, b + 2, …, b + 14` of a grid row.
