@@ -9,6 +9,11 @@
 //! all inside the frozen region. Screenshots of every step go to
 //! `target/editor-screenshots/` (or `$TERRASYNTH_SCREENSHOTS`).
 //!
+//! Beside it, the page's hold on its session: reloads in a row (some
+//! while the session request is in flight) never use up the slots, and a
+//! server that goes away and comes back finds the page reconnecting with
+//! its document.
+//!
 //! Without chromium and chromedriver the test says so and passes, unless
 //! `TERRASYNTH_REQUIRE_BROWSER` is set (as `.ci/run` does), which makes a
 //! missing browser a failure.
@@ -17,13 +22,13 @@
 mod common;
 
 use common::browser::{
-    click, connect, drag, executables, js, revision, settled, shot, start_driver, wait_for,
+    click, drag, executables, in_chromium, js, revision, settled, shot, wait_for,
 };
 use common::editor::{self, heights};
 use fantoccini::Client;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use terrasynth::scene::Scene;
 use terrasynth::server::Running;
 
@@ -165,7 +170,7 @@ async fn design(c: &Client, server: &Running, shots: &Path) -> Steps {
 
 #[test]
 fn a_design_session_in_chromium() {
-    let Some((chromium, driver)) = executables() else {
+    let Some(browser) = executables() else {
         return;
     };
     let started = Instant::now();
@@ -178,19 +183,9 @@ fn a_design_session_in_chromium() {
             PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/editor-screenshots")
         });
     std::fs::create_dir_all(&shots).unwrap();
-    let wd = start_driver(&driver);
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .unwrap();
-    let c = rt.block_on(connect(&wd, &chromium, dir.path()));
-    // Close the browser even when a step fails (chromedriver alone would
-    // leave it running).
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        rt.block_on(design(&c, &server, &shots))
-    }));
-    let _ = rt.block_on(c.close());
-    let s = outcome.unwrap_or_else(|p| std::panic::resume_unwind(p));
+    let s = in_chromium(&browser, dir.path(), async |c| {
+        design(c, &server, &shots).await
+    });
 
     // The saved scene has exactly the design's controls.
     let text = std::fs::read(&scene_path).expect("the scene was saved");
@@ -279,11 +274,126 @@ fn a_design_session_in_chromium() {
         left.abs() < 0.03 * relief,
         "after undo {left:.0} m of {raise:.0} m remain"
     );
-    drop(wd);
     server.stop();
     eprintln!(
         "browser test took {:.1} s; screenshots in {}",
         started.elapsed().as_secs_f64(),
         shots.display()
     );
+}
+
+/// Seven reloads in a row, every other one while the page's session
+/// request is still in flight (issue 43: each of those leaked a slot, and
+/// once the slots were full the page died for 180 s). With two slots and a
+/// two-second heartbeat, the page after the seventh reload must come up
+/// and edit.
+#[test]
+fn reloads_never_leak_a_session_slot() {
+    let Some(browser) = executables() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    // 512²: a first frame slow enough to reload in the middle of.
+    let server = editor::serve_with(512, None, |c| c.idle = Duration::from_secs(2));
+    let started = Instant::now();
+    let mid_request = in_chromium(&browser, dir.path(), async |c| {
+        c.goto(&server.url()).await.unwrap();
+        let mut mid_request = 0;
+        for k in 0..7 {
+            if k % 2 == 0 && reload_mid_request(c).await {
+                mid_request += 1;
+            } else {
+                settled(c, -1).await;
+                c.refresh().await.unwrap();
+            }
+        }
+        settled(c, -1).await;
+        click(c, "[data-tool=point]").await;
+        let rev = revision(c).await;
+        drag(c, &[(200.0, 200.0)]).await;
+        settled(c, rev).await;
+        assert_eq!(js(c, "return window.__errors").await, json!([]));
+        mid_request
+    });
+    let open = common::http::get(server.addr, "/api/info").json()["sessions"]["open"].clone();
+    eprintln!(
+        "7 reloads, {mid_request} mid-request, took {:.1} s; {open} sessions open after",
+        started.elapsed().as_secs_f64()
+    );
+    assert!(
+        mid_request >= 2,
+        "only {mid_request} reloads hit the request"
+    );
+    server.stop();
+}
+
+/// Reloads the page the moment its session request is in flight; false
+/// when the page got its session first (then it is left loaded).
+async fn reload_mid_request(c: &Client) -> bool {
+    let t = Instant::now();
+    while t.elapsed() < Duration::from_secs(60) {
+        let state = js(
+            c,
+            "if (document.body.dataset.session === 'opening') { location.reload(); return 'reloaded'; }
+             return window.terrasynth ? 'ready' : 'waiting';",
+        )
+        .await;
+        match state.as_str() {
+            Some("reloaded") => return true,
+            Some("ready") => return false,
+            _ => {}
+        }
+    }
+    panic!("the page never asked for a session");
+}
+
+/// The server goes away under an open page and comes back on the same
+/// port: the page says "server unreachable — retrying", keeps the edit
+/// made meanwhile, and reconnects with its whole document.
+#[test]
+fn the_page_reconnects_when_the_server_comes_back() {
+    let Some(browser) = executables() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let server = editor::serve(SIZE, None, 2);
+    let addr = server.addr;
+    let url = server.url();
+    let back = in_chromium(&browser, dir.path(), async move |c| {
+        c.goto(&url).await.unwrap();
+        settled(c, -1).await;
+        click(c, "[data-tool=point]").await;
+        let rev = revision(c).await;
+        drag(c, &[(60.0, 60.0)]).await;
+        settled(c, rev).await;
+        let before = js(c, "return window.terrasynth.api.session").await;
+        server.stop();
+        wait_for(
+            c,
+            "the page to say the server is gone",
+            "const o = document.getElementById('offline'); return !o.hidden && o.textContent === 'server unreachable — retrying'",
+            20,
+        )
+        .await;
+        // An edit while the server is away stays in the page.
+        drag(c, &[(180.0, 180.0)]).await;
+        let back = editor::serve_with(SIZE, None, |cf| cf.bind = addr);
+        wait_for(
+            c,
+            "the reconnect",
+            &format!(
+                "const ed = window.terrasynth; return document.getElementById('offline').hidden && ed.api.session !== {before} && !ed.api.busy()"
+            ),
+            30,
+        )
+        .await;
+        let session = js(c, "return window.terrasynth.api.session").await;
+        assert_eq!(js(c, "return window.__errors").await, json!([]));
+        (back, session.as_str().unwrap().to_string())
+    });
+    let (server, session) = back;
+    let shown = common::http::get(addr, &format!("/api/sessions/{session}")).json();
+    let points = shown["scene"]["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2, "{shown}");
+    server.stop();
 }
