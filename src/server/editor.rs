@@ -67,6 +67,8 @@ pub struct Latest {
     pub heightfield: Arc<Heightfield>,
     /// The last committed document (what Save writes).
     pub committed: Value,
+    /// What the undo history holds (estimated bytes; `GET` of a session).
+    pub history_bytes: usize,
 }
 
 /// A frame's changed part of the preview, as PNG: the page patches its
@@ -279,6 +281,7 @@ impl Handle {
             image: Arc::new(ed.image.clone()),
             heightfield: ed.heightfield.clone(),
             committed: ed.history.current().clone(),
+            history_bytes: ed.history.bytes(),
         };
         if let Some((rect, png)) = &ed.tile {
             let mut tiles = self.tiles.lock().unwrap_or_else(|e| e.into_inner());

@@ -23,6 +23,7 @@ mod error;
 mod frame;
 mod history;
 mod output;
+mod patch;
 mod registry;
 pub mod request;
 mod routes;
