@@ -22,7 +22,7 @@
 mod common;
 
 use common::browser::{
-    click, drag, executables, in_chromium, js, revision, settled, shot, wait_for,
+    click, drag, drag_screen, executables, in_chromium, js, revision, settled, shot, wait_for,
 };
 use common::editor::{self, heights};
 use fantoccini::Client;
@@ -395,5 +395,101 @@ fn the_page_reconnects_when_the_server_comes_back() {
     let shown = common::http::get(addr, &format!("/api/sessions/{session}")).json();
     let points = shown["scene"]["points"].as_array().unwrap();
     assert_eq!(points.len(), 2, "{shown}");
+    server.stop();
+}
+
+/// The curve widget's height bar and reach square dragged on the map
+/// (issue 43: the handles' hit built `{kind: 'widget-height', ...s}` and
+/// the spread's `kind: 'curve'` overwrote it, so a drag re-sketched the
+/// curve), and the Scene summary's counts after three freeze strokes
+/// (it said 0: it was built once per selection).
+#[test]
+fn widget_handles_drag_and_the_summary_counts() {
+    let Some(browser) = executables() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let server = editor::serve(SIZE, None, 2);
+    in_chromium(&browser, dir.path(), async |c| {
+        c.goto(&server.url()).await.unwrap();
+        settled(c, -1).await;
+        click(c, "[data-tool=freeze]").await;
+        for y in [30.0, 50.0, 70.0] {
+            let rev = revision(c).await;
+            drag(c, &[(20.0, y), (60.0, y)]).await;
+            settled(c, rev).await;
+        }
+        // Read with the freeze tool still on: switching tools rebuilt the
+        // panel and hid the bug.
+        let summary = js(c, "return document.getElementById('inspector').textContent").await;
+        assert!(
+            summary.as_str().unwrap().contains("3 freeze strokes"),
+            "{summary}"
+        );
+
+        click(c, "[data-tool=curve]").await;
+        let rev = revision(c).await;
+        drag(
+            c,
+            &[(90.0, 200.0), (130.0, 160.0), (170.0, 120.0), (210.0, 80.0)],
+        )
+        .await;
+        settled(c, rev).await;
+        let session = js(c, "return window.terrasynth.api.session").await;
+        let session = session.as_str().unwrap().to_string();
+        let h0 = heights(server.addr, &session);
+        let before = js(c, "return window.terrasynth.doc.curves[0].widgets[0]").await;
+        let sketched = js(c, "return window.terrasynth.doc.curves[0].points").await;
+        // Where the selected widget's handles are on the screen.
+        let handles = "const done = arguments[0];
+            import('/assets/js/controls.js').then((C) => {
+              const ed = window.terrasynth, m = ed.map, c = ed.doc.curves[0], w = c.widgets[0];
+              ed.tools.select('select');
+              ed.tools.setSel({ kind: 'curve', index: 0, widget: 0 });
+              const f = C.widgetFrame(ed, c, 0, w);
+              const r = document.getElementById('map').getBoundingClientRect();
+              const knob = C.barKnob(ed, m.toScreen(f.at), w.height_m, C.barRange(ed));
+              const reach = m.toScreen([f.at[0] + f.left[0] * w.reach_px[0], f.at[1] + f.left[1] * w.reach_px[0]]);
+              const out = m.toScreen([f.at[0] + f.left[0] * (w.reach_px[0] + 12), f.at[1] + f.left[1] * (w.reach_px[0] + 12)]);
+              done([[knob[0] + r.left, knob[1] + r.top], [reach[0] + r.left, reach[1] + r.top], [out[0] + r.left, out[1] + r.top]]);
+            });";
+        let at = c.execute_async(handles, vec![]).await.unwrap();
+        let p = |k: usize| (at[k][0].as_f64().unwrap(), at[k][1].as_f64().unwrap());
+        let (knob, reach, out) = (p(0), p(1), p(2));
+        let rev = revision(c).await;
+        drag_screen(c, &[knob, (knob.0, knob.1 - 15.0), (knob.0, knob.1 - 30.0)]).await;
+        settled(c, rev).await;
+        let rev = revision(c).await;
+        drag_screen(c, &[reach, out]).await;
+        settled(c, rev).await;
+        let after = js(c, "return window.terrasynth.doc.curves[0].widgets[0]").await;
+        let num = |v: &Value| v.as_f64().unwrap();
+        assert!(
+            num(&after["height_m"]) > num(&before["height_m"]) + 50.0,
+            "the bar dragged up: {before} → {after}"
+        );
+        assert!(
+            num(&after["reach_px"][0]) > num(&before["reach_px"][0]) + 6.0,
+            "the reach square dragged out: {before} → {after}"
+        );
+        assert_eq!(after["reach_px"][1], before["reach_px"][1]);
+        let line = js(
+            c,
+            "return window.terrasynth.doc.curves.map((c) => c.points)",
+        )
+        .await;
+        assert_eq!(line, json!([sketched]), "the curve was not re-sketched");
+        // The server shows the dragged widget, and the terrain moved.
+        let shown = common::http::get(server.addr, &format!("/api/sessions/{session}")).json();
+        assert_eq!(shown["scene"]["curves"][0]["widgets"][0], after);
+        let h1 = heights(server.addr, &session);
+        let moved = h0
+            .iter()
+            .zip(&h1)
+            .filter(|(a, b)| a.to_bits() != b.to_bits())
+            .count();
+        assert!(moved > 100, "{moved} pixels changed");
+        assert_eq!(js(c, "return window.__errors").await, json!([]));
+    });
     server.stop();
 }
