@@ -266,6 +266,46 @@ fn queued_documents_coalesce_latest_wins() {
     assert_eq!(shown["scene"]["points"][0]["at"], json!([10.0, 30]));
 }
 
+/// With "types" on, a painted stroke tints only where it is painted
+/// (issue 43: one stroke greyed the whole map): pixels whose heights and
+/// neighbours' heights did not change, away from the stroke, keep their
+/// colour exactly.
+#[test]
+fn painted_types_keep_the_tint_elsewhere() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, _) = create(a);
+    let preview = || {
+        let png = http::get(a, &format!("/api/sessions/{id}/preview.png"));
+        image::load_from_memory(&png.body).unwrap().to_rgba8()
+    };
+    let (p0, h0) = (preview(), heights(a, &id));
+    let name = http::get(a, "/api/info").json()["database"]["types"][0]["name"].clone();
+    let mut d = doc();
+    d["types"] = json!({"strokes": [{"type": name, "points": [[8, 8], [14, 8]], "radius_px": 2}]});
+    assert_eq!(put_scene(a, &id, &d, true).status, 200);
+    let (p1, h1) = (preview(), heights(a, &id));
+    let still = |x: usize, y: usize| {
+        (y.saturating_sub(1)..(y + 2).min(N)).all(|j| {
+            (x.saturating_sub(1)..(x + 2).min(N))
+                .all(|i| h0[j * N + i].to_bits() == h1[j * N + i].to_bits())
+        })
+    };
+    let (mut same, mut total) = (0, 0);
+    for (x, y, px) in p1.enumerate_pixels() {
+        let (x, y) = (x as usize, y as usize);
+        if y > 16 && still(x, y) {
+            total += 1;
+            same += (px == p0.get_pixel(x as u32, y as u32)) as usize;
+        }
+    }
+    assert!(total > N * N / 4, "{total} pixels kept their heights");
+    assert_eq!(
+        same, total,
+        "{same} of {total} unchanged pixels kept their colour"
+    );
+}
+
 #[test]
 fn previews_tiles_heights_and_exports() {
     let s = serve(N, None, 2);

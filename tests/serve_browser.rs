@@ -405,14 +405,7 @@ fn the_page_reconnects_when_the_server_comes_back() {
 /// (it said 0: it was built once per selection).
 #[test]
 fn widget_handles_drag_and_the_summary_counts() {
-    let Some(browser) = executables() else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
-    let server = editor::serve(SIZE, None, 2);
-    in_chromium(&browser, dir.path(), async |c| {
-        c.goto(&server.url()).await.unwrap();
-        settled(c, -1).await;
+    on_a_page(async |c, server| {
         click(c, "[data-tool=freeze]").await;
         for y in [30.0, 50.0, 70.0] {
             let rev = revision(c).await;
@@ -490,6 +483,105 @@ fn widget_handles_drag_and_the_summary_counts() {
             .count();
         assert!(moved > 100, "{moved} pixels changed");
         assert_eq!(js(c, "return window.__errors").await, json!([]));
+    });
+}
+
+/// Presets work with the ground (issue 43): on flat ground a new ridge's
+/// and valley's sides meet the ground at their reach (fixed −30° sides dug
+/// moats), a basin on ground below the range's floor does not raise it,
+/// and a ridge sketched across the real terrain leaves nothing within its
+/// reach lower than the lowest ground there was (less 3 % of the relief).
+#[test]
+fn presets_work_with_the_ground() {
+    on_a_page(async |c, server| {
+        // The presets on made-up ground: flat at mid-range, then 10 m
+        // under the exemplars' lowest.
+        let flat = c
+            .execute_async(
+                "const done = arguments[0];
+                 import('/assets/js/controls.js').then((C) => {
+                   const ed = window.terrasynth, cell = ed.cell();
+                   const on = (h) => Object.assign(Object.create(ed), { heightAt: () => h });
+                   const line = [[40, 100], [120, 100], [200, 100]];
+                   const mid = (ed.range().lo + ed.range().hi) / 2;
+                   const edges = ['ridge', 'valley'].map((p) => {
+                     const w = C.newCurve(on(mid), ed.doc, line, p).widgets[0];
+                     return w.slope_deg.map((s, k) => w.height_m + Math.tan(s * Math.PI / 180) * w.reach_px[k] * cell);
+                   });
+                   const lo = ed.range().lo - 10;
+                   done({ edges, mid, relief: ed.range().relief, basin: C.newPoint(on(lo), ed.doc, [50, 50], 'basin').height_m, lo });
+                 });",
+                vec![],
+            )
+            .await
+            .unwrap();
+        let (mid, relief) = (
+            flat["mid"].as_f64().unwrap(),
+            flat["relief"].as_f64().unwrap(),
+        );
+        for edge in flat["edges"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|e| e.as_array().unwrap())
+        {
+            let e = edge.as_f64().unwrap();
+            assert!(
+                (e - mid).abs() < 0.005 * relief,
+                "a side ends at {e} m on {mid} m ground: {flat}"
+            );
+        }
+        // (Heights are rounded to 0.1 m.)
+        assert!(
+            flat["basin"].as_f64().unwrap() <= flat["lo"].as_f64().unwrap() + 0.05,
+            "{flat}"
+        );
+
+        let session = js(c, "return window.terrasynth.api.session").await;
+        let session = session.as_str().unwrap().to_string();
+        let h0 = heights(server.addr, &session);
+        click(c, "[data-tool=curve]").await;
+        let rev = revision(c).await;
+        let line: Vec<(f64, f64)> = (0..=10).map(|k| (40.0 + 17.6 * k as f64, 128.0)).collect();
+        drag(c, &line).await;
+        settled(c, rev).await;
+        let w = js(c, "return window.terrasynth.doc.curves[0].widgets[0]").await;
+        let reach = w["reach_px"][0]
+            .as_f64()
+            .unwrap()
+            .min(w["reach_px"][1].as_f64().unwrap());
+        let h1 = heights(server.addr, &session);
+        let band = |h: &[f32]| {
+            (0..SIZE * SIZE)
+                .filter(|k| {
+                    let (x, y) = ((k % SIZE) as f64, (k / SIZE) as f64);
+                    (50.0..206.0).contains(&x) && (y - 128.0).abs() <= reach
+                })
+                .map(|k| h[k])
+                .fold(f32::INFINITY, f32::min) as f64
+        };
+        let (before, after) = (band(&h0), band(&h1));
+        eprintln!("ridge {w}: lowest within its reach {before:.0} m before, {after:.0} m after");
+        assert!(
+            after >= before - 0.03 * relief,
+            "a moat: {before:.0} → {after:.0} m"
+        );
+        assert_eq!(js(c, "return window.__errors").await, json!([]));
+    });
+}
+
+/// A new server's page in a fresh Chromium, at its first frame: runs
+/// `scenario` on it (nothing without a browser, see the module docs).
+fn on_a_page(scenario: impl AsyncFnOnce(&Client, &Running)) {
+    let Some(browser) = executables() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let server = editor::serve(SIZE, None, 2);
+    in_chromium(&browser, dir.path(), async |c| {
+        c.goto(&server.url()).await.unwrap();
+        settled(c, -1).await;
+        scenario(c, &server).await
     });
     server.stop();
 }
