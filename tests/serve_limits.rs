@@ -7,11 +7,12 @@
 
 mod common;
 
-use common::editor::{N, create, doc, expect_error, put_scene, serve};
+use common::editor::{N, create, doc, expect_error, put_scene, serve, serve_with};
 use common::http;
 use proptest::prelude::*;
 use serde_json::{Value, json};
 use std::net::SocketAddr;
+use std::time::Duration;
 use terrasynth::server::{self, Config, ServeError};
 
 #[test]
@@ -98,6 +99,34 @@ fn other_hosts_sites_and_oversized_bodies_are_refused() {
         None,
     );
     expect_error(&r, 413, "$");
+}
+
+/// A tab that stopped pinging (a crashed browser, a page reloaded before
+/// it learnt its session's id) gives its slot to the next tab within the
+/// idle time; one that pings keeps it. The heartbeat the page should keep
+/// is in /api/info.
+#[test]
+fn a_silent_session_gives_its_slot_up() {
+    let s = serve_with(N, None, |c| {
+        c.max_sessions = 2;
+        c.idle = Duration::from_millis(600);
+    });
+    let a = s.addr;
+    let info = http::get(a, "/api/info").json();
+    assert_eq!(info["sessions"]["heartbeat_ms"], 150, "{info}");
+    let (pinged, _) = create(a);
+    let (silent, _) = create(a);
+    expect_error(&http::post(a, "/api/sessions", None), 503, "$");
+    for _ in 0..8 {
+        std::thread::sleep(Duration::from_millis(100));
+        let r = http::post(a, &format!("/api/sessions/{pinged}/ping"), None);
+        assert_eq!(r.status, 204);
+    }
+    let (third, _) = create(a);
+    expect_error(&http::get(a, &format!("/api/sessions/{silent}")), 404, "id");
+    for id in [&pinged, &third] {
+        assert_eq!(http::get(a, &format!("/api/sessions/{id}")).status, 200);
+    }
 }
 
 #[test]

@@ -26,7 +26,8 @@ pub const RANGE_COLOUR: [u8; 3] = [226, 36, 30];
 pub const NODATA_COLOUR: [u8; 3] = [160, 160, 164];
 pub const NODATA_HATCH: [u8; 3] = [186, 186, 190];
 pub const GRID_COLOUR: [u8; 4] = [255, 255, 255, 90];
-/// How far the tint is muted toward grey under a type overlay.
+/// How far the tint is muted toward grey under a type overlay, unless
+/// its [`super::TypeOverlay::mute`] says otherwise.
 pub const TYPES_MUTE: f64 = 0.8;
 /// Grid lines closer than this are refused (they would grey the image out).
 pub const MIN_GRID_PX: f64 = 2.0;
@@ -147,8 +148,8 @@ pub fn prepare(hf: &Heightfield, o: &RenderOptions) -> Result<Prepared, RenderEr
         .unwrap_or((land_lo, land_lo + (hi - land_lo).max(tint::MIN_SPAN_M)));
     p.tint_lo = quantize(tlo);
     let span = (quantize(thi) - p.tint_lo).max(1) as u32;
-    let palette = match o.types {
-        Some(_) => o.palette.muted(TYPES_MUTE),
+    let palette = match &o.types {
+        Some(t) => o.palette.muted(t.mute),
         None => o.palette.clone(),
     };
     let (shift, lut) = tint::table(&palette, span);

@@ -30,6 +30,10 @@ pub struct TypeOverlay {
     pub mask: TypeMask,
     /// Colour and opacity per index; [`NO_TYPE`] is never drawn.
     pub colours: Box<[[u8; 4]; 256]>,
+    /// How far the tint is moved toward grey (0 = kept), everywhere: the
+    /// tint is one table. Muted, a map shows its painted types best; the
+    /// editor keeps the tint, as the artist paints over a map they read.
+    pub mute: f64,
 }
 
 impl TypeOverlay {
@@ -48,6 +52,10 @@ impl TypeOverlay {
                 },
             ]
         }));
-        TypeOverlay { mask, colours }
+        TypeOverlay {
+            mask,
+            colours,
+            mute: crate::render::prepare::TYPES_MUTE,
+        }
     }
 }

@@ -25,6 +25,11 @@ const FILES: &[(&str, &str, &[u8])] = &[
         include_bytes!("../../web/js/api.js"),
     ),
     (
+        "js/link.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../web/js/link.js"),
+    ),
+    (
         "js/map.js",
         "text/javascript; charset=utf-8",
         include_bytes!("../../web/js/map.js"),

@@ -23,7 +23,7 @@ use crate::scene::Scene;
 use image::RgbaImage;
 use serde_json::{Value, json};
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, RwLock};
 use std::time::{Duration, Instant};
 use tokio::sync::oneshot;
@@ -67,6 +67,8 @@ pub struct Latest {
     pub heightfield: Arc<Heightfield>,
     /// The last committed document (what Save writes).
     pub committed: Value,
+    /// What the undo history holds (estimated bytes; `GET` of a session).
+    pub history_bytes: usize,
 }
 
 /// A frame's changed part of the preview, as PNG: the page patches its
@@ -93,6 +95,9 @@ pub struct Handle {
     /// The whole preview's PNG, encoded on demand, by revision.
     full_png: Mutex<Option<(u64, Arc<Vec<u8>>)>>,
     last_used: Mutex<Instant>,
+    /// Making a frame (the first included): never idle then, however long
+    /// the synthesis takes.
+    working: AtomicBool,
     /// The revision of the scene file this session's document stands on
     /// (`App::saved`): a save from a session whose base is older would
     /// overwrite another tab's save.
@@ -128,6 +133,7 @@ impl Handle {
             tiles: Mutex::new(VecDeque::new()),
             full_png: Mutex::new(None),
             last_used: Mutex::new(Instant::now()),
+            working: AtomicBool::new(true),
             base: AtomicU64::new(base),
         });
         let (tx, rx) = oneshot::channel();
@@ -141,6 +147,7 @@ impl Handle {
                     Ok(mut ed) => {
                         let reply = ed.frame_reply(None, t.elapsed(), true);
                         h.publish(&ed);
+                        h.finished();
                         let _ = tx.send(Ok(reply));
                         h.serve(&mut ed);
                     }
@@ -226,11 +233,22 @@ impl Handle {
         *self.last_used.lock().unwrap_or_else(|e| e.into_inner()) = Instant::now();
     }
 
+    /// How long since the page was last heard from (zero while a frame is
+    /// being made).
     pub fn idle(&self) -> Duration {
+        if self.working.load(Ordering::Relaxed) {
+            return Duration::ZERO;
+        }
         self.last_used
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .elapsed()
+    }
+
+    /// A frame is done: the idle time counts from now.
+    fn finished(&self) {
+        self.touch();
+        self.working.store(false, Ordering::Relaxed);
     }
 
     /// A recent frame's tile.
@@ -263,6 +281,7 @@ impl Handle {
             image: Arc::new(ed.image.clone()),
             heightfield: ed.heightfield.clone(),
             committed: ed.history.current().clone(),
+            history_bytes: ed.history.bytes(),
         };
         if let Some((rect, png)) = &ed.tile {
             let mut tiles = self.tiles.lock().unwrap_or_else(|e| e.into_inner());
@@ -294,7 +313,9 @@ impl Handle {
                 }
             };
             let waited = job.queued.elapsed();
+            self.working.store(true, Ordering::Relaxed);
             let reply = guarded(|| ed.run(job.task, waited));
+            self.finished();
             let broken = matches!(&reply, Err(ApiError::Internal(_)));
             if reply.is_ok() {
                 self.publish(ed);

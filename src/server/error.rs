@@ -36,7 +36,7 @@ pub enum ApiError {
     NotFound(String),
     /// Every session slot is taken (503).
     #[error(
-        "{open} editor sessions are open, the limit (--max-sessions {open}): close another tab, or wait until an idle one times out after {idle_s} s"
+        "{open} editor sessions are open, the limit (--max-sessions {open}): close another tab; a tab not heard from for {idle_s} s gives its slot up"
     )]
     Full { open: usize, idle_s: u64 },
     /// Not enough memory for another session of this size (503).

@@ -201,9 +201,6 @@ impl Editor {
             None
         };
         let rect = union(heights, painted);
-        // Painted types mute the tint everywhere: when the first type is
-        // painted or the last erased, the whole preview changes.
-        let whole = whole || (self.view.types && self.types.is_some() != types.is_some());
         let full = [
             0,
             0,

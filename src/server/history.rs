@@ -1,64 +1,100 @@
-//! Undo and redo (seed 002 §2.5: "a powerful multiple-undo function"): a
-//! list of committed scene documents and a cursor. Undo and redo move the
-//! cursor and hand back the document to apply, which goes through the
-//! session like any edit, so only what the undone step touched is
-//! re-synthesized. Intermediate states of a drag are not committed: one
-//! drag is one step.
+//! Undo and redo (seed 002 §2.5: "a powerful multiple-undo function"): the
+//! current committed document and, per step, the [`Patch`] between it and
+//! the one before. Undo and redo apply a patch backwards or forwards and
+//! hand back the document to apply, which goes through the session like
+//! any edit, so only what the undone step touched is re-synthesized.
+//! Intermediate states of a drag are not committed: one drag is one step.
+//!
+//! Why patches: a step costs what its edit changed (a moved point: a few
+//! hundred bytes), where whole documents cost ~9× the scene's JSON each
+//! (issue 43). Steps also fall off, oldest first, beyond [`MAX_BYTES`], so
+//! a session's history stays bounded whatever its edits.
 
+use super::patch::Patch;
 use serde_json::Value;
+use std::collections::VecDeque;
 
-/// Most steps kept; the oldest fall off (documents are small, but a long
-/// painting session adds a stroke per step).
+/// Most steps kept; the oldest fall off.
 pub const MAX_STEPS: usize = 500;
+
+/// Most bytes the steps may hold (estimated, [`Patch::bytes`]): 500
+/// strokes of a few hundred points each.
+pub const MAX_BYTES: usize = 32 << 20;
 
 #[derive(Debug, Clone)]
 pub struct History {
-    docs: Vec<Value>,
-    /// Index of the current document in `docs`.
+    /// The document at the cursor.
+    current: Value,
+    /// `steps[i]` turns state `i` into state `i + 1` (None: a commit of
+    /// the same document, still a step as the page counts them), and its
+    /// bytes.
+    steps: VecDeque<(Option<Patch>, usize)>,
+    /// The state shown: `0..=steps.len()`.
     cursor: usize,
+    bytes: usize,
 }
 
 impl History {
     pub fn new(first: Value) -> History {
         History {
-            docs: vec![first],
+            current: first,
+            steps: VecDeque::new(),
             cursor: 0,
+            bytes: 0,
         }
     }
 
     /// The current committed document.
     pub fn current(&self) -> &Value {
-        &self.docs[self.cursor]
+        &self.current
     }
 
     /// Commits a document: it becomes current and the redo steps go.
     pub fn commit(&mut self, doc: Value) {
-        self.docs.truncate(self.cursor + 1);
-        self.docs.push(doc);
-        if self.docs.len() > MAX_STEPS {
-            self.docs.remove(0);
+        let patch = Patch::between(&self.current, &doc);
+        for (_, b) in self.steps.drain(self.cursor..) {
+            self.bytes -= b;
         }
-        self.cursor = self.docs.len() - 1;
+        let b = size_of::<(Option<Patch>, usize)>() + patch.as_ref().map_or(0, Patch::bytes);
+        self.steps.push_back((patch, b));
+        self.bytes += b;
+        self.current = doc;
+        self.cursor += 1;
+        // At most MAX_STEPS states: the first and MAX_STEPS - 1 steps.
+        while self.steps.len() >= MAX_STEPS || (self.bytes > MAX_BYTES && self.steps.len() > 1) {
+            if let Some((_, b)) = self.steps.pop_front() {
+                self.bytes -= b;
+                self.cursor -= 1;
+            }
+        }
     }
 
     /// Steps back; the document to apply, or None at the first.
     pub fn undo(&mut self) -> Option<&Value> {
         self.cursor = self.cursor.checked_sub(1)?;
-        Some(&self.docs[self.cursor])
+        if let Some(p) = &self.steps[self.cursor].0 {
+            p.apply(&mut self.current, false);
+        }
+        Some(&self.current)
     }
 
     /// Steps forward; the document to apply, or None at the last.
     pub fn redo(&mut self) -> Option<&Value> {
-        if self.cursor + 1 >= self.docs.len() {
-            return None;
+        if let Some(p) = &self.steps.get(self.cursor)?.0 {
+            p.apply(&mut self.current, true);
         }
         self.cursor += 1;
-        Some(&self.docs[self.cursor])
+        Some(&self.current)
     }
 
     /// Steps that undo and redo can take.
     pub fn counts(&self) -> (usize, usize) {
-        (self.cursor, self.docs.len() - 1 - self.cursor)
+        (self.cursor, self.steps.len() - self.cursor)
+    }
+
+    /// What the steps hold, estimated (bytes).
+    pub fn bytes(&self) -> usize {
+        self.bytes
     }
 }
 

@@ -23,6 +23,7 @@ mod error;
 mod frame;
 mod history;
 mod output;
+mod patch;
 mod registry;
 pub mod request;
 mod routes;
@@ -66,7 +67,8 @@ pub struct Config {
     pub seed: u32,
     pub max_sessions: usize,
     pub max_request_bytes: usize,
-    /// Sessions idle this long may be closed when another tab needs a slot.
+    /// A session whose page has not been heard from for this long (the
+    /// page pings every quarter of it) gives its slot to another tab.
     pub idle: Duration,
 }
 
@@ -80,7 +82,7 @@ impl Default for Config {
             seed: 1,
             max_sessions: 4,
             max_request_bytes: 16 << 20,
-            idle: Duration::from_secs(180),
+            idle: Duration::from_secs(8),
         }
     }
 }

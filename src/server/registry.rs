@@ -2,9 +2,15 @@
 //!
 //! A tab gets its own session (own synthesis state, own undo history) as
 //! long as a slot is free and memory allows; otherwise a clear refusal
-//! (503 naming the limit). A session idle for longer than the idle time
-//! (the page pings while open) is closed only when another tab needs its
-//! slot, so a tab left in the background keeps its work.
+//! (503 naming the limit; the page retries). The page sends a heartbeat
+//! (every quarter of the idle time) and closes its session when it is
+//! hidden; a session not heard from for the idle time (a crashed browser,
+//! a reload while its first frame was still being made, so the page never
+//! learnt its id) gives its slot to the next tab that needs one. It is
+//! reclaimed only then, not on a timer: browsers slow the timers of
+//! background tabs to once a minute, and such a tab keeps its undo
+//! history as long as no one needs the slot (its document is in the page:
+//! it reopens a session from it if the slot was taken).
 
 use super::editor::Handle;
 use super::error::ApiError;
@@ -94,6 +100,17 @@ impl Registry {
         Ok((id, r))
     }
 
+    /// Closes `id` unless `done`, when dropped: a session request
+    /// abandoned (its connection closed) after the session was admitted
+    /// would otherwise hold the slot until its heartbeat is missed.
+    pub fn until_answered<'a>(&'a self, id: &'a str) -> Unanswered<'a> {
+        Unanswered {
+            registry: self,
+            id,
+            done: false,
+        }
+    }
+
     pub fn close(&self, id: &str) -> bool {
         match self.map().remove(id) {
             Some(h) => {
@@ -107,6 +124,21 @@ impl Registry {
     pub fn close_all(&self) {
         for (_, h) in self.map().drain() {
             h.close();
+        }
+    }
+}
+
+/// See [`Registry::until_answered`].
+pub struct Unanswered<'a> {
+    registry: &'a Registry,
+    id: &'a str,
+    pub done: bool,
+}
+
+impl Drop for Unanswered<'_> {
+    fn drop(&mut self) {
+        if !self.done {
+            self.registry.close(self.id);
         }
     }
 }

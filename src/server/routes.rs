@@ -6,7 +6,7 @@
 //! | `GET /api/info` | database (types, exemplars, height range), loading progress, limits |
 //! | `GET /api/exemplars/{i}/preview.png` | an exemplar's relief, for lassos on exemplars |
 //! | `POST /api/sessions` | none, or `{"scene": doc}` → first frame + `session` id |
-//! | `GET /api/sessions/{id}` | → the shown document and history |
+//! | `GET /api/sessions/{id}` | → the shown document (`scene`) and what its undo history holds (`history_bytes`, estimated) |
 //! | `PUT /api/sessions/{id}/scene?commit=true` | scene document → frame (`commit=false`: a drag's intermediate state, not an undo step) |
 //! | `POST /api/sessions/{id}/undo`, `…/redo` | → frame + the document now shown |
 //! | `PUT /api/sessions/{id}/view` | `{"contours", "types", "range"}` → frame |
@@ -15,7 +15,7 @@
 //! | `GET /api/sessions/{id}/heights` | binary: u32 width, u32 height, u32 stride, then f32 metres (≤ 512² samples); header `x-revision` |
 //! | `GET /api/sessions/{id}/export?format=exr[&sidecar=true]` | a download (any writable format, or `preview`) |
 //! | `POST /api/sessions/{id}/save[?force=true]` | writes the `--scene` file → `{"path"}`; 409 when another tab saved after this session's document was loaded (unless forced) |
-//! | `POST /api/sessions/{id}/ping`, `…/close` | keep alive; free the slot |
+//! | `POST /api/sessions/{id}/ping`, `…/close` | the page's heartbeat (`info.sessions.heartbeat_ms`); free the slot (on page hide, by beacon) |
 //!
 //! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
 //! `timing_ms {queued, edits, synth, render, total}`, `changed {pixels,
@@ -183,7 +183,13 @@ async fn info(State(app): State<Arc<App>>) -> axum::Json<Value> {
         },
         "database": database,
         "scene_file": app.scene_file.as_ref().map(|p| p.display().to_string()),
-        "sessions": {"open": app.registry.open(), "limit": app.registry.limit},
+        // The page pings four times per idle time: a missed ping or two is
+        // no reason to lose the slot.
+        "sessions": {
+            "open": app.registry.open(),
+            "limit": app.registry.limit,
+            "heartbeat_ms": app.registry.idle.as_millis() / 4,
+        },
         "max_request_bytes": app.max_request_bytes,
         "export_formats": Format::ALL.iter().filter(|f| f.can_write()).map(|f| f.name()).collect::<Vec<_>>(),
     }))
@@ -238,16 +244,11 @@ async fn create(
     let (id, rx) = app
         .registry
         .admit(w, h, || Handle::spawn(db, policy, style, doc, scene, base))?;
-    match reply(rx).await {
-        Ok(axum::Json(mut frame)) => {
-            frame["session"] = json!(id);
-            Ok(axum::Json(frame))
-        }
-        Err(e) => {
-            app.registry.close(&id);
-            Err(e)
-        }
-    }
+    let mut pending = app.registry.until_answered(&id);
+    let mut frame = reply(rx).await?;
+    pending.done = true;
+    frame["session"] = json!(id);
+    Ok(frame)
 }
 
 async fn state(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
@@ -256,7 +257,7 @@ async fn state(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
         .latest()
         .ok_or_else(|| ApiError::NotReady("the first frame is not ready".into()))?;
     Ok(axum::Json(
-        json!({"revision": latest.revision, "scene": latest.committed}),
+        json!({"revision": latest.revision, "scene": latest.committed, "history_bytes": latest.history_bytes}),
     ))
 }
 

@@ -101,6 +101,9 @@ impl Style {
             .map(|(i, n)| (i as u8, n.clone()))
             .collect();
         let mut o = TypeOverlay::new(mask);
+        // The tint stays where nothing is painted (issue 43: one stroke
+        // greyed the whole map).
+        o.mute = 0.0;
         for c in o
             .colours
             .iter_mut()

@@ -103,6 +103,27 @@ pub fn start_driver(exe: &Path) -> Driver {
     d
 }
 
+/// Runs `scenario` in a fresh headless Chromium (its profile under
+/// `dir`), closing the browser even when a step fails (chromedriver alone
+/// would leave it running).
+pub fn in_chromium<T>(
+    (chromium, driver): &(PathBuf, PathBuf),
+    dir: &Path,
+    scenario: impl AsyncFnOnce(&Client) -> T,
+) -> T {
+    let wd = start_driver(driver);
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let c = rt.block_on(connect(&wd, chromium, dir));
+    let outcome =
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| rt.block_on(scenario(&c))));
+    let _ = rt.block_on(c.close());
+    drop(wd);
+    outcome.unwrap_or_else(|p| std::panic::resume_unwind(p))
+}
+
 pub async fn js(c: &Client, script: &str) -> Value {
     c.execute(script, vec![])
         .await
@@ -155,8 +176,17 @@ pub async fn screen(c: &Client, p: (f64, f64)) -> (f64, f64) {
 
 /// A left-button drag through terrain positions (a click when only one).
 pub async fn drag(c: &Client, pts: &[(f64, f64)]) {
+    let mut at = Vec::with_capacity(pts.len());
+    for p in pts {
+        at.push(screen(c, *p).await);
+    }
+    drag_screen(c, &at).await;
+}
+
+/// A left-button drag through viewport positions (a click when only one).
+pub async fn drag_screen(c: &Client, pts: &[(f64, f64)]) {
     let mut m = MouseActions::new("mouse".into());
-    let first = screen(c, pts[0]).await;
+    let first = pts[0];
     m = m
         .then(PointerAction::MoveTo {
             duration: None,
@@ -164,8 +194,7 @@ pub async fn drag(c: &Client, pts: &[(f64, f64)]) {
             y: first.1.round(),
         })
         .then(PointerAction::Down { button: 0 });
-    for p in &pts[1..] {
-        let q = screen(c, *p).await;
+    for &q in &pts[1..] {
         m = m.then(PointerAction::MoveTo {
             duration: Some(Duration::from_millis(60)),
             x: q.0.round(),

@@ -18,16 +18,22 @@ pub fn database() -> &'static Database {
 
 /// A running server, ready (database loaded).
 pub fn serve(size: usize, scene: Option<PathBuf>, max_sessions: usize) -> Running {
-    let running = server::start(Config {
+    serve_with(size, scene, |c| c.max_sessions = max_sessions)
+}
+
+/// [`serve`] with the test's own settings (port, idle time, …).
+pub fn serve_with(size: usize, scene: Option<PathBuf>, tweak: impl FnOnce(&mut Config)) -> Running {
+    let mut config = Config {
         bind: SocketAddr::from(([127, 0, 0, 1], 0)),
         database: Some(DbSource::Loaded(database())),
         scene,
         size: (size, size),
         seed: 3,
-        max_sessions,
+        max_sessions: 2,
         ..Config::default()
-    })
-    .expect("the server starts");
+    };
+    tweak(&mut config);
+    let running = server::start(config).expect("the server starts");
     running.wait_ready().expect("the database loads");
     running
 }

@@ -50,9 +50,15 @@ export class Api {
       init.headers = JSON_HEADERS;
       init.body = JSON.stringify({ scene: doc });
     }
-    const frame = await (await check(await fetch('/api/sessions', init))).json();
-    this.session = frame.session;
-    return frame;
+    // For scripts and the browser test: a session request in flight.
+    document.body.dataset.session = 'opening';
+    try {
+      const frame = await (await check(await fetch('/api/sessions', init))).json();
+      this.session = frame.session;
+      return frame;
+    } finally {
+      document.body.dataset.session = this.session ? 'open' : 'none';
+    }
   }
 
   /**
@@ -142,8 +148,9 @@ export class Api {
     return { w: head[0], h: head[1], stride: head[2], data: new Float32Array(buf, 12), revision };
   }
 
-  ping() {
-    return fetch(this.url('/ping'), { method: 'POST' }).catch(() => {});
+  /** The heartbeat; rejects when the session or the server is gone. */
+  async ping() {
+    await check(await fetch(this.url('/ping'), { method: 'POST' }));
   }
 
   close() {

@@ -6,17 +6,29 @@ import * as g from './geometry.js';
 
 export const HEIGHT_BAR = { dx: 22, half: 45 };
 
+// Presets, one line each (`rise` and `crest` in exemplar reliefs, `reach`
+// in terrain sides; a side's slope runs from the crest down or up to the
+// terrain's own height at the reach, never past it, so nothing digs a moat):
+//  peak      raises the ground under it by a fifth of the relief, never lowers it
+//  basin     lowers the ground under it by a fifth of the relief, never raises it
+//  flatten   pins the ground's height where it is
+//  ridge     a crest 5 % above the highest ground under the stroke; sides fall to the ground
+//  valley    a floor 5 % below the lowest ground under the stroke; sides climb to the ground
+//  cliff     the ground's mean height, level on the left, dropping steeply on the right
+//  flat      the ground's mean height, level both sides (a road, a terrace)
 export const POINT_PRESETS = {
   peak: { label: 'Peak (raise)', rise: 0.2 },
   basin: { label: 'Basin (lower)', rise: -0.2 },
   flatten: { label: 'Pin height (flat)', rise: 0 },
 };
 
+// `sides`: per side, the sign the slope may take (−1 falls away from the
+// crest, +1 climbs, 0 level).
 export const CURVE_PRESETS = {
-  ridge: { label: 'Ridge', slope: [-30, -30], reach: [0.06, 0.06] },
-  valley: { label: 'Valley / canyon', slope: [25, 25], reach: [0.05, 0.05] },
-  cliff: { label: 'Cliff top (drops right)', slope: [0, -60], reach: [0.03, 0.04] },
-  flat: { label: 'Road / terrace (flat)', slope: [0, 0], reach: [0.02, 0.02] },
+  ridge: { label: 'Ridge', crest: 0.05, sides: [-1, -1], reach: [0.06, 0.06] },
+  valley: { label: 'Valley / canyon', crest: -0.05, sides: [1, 1], reach: [0.05, 0.05] },
+  cliff: { label: 'Cliff top (drops right)', crest: 0, sides: [0, -1], reach: [0.03, 0.04] },
+  flat: { label: 'Road / terrace (flat)', crest: 0, sides: [0, 0], reach: [0.02, 0.02] },
 };
 
 /** A key no other item of the document uses ("point-3"). */
@@ -110,14 +122,38 @@ export function newPoint(ed, doc, at, preset) {
   const { relief } = ed.range();
   const h0 = ed.heightAt(at) ?? (ed.range().lo + relief / 2);
   const side = Math.max(doc.size[0], doc.size[1]);
+  const rise = POINT_PRESETS[preset].rise;
+  // Kept in range, but never the other way: a basin on low ground lowers
+  // it (or leaves it), it does not raise it to the range's floor.
+  const h = inRange(ed, h0 + rise * relief);
   return {
     id: newId(doc, 'point'),
     at: g.r1p(at),
-    height_m: round(inRange(ed, h0 + POINT_PRESETS[preset].rise * relief)),
+    height_m: round(rise < 0 ? Math.min(h0, h) : rise > 0 ? Math.max(h0, h) : h),
     slope_deg: 0,
     slope_direction_deg: 0,
     radius_px: round(Math.max(4, side * 0.06)),
   };
+}
+
+/**
+ * The mean ground height at `reach` px to each side of a stroke (side 0 on
+ * the left, as the curve's widgets count them), or null where the map has
+ * no heights yet.
+ */
+function groundBeside(ed, pts, reach) {
+  const sums = [[0, 0], [0, 0]];
+  for (let i = 0; i < pts.length; i++) {
+    const a = pts[Math.max(0, i - 1)], b = pts[Math.min(pts.length - 1, i + 1)];
+    const d = g.sub(b, a), n = Math.hypot(d[0], d[1]);
+    if (!n) continue;
+    const left = [d[1] / n, -d[0] / n];
+    for (const side of [0, 1]) {
+      const h = ed.heightAt(g.add(pts[i], g.scale(left, (side === 0 ? 1 : -1) * reach[side])));
+      if (h != null) sums[side] = [sums[side][0] + h, sums[side][1] + 1];
+    }
+  }
+  return sums.map(([s, k]) => (k ? s / k : null));
 }
 
 export function newCurve(ed, doc, pts, preset) {
@@ -125,18 +161,23 @@ export function newCurve(ed, doc, pts, preset) {
   const hs = sampled(ed, pts);
   const { relief } = ed.range();
   const mean = hs.reduce((a, b) => a + b, 0) / hs.length;
-  const h = preset === 'ridge' ? Math.max(...hs) + 0.05 * relief : preset === 'valley' ? Math.min(...hs) - 0.05 * relief : mean;
+  const crest = P.crest > 0 ? Math.max(...hs) : P.crest < 0 ? Math.min(...hs) : mean;
+  const h = round(inRange(ed, crest + P.crest * relief));
   const side = Math.max(doc.size[0], doc.size[1]);
+  const reach = P.reach.map((f) => round(Math.min(4096, Math.max(4, side * f))));
+  // Each side's slope meets the ground at the reach (issue 43: fixed −30°
+  // sides dug moats up to 1 km deep beside a ridge).
+  const ground = groundBeside(ed, pts, reach);
+  const slope = P.sides.map((sign, k) => {
+    if (sign === 0 || ground[k] == null) return 0;
+    const deg = (Math.atan((ground[k] - h) / (reach[k] * ed.cell())) * 180) / Math.PI;
+    return round(sign < 0 ? Math.min(0, deg) : Math.max(0, deg));
+  });
   return {
     id: newId(doc, 'curve'),
     points: pts.map(g.r1p),
     smoothing: 2,
-    widgets: [{
-      at: 0.5,
-      height_m: round(inRange(ed, h)),
-      slope_deg: P.slope.slice(),
-      reach_px: P.reach.map((f) => round(Math.min(4096, Math.max(4, side * f)))),
-    }],
+    widgets: [{ at: 0.5, height_m: h, slope_deg: slope, reach_px: reach }],
   };
 }
 

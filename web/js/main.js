@@ -6,6 +6,7 @@ import { Api, ApiError } from './api.js';
 import { MapView, isTyping } from './map.js';
 import { Tools } from './tools.js';
 import { Panel } from './panel.js';
+import { Link, open, closeOnHide } from './link.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -67,6 +68,8 @@ export const ed = {
   },
 
   error(e) {
+    // The session or the server gone: the link reconnects and says so.
+    if (this.link && this.link.lost(e)) return;
     const text = e instanceof ApiError ? `${e.message}` : `${e}`;
     $('status-error').textContent = text;
     $('status-error').title = text;
@@ -346,8 +349,6 @@ function wireBar() {
       else ed.tools.key(e);
     }
   });
-  window.addEventListener('pagehide', () => ed.api.close());
-  setInterval(() => ed.api.ping(), 30000);
 }
 
 async function boot() {
@@ -356,7 +357,7 @@ async function boot() {
     try {
       ed.info = await ed.api.info();
     } catch (e) {
-      text.textContent = `cannot reach the server: ${e}`;
+      text.textContent = 'server unreachable — retrying';
       await new Promise((r) => setTimeout(r, 1000));
       continue;
     }
@@ -381,9 +382,11 @@ async function boot() {
   }, 100);
   bar.removeAttribute('value');
   let frame;
+  closeOnHide(ed.api);
+  const say = (why) => (text.textContent = why);
   try {
     const before = sessionStorage.getItem(kept());
-    frame = before ? await ed.api.create(JSON.parse(before)).catch(() => ed.api.create()) : await ed.api.create();
+    frame = before ? await open(ed.api, JSON.parse(before), say).catch(() => open(ed.api, null, say)) : await open(ed.api, null, say);
   } catch (e) {
     clearInterval(tick);
     $('loading').classList.add('failed');
@@ -397,19 +400,11 @@ async function boot() {
   ed.tools = new Tools(ed);
   wireBar();
   ed.api.onFrame = showFrame;
-  ed.api.onError = async (e, job) => {
-    if (e instanceof ApiError && e.status === 404 && e.message.includes('no editor session')) {
-      // The session was closed (idle, server restarted): start a new one
-      // from this page's document.
-      try {
-        await showFrame(await ed.api.create(ed.doc), job);
-        return;
-      } catch (e2) {
-        e = e2;
-      }
-    }
-    ed.error(e);
-  };
+  // The session closed (its slot taken while the tab slept) or the server
+  // gone: ed.error hands that to the link, which reopens from ed.doc.
+  ed.api.onError = (e) => ed.error(e);
+  ed.link = new Link(ed, showFrame);
+  ed.link.heartbeat();
   ed.api.onIdle = () => setBusy(null);
   const slow = setInterval(() => {
     const j = ed.api.inFlight;

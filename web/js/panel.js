@@ -33,7 +33,11 @@ export class Panel {
     const ed = this.ed, t = ed.tools;
     if (!t) return;
     const s = t.sel;
-    const key = JSON.stringify([t.tool, s, !!t.pending, t.opts, ed.doc.size, (ed.frame && ed.frame.overlay.junctions.length) || 0]);
+    // The controls' counts are in the key: the Scene summary shows them
+    // (issue 43: it said "0 freeze strokes" after three).
+    const n = (list) => (list || []).length;
+    const counts = [ed.doc.points, ed.doc.curves, ed.doc.pastes, ed.doc.types && ed.doc.types.strokes, ed.doc.freeze && ed.doc.freeze.strokes].map(n);
+    const key = JSON.stringify([t.tool, s, !!t.pending, t.opts, ed.doc.size, (ed.frame && ed.frame.overlay.junctions.length) || 0, counts]);
     if (key !== this.key) {
       this.key = key;
       this.build();

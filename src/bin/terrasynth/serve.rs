@@ -5,7 +5,6 @@ use crate::CliResult;
 use crate::args::parse_size;
 use std::net::SocketAddr;
 use std::path::PathBuf;
-use std::time::Duration;
 use terrasynth::server::{self, Config, DbSource};
 
 #[derive(clap::Args)]
@@ -45,7 +44,7 @@ pub fn run(a: Args) -> CliResult {
         seed: a.seed,
         max_sessions: a.max_sessions as usize,
         max_request_bytes: (a.max_request_mib as usize) << 20,
-        idle: Duration::from_secs(180),
+        ..Config::default()
     };
     server::run(config, |s| {
         eprintln!(
