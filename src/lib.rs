@@ -20,6 +20,7 @@ pub mod heightfield;
 pub mod io;
 pub mod level;
 pub mod masks;
+pub mod mesh;
 pub mod nodata;
 pub mod order;
 pub mod pages;

@@ -10,6 +10,7 @@ mod eval;
 mod generate;
 mod info;
 mod masks;
+mod mesh;
 mod progress;
 mod render;
 #[cfg(feature = "serve")]
@@ -42,6 +43,9 @@ enum Command {
     Convert(convert::Args),
     /// Write slope, flow accumulation, terrain-type and splat masks of a heightfield.
     Masks(masks::Args),
+    /// Write a triangle mesh (glTF, GLB or OBJ) of a heightfield: regular
+    /// or adaptive (error-bounded), with LODs, tiles, skirts, normals, UVs.
+    Mesh(mesh::Args),
     /// Fill depressions and route water: filled surface, lakes (water
     /// depth), flow accumulation, rivers (raster and GeoJSON lines).
     Water(water::Args),
@@ -93,6 +97,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Masks(a) => masks::run(a),
+        Command::Mesh(a) => mesh::run(a),
         Command::Water(a) => water::run(a),
         Command::Erode(a) => erode::run(a),
         Command::Bench(a) => bench::run(a),
