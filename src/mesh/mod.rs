@@ -20,6 +20,7 @@
 pub mod gltf;
 pub mod grid;
 pub mod measure;
+pub mod normal_map;
 pub mod obj;
 pub mod rtin;
 
@@ -61,6 +62,8 @@ pub enum MeshError {
     },
     #[error("{path}: cannot tell the mesh format from the name; use .glb, .gltf or .obj")]
     Format { path: PathBuf },
+    #[error(transparent)]
+    Size(#[from] crate::size::SizeError),
     #[error(transparent)]
     Io(#[from] IoError),
 }
@@ -209,7 +212,8 @@ pub struct Meshes {
     /// The triangulations the meshes were made from (before skirts), in
     /// the same order, for measuring.
     pub triangulations: Vec<Triangulation>,
-    /// Per level: the error bound used (0 for a regular mesh).
+    /// Per level: the error bound used; 0 for a regular mesh, whose level
+    /// 0 is exact and coarser levels are not error-bounded.
     pub bounds: Vec<f32>,
     /// Tiles per row and column.
     pub tiles: (usize, usize),
@@ -243,11 +247,8 @@ pub fn normal(hf: &Heightfield, x: u32, y: u32) -> [f32; 3] {
     [(-gx / len) as f32, (1.0 / len) as f32, (-gz / len) as f32]
 }
 
-/// Triangulates `hf` as `opts` asks and turns every piece into a [`Mesh`].
-/// Sizes are checked against the available memory before the large
-/// allocations.
-pub fn build(hf: &Heightfield, opts: &Options) -> Result<Meshes, MeshError> {
-    opts.check()?;
+/// Refuses a grid with no cell or with nodata.
+fn check_heights(hf: &Heightfield) -> Result<(), MeshError> {
     let (w, h) = (hf.width(), hf.height());
     if w < 2 || h < 2 {
         return Err(MeshError::TooSmall {
@@ -255,13 +256,23 @@ pub fn build(hf: &Heightfield, opts: &Options) -> Result<Meshes, MeshError> {
             height: h,
         });
     }
-    if let Some(i) = hf.data().iter().position(|v| v.is_nan()) {
-        return Err(MeshError::Nodata {
+    match hf.data().iter().position(|v| v.is_nan()) {
+        Some(i) => Err(MeshError::Nodata {
             count: hf.nodata_count(),
             x: i % w,
             y: i / w,
-        });
+        }),
+        None => Ok(()),
     }
+}
+
+/// Triangulates `hf` as `opts` asks and turns every piece into a [`Mesh`].
+/// Sizes are checked against the available memory before the large
+/// allocations.
+pub fn build(hf: &Heightfield, opts: &Options) -> Result<Meshes, MeshError> {
+    opts.check()?;
+    check_heights(hf)?;
+    let (w, h) = (hf.width(), hf.height());
     let tile = opts.tile.unwrap_or(usize::MAX).min((w - 1).max(h - 1));
     let tiles = ((w - 1).div_ceil(tile), (h - 1).div_ceil(tile));
     let mut levels: Vec<(f32, Vec<Triangulation>)> = Vec::with_capacity(opts.lods);
