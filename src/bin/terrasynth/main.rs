@@ -11,6 +11,7 @@ mod generate;
 mod info;
 mod masks;
 mod mesh;
+mod normals;
 mod progress;
 mod render;
 #[cfg(feature = "serve")]
@@ -46,6 +47,9 @@ enum Command {
     /// Write a triangle mesh (glTF, GLB or OBJ) of a heightfield: regular
     /// or adaptive (error-bounded), with LODs, tiles, skirts, normals, UVs.
     Mesh(mesh::Args),
+    /// Write a tangent-space normal map (PNG, OpenGL or DirectX Y) of a
+    /// heightfield, for the UVs of `mesh --uv`.
+    Normals(normals::Args),
     /// Fill depressions and route water: filled surface, lakes (water
     /// depth), flow accumulation, rivers (raster and GeoJSON lines).
     Water(water::Args),
@@ -98,6 +102,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => convert::run(a),
         Command::Masks(a) => masks::run(a),
         Command::Mesh(a) => mesh::run(a),
+        Command::Normals(a) => normals::run(a),
         Command::Water(a) => water::run(a),
         Command::Erode(a) => erode::run(a),
         Command::Bench(a) => bench::run(a),
