@@ -11,8 +11,11 @@
 //! (set by `.ci/run`) turn the skip into a failure.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 use terrasynth::Heightfield;
+
+mod common;
+use common::terrasynth;
 
 /// Validates each file given, printing one JSON line per file with the
 /// validator's counts and its messages.
@@ -30,8 +33,13 @@ const v = require('gltf-validator'); const fs = require('fs'); const path = requ
 })().catch((e) => { console.error(e); process.exit(1); });
 "#;
 
-/// Whether a client can run; panics under its `require` variable.
-fn available(ok: bool, require: &str, what: &str) -> bool {
+/// Whether `program args` (a probe of a client) succeeds; panics when it
+/// does not under the `require` variable.
+fn available(program: &str, args: &[&str], require: &str, what: &str) -> bool {
+    let ok = Command::new(program)
+        .args(args)
+        .output()
+        .is_ok_and(|o| o.status.success());
     if !ok {
         assert!(
             std::env::var_os(require).is_none_or(|v| v.is_empty()),
@@ -40,19 +48,6 @@ fn available(ok: bool, require: &str, what: &str) -> bool {
         eprintln!("{what} not found: skipped ({require} makes this a failure)");
     }
     ok
-}
-
-fn terrasynth(args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "terrasynth {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
 }
 
 /// A 16-bit PNG heightfield (with sidecar) of 65 × 49 samples of 30 m.
@@ -70,11 +65,9 @@ fn input(dir: &Path) -> (String, Heightfield) {
 
 #[test]
 fn gltf_validator_finds_no_error_or_warning() {
-    let node = Command::new("node")
-        .args(["-e", "require('gltf-validator')"])
-        .output();
     if !available(
-        node.is_ok_and(|o| o.status.success()),
+        "node",
+        &["-e", "require('gltf-validator')"],
         "TERRASYNTH_REQUIRE_GLTF_VALIDATOR",
         "node with gltf-validator (npm install gltf-validator; NODE_PATH=…/node_modules)",
     ) {
@@ -143,11 +136,9 @@ fn gltf_validator_finds_no_error_or_warning() {
 #[test]
 fn trimesh_loads_the_obj_with_our_vertices_and_bounds() {
     let python = std::env::var("TERRASYNTH_PYTHON").unwrap_or_else(|_| "python3".into());
-    let probe = Command::new(&python)
-        .args(["-c", "import trimesh"])
-        .output();
     if !available(
-        probe.is_ok_and(|o| o.status.success()),
+        &python,
+        &["-c", "import trimesh"],
         "TERRASYNTH_REQUIRE_TRIMESH",
         "python with trimesh (pip install trimesh; TERRASYNTH_PYTHON=…/python)",
     ) {

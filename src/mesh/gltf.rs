@@ -51,21 +51,17 @@ pub fn encode(meshes: &[Mesh], uri: Option<&str>) -> (Value, Vec<u8>) {
             json!({"componentType": FLOAT, "count": n, "type": "VEC3", "min": f64s(lo), "max": f64s(hi)}),
         );
         attributes.insert("POSITION".into(), json!(pos));
-        if !m.normals.is_empty() {
+        let extra: [(&str, &[u8], &str); 2] = [
+            ("NORMAL", bytemuck::cast_slice(&m.normals), "VEC3"),
+            ("TEXCOORD_0", bytemuck::cast_slice(&m.uvs), "VEC2"),
+        ];
+        for (name, bytes, kind) in extra.into_iter().filter(|e| !e.1.is_empty()) {
             let a = add(
-                bytemuck::cast_slice(&m.normals),
+                bytes,
                 ARRAY_BUFFER,
-                json!({"componentType": FLOAT, "count": n, "type": "VEC3"}),
+                json!({"componentType": FLOAT, "count": n, "type": kind}),
             );
-            attributes.insert("NORMAL".into(), json!(a));
-        }
-        if !m.uvs.is_empty() {
-            let a = add(
-                bytemuck::cast_slice(&m.uvs),
-                ARRAY_BUFFER,
-                json!({"componentType": FLOAT, "count": n, "type": "VEC2"}),
-            );
-            attributes.insert("TEXCOORD_0".into(), json!(a));
+            attributes.insert(name.into(), json!(a));
         }
         let indices = add(
             bytemuck::cast_slice(&m.triangles),

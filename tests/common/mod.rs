@@ -15,6 +15,7 @@ pub mod render;
 pub mod states;
 pub mod variants;
 
+use std::process::{Command, Output};
 use terrasynth::io::Format;
 use terrasynth::{Georef, Heightfield};
 
@@ -161,4 +162,18 @@ pub fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
         best = best.min((x - a.0 - t * ex).hypot(y - a.1 - t * ey));
     }
     best
+}
+
+/// Runs the CLI; panics with its stderr unless it succeeds.
+pub fn terrasynth(args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "terrasynth {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
