@@ -15,7 +15,7 @@ use std::process::Command;
 use terrasynth::Heightfield;
 
 mod common;
-use common::terrasynth;
+use common::{run_ok, terrasynth};
 
 /// Validates each file given, printing one JSON line per file with the
 /// validator's counts and its messages.
@@ -151,15 +151,7 @@ fn trimesh_loads_the_obj_with_our_vertices_and_bounds() {
     let script = "import sys, json, trimesh\n\
         m = trimesh.load(sys.argv[1], force='mesh', process=False)\n\
         print(json.dumps({'vertices': len(m.vertices), 'faces': len(m.faces), 'bounds': m.bounds.tolist()}))";
-    let out = Command::new(&python)
-        .args(["-c", script, &obj])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = run_ok(Command::new(&python).args(["-c", script, &obj]));
     let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     eprintln!("trimesh: {r}");
     let s = hf.stats().unwrap();

@@ -164,16 +164,18 @@ pub fn distance_to(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
     best
 }
 
-/// Runs the CLI; panics with its stderr unless it succeeds.
-pub fn terrasynth(args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
-        .args(args)
-        .output()
-        .unwrap();
+/// Runs `cmd`; panics with its stderr unless it succeeds.
+pub fn run_ok(cmd: &mut Command) -> Output {
+    let out = cmd.output().unwrap();
     assert!(
         out.status.success(),
-        "terrasynth {args:?}: {}",
+        "{cmd:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     out
+}
+
+/// Runs the CLI; panics with its stderr unless it succeeds.
+pub fn terrasynth(args: &[&str]) -> Output {
+    run_ok(Command::new(env!("CARGO_BIN_EXE_terrasynth")).args(args))
 }
