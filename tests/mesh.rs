@@ -153,7 +153,6 @@ fn tiles_share_their_border_vertices_bit_for_bit() {
                 normals: true,
                 uvs: true,
                 skirt: Some(5.0),
-                ..Default::default()
             };
             let built = mesh::build(&hf, &opts).unwrap();
             let (tx, ty) = built.tiles;
