@@ -99,6 +99,9 @@ pub fn erode<'py>(
         .into_pyarray(py))
 }
 
+/// `mesh`'s vertices (n × 3) and triangles (m × 3).
+type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>);
+
 /// A triangle mesh of a heightfield (``terrasynth mesh``): regular (every
 /// sample a vertex) or, with ``max_error`` (metres) or ``triangles``,
 /// adaptive (RTIN, every sample within the bound). Y up, X east, Z south,
@@ -115,7 +118,7 @@ pub fn mesh<'py>(
     cell_size: f64,
     max_error: Option<f32>,
     triangles: Option<usize>,
-) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>)> {
+) -> PyResult<MeshArrays<'py>> {
     use terrasynth::mesh::{self, Detail, Options};
     let hf = heightfield(heights, cell_size, "heights")?;
     let detail = match (max_error, triangles) {
