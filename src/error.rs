@@ -24,6 +24,8 @@ pub enum Error {
     Water(#[from] crate::water::WaterError),
     #[error(transparent)]
     Erode(#[from] crate::erode::ErodeError),
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

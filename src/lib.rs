@@ -21,6 +21,7 @@ pub mod io;
 pub mod isa;
 pub mod level;
 pub mod masks;
+pub mod mesh;
 pub mod nodata;
 pub mod order;
 pub mod pages;

@@ -97,14 +97,14 @@ pub fn compute(hf: &Heightfield, splat: bool) -> Result<Masks, WaterError> {
     })
 }
 
-/// An 8-bit PNG of `channels` samples per pixel (1 grey, 4 RGBA).
+/// An 8-bit PNG of `channels` samples per pixel (1 grey, 3 RGB, 4 RGBA).
 pub fn encode_png8(width: usize, height: usize, channels: usize, data: &[u8]) -> Vec<u8> {
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
-    enc.set_color(if channels == 4 {
-        png::ColorType::Rgba
-    } else {
-        png::ColorType::Grayscale
+    enc.set_color(match channels {
+        4 => png::ColorType::Rgba,
+        3 => png::ColorType::Rgb,
+        _ => png::ColorType::Grayscale,
     });
     enc.set_depth(png::BitDepth::Eight);
     let mut writer = enc

@@ -521,6 +521,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(novelty, m)?)?;
     m.add_function(wrap_pyfunction!(terrain::water, m)?)?;
     m.add_function(wrap_pyfunction!(terrain::erode, m)?)?;
+    m.add_function(wrap_pyfunction!(terrain::mesh, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,4 +1,5 @@
-//! Water and erosion on heightfields: `terrasynth.water`, `terrasynth.erode`.
+//! Water, erosion and meshes of heightfields: `terrasynth.water`,
+//! `terrasynth.erode`, `terrasynth.mesh`.
 
 use super::{err, heightfield};
 use numpy::ndarray::Array2;
@@ -96,4 +97,44 @@ pub fn erode<'py>(
     Ok(Array2::from_shape_vec(shape, out.into_vec())
         .expect("one value per cell")
         .into_pyarray(py))
+}
+
+/// `mesh`'s vertices (n × 3) and triangles (m × 3).
+type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>);
+
+/// A triangle mesh of a heightfield (``terrasynth mesh``): regular (every
+/// sample a vertex) or, with ``max_error`` (metres) or ``triangles``,
+/// adaptive (RTIN, every sample within the bound). Y up, X east, Z south,
+/// metres; triangles counter-clockwise seen from above.
+///
+/// ``heights``: float32/float64 (rows, columns), metres, no NaN;
+/// ``cell_size`` in metres. Returns ``(vertices, indices)``: float32
+/// (n, 3) positions and uint32 (m, 3) triangles.
+#[pyfunction]
+#[pyo3(signature = (heights, cell_size, *, max_error=None, triangles=None))]
+pub fn mesh<'py>(
+    py: Python<'py>,
+    heights: &Bound<'py, PyAny>,
+    cell_size: f64,
+    max_error: Option<f32>,
+    triangles: Option<usize>,
+) -> PyResult<MeshArrays<'py>> {
+    use terrasynth::mesh::{self, Detail, Options};
+    let hf = heightfield(heights, cell_size, "heights")?;
+    let detail = match (max_error, triangles) {
+        (Some(_), Some(_)) => return Err(err("give max_error or triangles, not both")),
+        (Some(e), None) => Detail::MaxError(e),
+        (None, Some(n)) => Detail::Triangles(n),
+        (None, None) => Detail::Regular,
+    };
+    let opts = Options {
+        detail,
+        ..Options::default()
+    };
+    let mut built = py.allow_threads(|| mesh::build(&hf, &opts)).map_err(err)?;
+    let m = built.meshes.swap_remove(0);
+    let (n, t) = (m.positions.len(), m.triangles.len());
+    let v = Array2::from_shape_vec((n, 3), m.positions.into_flattened()).expect("3 per vertex");
+    let i = Array2::from_shape_vec((t, 3), m.triangles.into_flattened()).expect("3 per triangle");
+    Ok((v.into_pyarray(py), i.into_pyarray(py)))
 }

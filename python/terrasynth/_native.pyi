@@ -106,3 +106,12 @@ def erode(
     strength: float = 1.0,
 ) -> npt.NDArray[np.float32]:
     """`terrasynth erode`: the heights after the local erosion filter."""
+
+def mesh(
+    heights: Union[npt.NDArray[np.float32], npt.NDArray[np.float64]],
+    cell_size: float,
+    *,
+    max_error: Optional[float] = None,
+    triangles: Optional[int] = None,
+) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32]]:
+    """`terrasynth mesh`: vertices (n, 3; Y up, X east, Z south, metres) and triangles (m, 3)."""

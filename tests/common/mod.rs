@@ -16,6 +16,7 @@ pub mod render;
 pub mod states;
 pub mod variants;
 
+use std::process::{Command, Output};
 use terrasynth::io::Format;
 use terrasynth::{Georef, Heightfield};
 
@@ -183,4 +184,20 @@ pub fn moved_outside(
         }
     }
     moved as f64 / n as f64
+}
+
+/// Runs `cmd`; panics with its stderr unless it succeeds.
+pub fn run_ok(cmd: &mut Command) -> Output {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{cmd:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Runs the CLI; panics with its stderr unless it succeeds.
+pub fn terrasynth(args: &[&str]) -> Output {
+    run_ok(Command::new(env!("CARGO_BIN_EXE_terrasynth")).args(args))
 }

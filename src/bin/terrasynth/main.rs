@@ -10,6 +10,8 @@ mod eval;
 mod generate;
 mod info;
 mod masks;
+mod mesh;
+mod normals;
 mod progress;
 mod render;
 #[cfg(feature = "serve")]
@@ -42,6 +44,12 @@ enum Command {
     Convert(convert::Args),
     /// Write slope, flow accumulation, terrain-type and splat masks of a heightfield.
     Masks(masks::Args),
+    /// Write a triangle mesh (glTF, GLB or OBJ) of a heightfield: regular
+    /// or adaptive (error-bounded), with LODs, tiles, skirts, normals, UVs.
+    Mesh(mesh::Args),
+    /// Write a tangent-space normal map (PNG, OpenGL or DirectX Y) of a
+    /// heightfield, for the UVs of `mesh --uv`.
+    Normals(normals::Args),
     /// Fill depressions and route water: filled surface, lakes (water
     /// depth), flow accumulation, rivers (raster and GeoJSON lines).
     Water(water::Args),
@@ -93,6 +101,8 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Masks(a) => masks::run(a),
+        Command::Mesh(a) => mesh::run(a),
+        Command::Normals(a) => normals::run(a),
         Command::Water(a) => water::run(a),
         Command::Erode(a) => erode::run(a),
         Command::Bench(a) => bench::run(a),
