@@ -31,7 +31,7 @@ pub struct Extent {
     pub nodata: usize,
 }
 
-pub use crate::georef::Georef;
+use crate::georef::Georef;
 
 /// A row-major grid of heights in metres; row 0 is north, column 0 is west.
 #[derive(Debug, Clone, PartialEq)]

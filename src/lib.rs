@@ -41,7 +41,8 @@ pub mod tiles;
 pub mod water;
 
 pub use error::{Error, Result};
-pub use heightfield::{Georef, Heightfield, Stats};
+pub use georef::Georef;
+pub use heightfield::{Heightfield, Stats};
 pub use size::SizeError;
 
 /// The file `name` of the shared DEMs (`../shared/dem`, beside the

@@ -3,8 +3,9 @@
 use proptest::prelude::*;
 use std::sync::OnceLock;
 use terrasynth::database::{
-    self, BuildOptions, Database, ExemplarInput, TypeMask, appearance, c2, c2_cache, layout, types,
+    self, BuildOptions, Database, ExemplarInput, appearance, c2, c2_cache, layout, types,
 };
+use terrasynth::io::TypeMask;
 use terrasynth::{Heightfield, progress::Silent};
 
 mod common;

@@ -7,10 +7,11 @@ mod common;
 
 use common::crop::crop_db;
 use terrasynth::Heightfield;
-use terrasynth::database::{self, BuildOptions, ExemplarInput, TypeMask};
+use terrasynth::database::{self, BuildOptions, ExemplarInput};
 use terrasynth::eval::drainage::d8_area;
 use terrasynth::eval::{self, Reference, Value, describe, id};
 use terrasynth::io::CoordsMap;
+use terrasynth::io::TypeMask;
 use terrasynth::io::coords_map::{NO_EXEMPLAR, Source};
 use terrasynth::progress::Silent;
 use terrasynth::synth::source_map::source_map;

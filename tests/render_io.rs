@@ -8,7 +8,8 @@ use image::Rgba;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use terrasynth::Heightfield;
-use terrasynth::render::{Grid, RenderOptions, TypeMask, TypeOverlay, render};
+use terrasynth::io::TypeMask;
+use terrasynth::render::{Grid, RenderOptions, TypeOverlay, render};
 
 fn dem_dir() -> Option<PathBuf> {
     common::dem::dir("the shared-DEM previews").map(Path::to_path_buf)

@@ -7,10 +7,10 @@ mod common;
 use common::render::plain;
 use proptest::prelude::*;
 use terrasynth::Heightfield;
+use terrasynth::io::TypeMask;
 use terrasynth::render::prepare::UNITS_PER_M;
 use terrasynth::render::{
-    Contours, Grid, Lighting, RenderError, RenderOptions, Sea, TypeMask, TypeOverlay, prepare,
-    render,
+    Contours, Grid, Lighting, RenderError, RenderOptions, Sea, TypeOverlay, prepare, render,
 };
 use terrasynth::stages::shade::{self, flags};
 

@@ -6,10 +6,11 @@ mod common;
 
 use common::render::{GREY, plain, px, west_light};
 use terrasynth::Heightfield;
+use terrasynth::io::TypeMask;
 use terrasynth::render::prepare::{NODATA_COLOUR, NODATA_HATCH, RANGE_COLOUR, UNITS_PER_M};
 use terrasynth::render::tint::{WATER_SHALLOW, pack};
 use terrasynth::render::{
-    Contours, Grid, RenderError, RenderOptions, Sea, TypeMask, TypeOverlay, prepare, render,
+    Contours, Grid, RenderError, RenderOptions, Sea, TypeOverlay, prepare, render,
 };
 use terrasynth::stages::shade::{self, ShadeParams};
 

@@ -8,9 +8,8 @@ use proptest::prelude::*;
 use std::collections::BTreeMap;
 use std::path::Path;
 use terrasynth::Heightfield;
-use terrasynth::render::{
-    Contours, Lighting, Palette, RenderOptions, TypeMask, TypeOverlay, prepare,
-};
+use terrasynth::io::TypeMask;
+use terrasynth::render::{Contours, Lighting, Palette, RenderOptions, TypeOverlay, prepare};
 use terrasynth::stages::shade::flags;
 
 mod common;

@@ -6,9 +6,10 @@ use super::file::{self, Bytes, Kind, Section};
 use super::layout::{self, MAX_EXEMPLARS};
 use super::patchmatch;
 use super::pyramid::{self, Grid, Quantization};
-use super::types::{self, TypeMask};
+use super::types;
 use super::{BuildMeta, Database, ExemplarMeta, LevelMeta, Meta};
 use crate::heightfield::Heightfield;
+use crate::io::TypeMask;
 use crate::progress::Progress;
 use std::path::Path;
 

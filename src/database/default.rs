@@ -9,11 +9,10 @@
 //!
 //! Analysing them takes seconds, so the database is built on first use and
 //! cached in the user's cache directory under a name that hashes the
-//! embedded bytes, the crate version and [`BUILD_REVISION`]: a new binary
+//! embedded bytes, the crate version and [`cache::BUILD_REVISION`]: a new binary
 //! never reuses a stale cache. A cache that fails to load is rebuilt; a
 //! cache that cannot be written only costs a rebuild next time.
 
-pub use super::cache::BUILD_REVISION;
 use super::{BuildOptions, Database, DbError, ExemplarInput, build, cache};
 use crate::io::{self, Format, ReadOptions, TypeMask};
 use crate::progress::Progress;

@@ -32,7 +32,6 @@ pub use build::{BuildOptions, BuildReport, ExemplarInput, build};
 pub use error::DbError;
 pub use layout::{LevelLayout, Rect};
 pub use pyramid::Quantization;
-pub use types::TypeMask;
 
 use file::{Bytes, Kind};
 use rayon::prelude::*;

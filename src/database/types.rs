@@ -10,7 +10,7 @@
 use super::error::DbError;
 use super::layout::{LevelLayout, pack};
 use crate::hash::hash4;
-pub use crate::io::TypeMask;
+use crate::io::TypeMask;
 
 /// Most types in one database: target sets are u32 bit masks (DESIGN §3).
 pub const MAX_TYPES: usize = 32;

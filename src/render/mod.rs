@@ -33,7 +33,7 @@ pub use error::RenderError;
 pub use overlay::{Canvas, Marker};
 pub use prepare::{Prepared, RenderInfo, prepare};
 pub use tint::Palette;
-pub use types::{TypeMask, TypeOverlay};
+pub use types::TypeOverlay;
 
 use crate::heightfield::Heightfield;
 use crate::stages::shade;

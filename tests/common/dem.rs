@@ -4,7 +4,8 @@
 //! switch, [`REQUIRE_DEM`], turns every "absent, skipped" into a failure.
 
 use std::path::Path;
-use terrasynth::database::{ExemplarInput, TypeMask};
+use terrasynth::database::ExemplarInput;
+use terrasynth::io::TypeMask;
 
 /// Where the shared DEMs are.
 pub const DEM: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/dem");

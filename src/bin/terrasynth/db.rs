@@ -4,7 +4,8 @@ use crate::{CliResult, args::Input, progress::Bar};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use terrasynth::database::c2;
-use terrasynth::database::{self, BuildOptions, Database, ExemplarInput, TypeMask};
+use terrasynth::database::{self, BuildOptions, Database, ExemplarInput};
+use terrasynth::io::TypeMask;
 
 #[derive(clap::Subcommand)]
 pub enum Command {

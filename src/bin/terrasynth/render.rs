@@ -2,7 +2,8 @@
 
 use crate::{CliResult, args::Input};
 use std::path::PathBuf;
-use terrasynth::render::{self, Contours, Grid, RenderOptions, Sea, TypeMask, TypeOverlay};
+use terrasynth::io::TypeMask;
+use terrasynth::render::{self, Contours, Grid, RenderOptions, Sea, TypeOverlay};
 
 /// What the picture shows, printed after the options.
 const ABOUT_THE_MAP: &str = "\
