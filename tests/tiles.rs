@@ -34,6 +34,7 @@ fn tiling(format: Format, tile: usize, overlap: usize) -> Tiling {
             world: WORLD,
             tile,
             overlap,
+            engine: None,
         },
         format,
         height_range_m: range,

@@ -30,6 +30,9 @@ pub struct Identity {
     pub overlap: usize,
     /// The height range mapped onto 16-bit codes (png16, r16), metres.
     pub height_range_m: Option<[f64; 2]>,
+    /// The game engine the tiles are laid out for (`tiles --for`), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub engine: Option<String>,
 }
 
 /// One finished tile.

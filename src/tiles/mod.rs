@@ -17,11 +17,15 @@
 //!   loses at most that much work.
 //! - With water (`tiles --water`, [`water`]): per-tile lakes, flow and
 //!   rivers equal to the whole world's, written after the height tiles.
+//! - For a game engine (`tiles --for unreal|unity`, [`engine`]): its
+//!   names, sizes and format, neighbours sharing their edge samples, and
+//!   `import.json` with the scales and positions to import them at.
 //! - 16-bit formats share one height mapping across tiles (game engines
 //!   import tiled heightmaps with one height scale, and the mosaic needs
 //!   one): the caller's range, or the database's widened by a quarter on
 //!   each side; heights outside it are clamped and counted.
 
+pub mod engine;
 pub mod grid;
 pub mod manifest;
 pub mod vrt;
@@ -32,6 +36,7 @@ use crate::io::{self, Format, HeightMapping, IoError};
 use crate::progress::Progress;
 use crate::synth::SynthError;
 use crate::synth::cone::Rect;
+use engine::Engine;
 use grid::Grid;
 use manifest::{Identity, Manifest, Record};
 use rayon::prelude::*;
@@ -71,7 +76,12 @@ pub struct Summary {
     pub clamped: u64,
     pub manifest: PathBuf,
     pub vrt: Option<PathBuf>,
+    /// For an engine: its import settings, also written to [`IMPORT_FILE`].
+    pub import: Option<serde_json::Value>,
 }
+
+/// The import settings of an engine tile set, in its directory.
+pub const IMPORT_FILE: &str = "import.json";
 
 /// Failures of a tiled run.
 #[non_exhaustive]
@@ -87,6 +97,28 @@ pub enum TilesError {
     HeightRange(f64, f64),
     #[error("{0} tiles need one height range for every tile (e.g. `default_height_range`)")]
     NoHeightRange(Format),
+    #[error("{engine} tiles of {samples} samples are not imported: expected one of {sizes:?}", engine = .engine.name())]
+    EngineSize {
+        engine: Engine,
+        samples: usize,
+        sizes: &'static [usize],
+    },
+    #[error("{engine} tiles are {format} files with no overlap (got {got} with overlap {overlap})", engine = .engine.name(), format = .engine.format())]
+    EngineLayout {
+        engine: Engine,
+        got: Format,
+        overlap: usize,
+    },
+    #[error(
+        "a {w}x{h} world is not a whole number of {engine} tiles of {samples} samples sharing their edges: each side must be k x {quads} + 1, e.g. {sw}x{sh}",
+        engine = .engine.name(), quads = .samples - 1, w = .world.0, h = .world.1,
+        sw = fit(.world.0, .samples - 1), sh = fit(.world.1, .samples - 1)
+    )]
+    EngineWorld {
+        engine: Engine,
+        world: (usize, usize),
+        samples: usize,
+    },
     #[error("{path}: {reason}")]
     Manifest { path: PathBuf, reason: String },
     #[error(
@@ -105,6 +137,12 @@ pub enum TilesError {
     Water(#[from] crate::water::WaterError),
 }
 
+/// The world side nearest `n` (at least one tile) made of whole tiles of
+/// `quads` quads sharing their edges.
+fn fit(n: usize, quads: usize) -> usize {
+    ((n.saturating_sub(1) + quads / 2) / quads).max(1) * quads + 1
+}
+
 /// The identity a tiling writes into its manifest.
 fn identity(t: &Tiling, range: Option<(f64, f64)>) -> Identity {
     Identity {
@@ -115,6 +153,7 @@ fn identity(t: &Tiling, range: Option<(f64, f64)>) -> Identity {
         tile_size: t.grid.tile,
         overlap: t.grid.overlap,
         height_range_m: range.map(|(a, b)| [a, b]),
+        engine: t.grid.engine.map(|e| e.name().to_string()),
     }
 }
 
@@ -132,6 +171,31 @@ fn check(t: &Tiling) -> Result<(), TilesError> {
     }
     if !FORMATS.contains(&t.format) {
         return Err(TilesError::Format(t.format));
+    }
+    if let Some(engine) = g.engine {
+        let samples = g.tile + 1;
+        if !engine.sizes().contains(&samples) {
+            return Err(TilesError::EngineSize {
+                engine,
+                samples,
+                sizes: engine.sizes(),
+            });
+        }
+        if t.format != engine.format() || g.overlap != 0 {
+            return Err(TilesError::EngineLayout {
+                engine,
+                got: t.format,
+                overlap: g.overlap,
+            });
+        }
+        let whole = |n: usize| n > g.tile && (n - 1) % g.tile == 0;
+        if !(whole(g.world.0) && whole(g.world.1)) {
+            return Err(TilesError::EngineWorld {
+                engine,
+                world: g.world,
+                samples,
+            });
+        }
     }
     match t.height_range_m {
         Some((a, b)) if !(a.is_finite() && b.is_finite() && a < b) => {
@@ -167,6 +231,7 @@ fn differs(a: &Identity, b: &Identity) -> Option<&'static str> {
         ("tile size", a.tile_size == b.tile_size),
         ("overlap", a.overlap == b.overlap),
         ("height range", a.height_range_m == b.height_range_m),
+        ("engine", a.engine == b.engine),
     ]
     .into_iter()
     .find(|(_, same)| !same)
@@ -263,6 +328,10 @@ pub fn write(
                 file: file.clone(),
                 source,
             })?;
+            let hf = match t.grid.engine {
+                Some(e) => e.orient(hf),
+                None => hf,
+            };
             if let Some((lo, hi)) = range {
                 let n = hf
                     .data()
@@ -313,6 +382,15 @@ pub fn write(
         m.0.vrt = Some(vrt::FILE.to_string());
         save(&mut m)?;
     }
+    let import = t.grid.engine.map(|e| {
+        let range = range.expect("engine tiles are 16-bit, with a range");
+        engine::settings(e, &t.grid, &files, t.cell_size_m, range)
+    });
+    if let Some(s) = &import {
+        let mut json = serde_json::to_vec_pretty(s).expect("JSON values serialize");
+        json.push(b'\n');
+        io::write_atomic(&dir.join(IMPORT_FILE), &json)?;
+    }
     Ok(Summary {
         written: todo.len(),
         pixels: todo.iter().map(|&k| tiles[k].core.pixels() as u64).sum(),
@@ -320,5 +398,6 @@ pub fn write(
         clamped: clamped.into_inner(),
         manifest: dir.join(manifest::FILE),
         vrt: vrt.map(|_| dir.join(vrt::FILE)),
+        import,
     })
 }

@@ -9,7 +9,7 @@ use terrasynth::io::{self, Format};
 use terrasynth::scene::{Scene, WindowedScene};
 use terrasynth::synth::Synthesizer;
 use terrasynth::synth::cone::Rect;
-use terrasynth::tiles::{self, Tiling, grid::Grid};
+use terrasynth::tiles::{self, Tiling, engine::Engine, grid::Grid};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -25,17 +25,29 @@ pub struct Args {
     /// --start-exemplar and --height-prior).
     #[arg(long, conflicts_with_all = ["db", "size", "seed", "jitter", "passes", "start_exemplar", "piece_size", "height_prior"])]
     scene: Option<PathBuf>,
-    /// Tile side in pixels (the last row and column may be shorter).
-    #[arg(long, default_value_t = 1024)]
-    tile: usize,
+    /// Tile side in pixels (the last row and column may be shorter)
+    /// [default: 1024]. With --for: samples per tile file, its shared edge
+    /// included — Unreal 127, 253, 505, 1009 (default), 2017, 4033, 8129;
+    /// Unity 33 … 1025 (default) … 4097 (2^k + 1).
+    #[arg(long)]
+    tile: Option<usize>,
     /// Extra pixels each tile file holds on every side (shared with its
     /// neighbours, for tools that blend tile borders; the mosaic uses the
     /// cores only). At most the tile size.
     #[arg(long, default_value_t = 0)]
     overlap: usize,
-    /// Tile format.
-    #[arg(long, value_enum, default_value_t = TileFormat::Tiff)]
-    format: TileFormat,
+    /// Tile format [default: tiff].
+    #[arg(long, value_enum, conflicts_with = "engine")]
+    format: Option<TileFormat>,
+    /// Lay the tiles out for a game engine: its names, sizes and format,
+    /// neighbours sharing their edge samples (so the engine joins them
+    /// without seams), and import.json with the scales and positions to
+    /// import them at (also printed). The world must be k x (tile − 1) + 1
+    /// samples on each side. unreal: tile_x<X>_y<Y>.png, 16-bit PNG;
+    /// unity: tile_<X>_<Z>.raw, 16-bit RAW (Windows byte order), rows south
+    /// first, Z northwards.
+    #[arg(long = "for", value_enum, conflicts_with_all = ["overlap", "water"])]
+    engine: Option<EngineArg>,
     /// 16-bit formats (png, r16): metres MIN,MAX mapped onto the codes,
     /// the same for every tile. Default: the database's height range
     /// widened by a quarter of it on each side.
@@ -60,6 +72,24 @@ pub struct Args {
     water: bool,
     #[command(flatten)]
     water_params: crate::water::Knobs,
+}
+
+/// `--for`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum EngineArg {
+    /// Unreal Engine (World Partition / World Composition tiled import).
+    Unreal,
+    /// Unity (Terrain Toolbox, Import Heightmap, Batch mode).
+    Unity,
+}
+
+impl From<EngineArg> for Engine {
+    fn from(e: EngineArg) -> Engine {
+        match e {
+            EngineArg::Unreal => Engine::Unreal,
+            EngineArg::Unity => Engine::Unity,
+        }
+    }
 }
 
 /// `--format`.
@@ -139,17 +169,27 @@ pub fn run(a: Args) -> CliResult {
     };
     let mut synth = Synthesizer::new(&db, params.clone())?;
     select_backend(&mut synth, a.backend)?;
-    let format = Format::from(a.format);
+    let engine = a.engine.map(Engine::from);
+    let format = match engine {
+        Some(e) => e.format(),
+        None => Format::from(a.format.unwrap_or(TileFormat::Tiff)),
+    };
+    // An engine's tile counts samples, shared edge included; the grid, quads.
+    let tile = match engine {
+        Some(e) => a.tile.unwrap_or(e.default_size()).saturating_sub(1),
+        None => a.tile.unwrap_or(1024),
+    };
     let grid = Grid {
         world: size,
-        tile: a.tile,
+        tile,
         overlap: a.overlap,
+        engine,
     };
     // Memory: one tile's cone per thread, for a tile amid the world (at
     // the edges the cone is smaller); a scene's tiles hold about three
     // times that (its first frame's passes are recorded for the pastes).
     let (w, h) = size;
-    let side = |n: usize| (a.tile + 2 * a.overlap).min(n);
+    let side = |n: usize| (tile + 1 + 2 * a.overlap).min(n);
     let (tw, th) = (side(w), side(h));
     let probe = Rect::new((w - tw) / 2, (h - th) / 2, tw, th);
     let cone = synth
@@ -162,8 +202,8 @@ pub fn run(a: Args) -> CliResult {
         cone.bytes() * threads * factor,
     )?;
     if a.water {
-        let (cw, ch) = (a.tile.min(w), a.tile.min(h));
-        let rings = (w.div_ceil(a.tile) * h.div_ceil(a.tile) * 2 * (cw + ch)) as u64;
+        let (cw, ch) = (tile.min(w), tile.min(h));
+        let rings = (w.div_ceil(tile) * h.div_ceil(tile) * 2 * (cw + ch)) as u64;
         io::check_memory(
             &format!("water of {threads} tiles of {cw}x{ch} in parallel"),
             terrasynth::water::tiled::BYTES_PER_CELL * (cw * ch) as u64 * threads
@@ -244,6 +284,10 @@ pub fn run(a: Args) -> CliResult {
             r.flow_rounds,
             t.elapsed().as_secs_f64()
         );
+    }
+    if let Some(settings) = &s.import {
+        eprintln!("{}", tiles::engine::summary(settings));
+        eprintln!("wrote {}", a.out_dir.join(tiles::IMPORT_FILE).display());
     }
     eprintln!("wrote {}", s.manifest.display());
     match &s.vrt {
