@@ -10,10 +10,11 @@ use std::process::Command;
 use std::sync::OnceLock;
 use terrasynth::Heightfield;
 use terrasynth::database::{Database, default};
+use terrasynth::io::engine::Engine;
 use terrasynth::progress::Silent;
 use terrasynth::synth::cone::Rect;
 use terrasynth::synth::{Params, Synthesizer};
-use terrasynth::tiles::{self, TilesError, Tiling, engine::Engine, grid::Grid};
+use terrasynth::tiles::{self, TilesError, Tiling, engine, grid::Grid};
 
 fn db() -> &'static Database {
     static DB: OnceLock<Database> = OnceLock::new();
@@ -23,15 +24,15 @@ fn db() -> &'static Database {
 const SEED: u32 = 5;
 const CELL_M: f64 = 30.0;
 
-fn tiling(engine: Engine, world: (usize, usize), samples: usize) -> Tiling {
+fn tiling(e: Engine, world: (usize, usize), samples: usize) -> Tiling {
     Tiling {
         grid: Grid {
             world,
             tile: samples - 1,
             overlap: 0,
-            engine: Some(engine),
+            engine: Some(e),
         },
-        format: engine.format(),
+        format: engine::format(e),
         height_range_m: Some(tiles::default_height_range(db().quantization())),
         cell_size_m: CELL_M,
         source: serde_json::json!({"seed": SEED}),

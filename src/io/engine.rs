@@ -89,6 +89,15 @@ impl Engine {
     }
 }
 
+/// Unreal's Z scale and location Z (cm) for heights `lo … hi` metres mapped
+/// onto the codes 0 … 65535: code v lies (v − 32768) / 128 × Z scale cm
+/// above the location (module docs).
+pub fn unreal_z(lo: f64, hi: f64) -> (f64, f64) {
+    let relief = hi - lo;
+    let mid = lo + relief * 32768.0 / 65535.0;
+    (relief * 100.0 * 128.0 / 65535.0, mid * 100.0)
+}
+
 /// Resamples and orders `hf` for `engine` and works out the import settings.
 pub fn prepare(hf: &Heightfield, engine: Engine) -> Result<Prepared, FormatError> {
     let stats = hf.stats().ok_or_else(|| {
@@ -141,8 +150,7 @@ pub fn prepare(hf: &Heightfield, engine: Engine) -> Result<Prepared, FormatError
             ]
         }
         Engine::Unreal => {
-            let z_scale = relief * 100.0 * 128.0 / 65535.0;
-            let mid = min + relief * 32768.0 / 65535.0;
+            let (z_scale, location_z) = unreal_z(min, max);
             vec![
                 "Landscape > Manage > Import from File".to_string(),
                 format!("Heightmap resolution: {side} x {side}"),
@@ -151,7 +159,7 @@ pub fn prepare(hf: &Heightfield, engine: Engine) -> Result<Prepared, FormatError
                     out.cell_size() * 100.0,
                     out.cell_size() * 100.0 * ext_z / ext_x
                 ),
-                format!("Location Z: {:.1} cm (height of sample 32768)", mid * 100.0),
+                format!("Location Z: {location_z:.1} cm (height of sample 32768)"),
             ]
         }
     };

@@ -1,7 +1,7 @@
 //! The tile grid of a world: which pixels each tile file holds and under
 //! which name.
 
-use super::engine::Engine;
+use crate::io::engine::Engine;
 use crate::synth::cone::Rect;
 
 /// A world cut into `tile × tile` cores (the last row and column shorter),
@@ -82,10 +82,10 @@ impl Grid {
 
     /// The file name of a tile: `tile_<col>_<row>.<ext>`, both numbers
     /// zero-padded to the grid's widest, so names sort in grid order; an
-    /// engine's own names for its tiles ([`Engine::file_name`]).
+    /// engine's own names for its tiles ([`super::engine::file_name`]).
     pub fn file_name(&self, t: &Tile, ext: &str) -> String {
         if let Some(e) = self.engine {
-            return e.file_name(self, t);
+            return super::engine::file_name(e, self, t);
         }
         let (cols, rows) = self.size();
         let digits = (cols.max(rows) - 1).max(1).ilog10() as usize + 1;

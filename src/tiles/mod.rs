@@ -32,11 +32,11 @@ pub mod vrt;
 pub mod water;
 
 use crate::heightfield::Heightfield;
+use crate::io::engine::Engine;
 use crate::io::{self, Format, HeightMapping, IoError};
 use crate::progress::Progress;
 use crate::synth::SynthError;
 use crate::synth::cone::Rect;
-use engine::Engine;
 use grid::Grid;
 use manifest::{Identity, Manifest, Record};
 use rayon::prelude::*;
@@ -103,7 +103,7 @@ pub enum TilesError {
         samples: usize,
         sizes: &'static [usize],
     },
-    #[error("{engine} tiles are {format} files with no overlap (got {got} with overlap {overlap})", engine = .engine.name(), format = .engine.format())]
+    #[error("{engine} tiles are {format} files with no overlap (got {got} with overlap {overlap})", engine = .engine.name(), format = engine::format(*.engine))]
     EngineLayout {
         engine: Engine,
         got: Format,
@@ -181,7 +181,7 @@ fn check(t: &Tiling) -> Result<(), TilesError> {
                 sizes: engine.sizes(),
             });
         }
-        if t.format != engine.format() || g.overlap != 0 {
+        if t.format != engine::format(engine) || g.overlap != 0 {
             return Err(TilesError::EngineLayout {
                 engine,
                 got: t.format,
@@ -314,6 +314,8 @@ pub fn write(
     let opts = io::WriteOptions {
         format: Some(t.format),
         height_range: range,
+        // Unity reads a RAW file's first row as its south edge.
+        south_up: t.grid.engine == Some(Engine::Unity),
         ..Default::default()
     };
     let clamped = std::sync::atomic::AtomicU64::new(0);
@@ -328,10 +330,6 @@ pub fn write(
                 file: file.clone(),
                 source,
             })?;
-            let hf = match t.grid.engine {
-                Some(e) => e.orient(hf),
-                None => hf,
-            };
             if let Some((lo, hi)) = range {
                 let n = hf
                     .data()

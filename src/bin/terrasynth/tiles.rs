@@ -5,11 +5,12 @@ use crate::CliResult;
 use crate::args::{BackendArg, SynthesisArgs, load_database, parse_world_size, select_backend};
 use std::path::PathBuf;
 use std::time::Instant;
+use terrasynth::io::engine::Engine;
 use terrasynth::io::{self, Format};
 use terrasynth::scene::{Scene, WindowedScene};
 use terrasynth::synth::Synthesizer;
 use terrasynth::synth::cone::Rect;
-use terrasynth::tiles::{self, Tiling, engine::Engine, grid::Grid};
+use terrasynth::tiles::{self, Tiling, grid::Grid};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -171,12 +172,15 @@ pub fn run(a: Args) -> CliResult {
     select_backend(&mut synth, a.backend)?;
     let engine = a.engine.map(Engine::from);
     let format = match engine {
-        Some(e) => e.format(),
+        Some(e) => tiles::engine::format(e),
         None => Format::from(a.format.unwrap_or(TileFormat::Tiff)),
     };
     // An engine's tile counts samples, shared edge included; the grid, quads.
     let tile = match engine {
-        Some(e) => a.tile.unwrap_or(e.default_size()).saturating_sub(1),
+        Some(e) => a
+            .tile
+            .unwrap_or(tiles::engine::default_samples(e))
+            .saturating_sub(1),
         None => a.tile.unwrap_or(1024),
     };
     let grid = Grid {
@@ -189,7 +193,7 @@ pub fn run(a: Args) -> CliResult {
     // the edges the cone is smaller); a scene's tiles hold about three
     // times that (its first frame's passes are recorded for the pastes).
     let (w, h) = size;
-    let side = |n: usize| (tile + 1 + 2 * a.overlap).min(n);
+    let side = |n: usize| (tile + usize::from(engine.is_some()) + 2 * a.overlap).min(n);
     let (tw, th) = (side(w), side(h));
     let probe = Rect::new((w - tw) / 2, (h - th) / 2, tw, th);
     let cone = synth
