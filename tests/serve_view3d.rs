@@ -4,7 +4,8 @@
 //! contrast, and clearly unlike the same camera at exaggeration 0 (a flat
 //! mesh) — so a blank canvas, an unbound texture or a mesh without heights
 //! fails. It must follow edits: a point placed on the map and an undo made
-//! in 3D each bring that frame's heights and preview into the view.
+//! in 3D each bring that frame's heights and preview into the view, and
+//! a browser without WebGL gets a message in the view, not an exception.
 //! Screenshots go to `target/editor-screenshots/` (or
 //! `$TERRASYNTH_SCREENSHOTS`).
 //!
@@ -188,6 +189,26 @@ fn the_3d_view_draws_relief_and_follows_edits() {
         assert!(shown(c).await, "undo keeps the 3D view");
         let errors = js(c, "return window.__errors || []").await;
         assert_eq!(errors, json!([]), "the page logged errors");
+
+        // A browser without WebGL: the view says so, and nothing throws.
+        c.refresh().await.unwrap();
+        settled(c, -1).await;
+        js(
+            c,
+            "const get = HTMLCanvasElement.prototype.getContext;
+             HTMLCanvasElement.prototype.getContext = function (kind, ...rest) {
+               return kind.startsWith('webgl') ? null : get.call(this, kind, ...rest);
+             };",
+        )
+        .await;
+        key(c, '3').await;
+        let message = js(c, "const m = document.querySelector('#view3d .message'); return m.hidden ? null : m.textContent").await;
+        assert!(
+            message.as_str().is_some_and(|m| m.contains("WebGL")),
+            "without WebGL the 3D view says so: {message}"
+        );
+        let errors = js(c, "return window.__errors || []").await;
+        assert_eq!(errors, json!([]), "the page logged errors without WebGL");
     });
     eprintln!(
         "the 3D view test took {:.1} s",
