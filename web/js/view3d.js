@@ -225,7 +225,6 @@ export class View3d {
     d.draws = String(this.draws);
     d.heightsRevision = String(s.heights.revision);
     d.imageRevision = String(this.textured);
-    d.exaggeration = String(this.ex);
   }
 
   /**
