@@ -35,6 +35,11 @@ const FILES: &[(&str, &str, &[u8])] = &[
         include_bytes!("../../web/js/map.js"),
     ),
     (
+        "js/view3d.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../web/js/view3d.js"),
+    ),
+    (
         "js/geometry.js",
         "text/javascript; charset=utf-8",
         include_bytes!("../../web/js/geometry.js"),

@@ -6,6 +6,7 @@ import { Api, ApiError } from './api.js';
 import { MapView, isTyping } from './map.js';
 import { Tools } from './tools.js';
 import { Panel } from './panel.js';
+import { View3d } from './view3d.js';
 import { Link, open, closeOnHide } from './link.js';
 
 const $ = (id) => document.getElementById(id);
@@ -112,6 +113,7 @@ async function showFrame(frame, job) {
   ed.revision = frame.revision;
   if (frame.scene) ed.doc = frame.scene;
   ed.map.draw();
+  ed.view3d.imageChanged();
   if (job) {
     $('status-error').textContent = '';
     const ms = performance.now() - job.t0;
@@ -153,6 +155,7 @@ function scheduleHeights() {
     if (ed.api.busy()) return scheduleHeights();
     try {
       ed.heights = await ed.api.heights();
+      ed.view3d.heightsChanged();
       // The cross-section draws the terrain from these samples.
       if (ed.panel.profile) ed.panel.profile.draw();
     } catch (e) {
@@ -258,6 +261,24 @@ function scaleDoc(doc, [w, h]) {
   doc.size = [w, h];
 }
 
+/** Switches the stage between the map and the 3D view. */
+function show3d(on) {
+  ed.view3d.show(on);
+  $('toggle-3d').classList.toggle('active', on);
+}
+
+/** Picks a tool; the tools draw on the map, so it comes back. */
+function tool(name) {
+  if (ed.view3d.shown) show3d(false);
+  ed.tools.select(name);
+}
+
+/** Fits the map, or in 3D puts the camera back. */
+function fit() {
+  if (ed.view3d.shown) ed.view3d.reset();
+  else ed.map.fit();
+}
+
 function wireBar() {
   $('undo').onclick = () => undoRedo('undo');
   $('redo').onclick = () => undoRedo('redo');
@@ -326,9 +347,10 @@ function wireBar() {
     ed.handles = $('v-handles').checked;
     ed.map.redraw();
   };
-  $('fit').onclick = () => ed.map.fit();
+  $('fit').onclick = fit;
+  $('toggle-3d').onclick = () => show3d(!ed.view3d.shown);
   for (const b of document.querySelectorAll('#tools button[data-tool]')) {
-    b.onclick = () => ed.tools.select(b.dataset.tool);
+    b.onclick = () => tool(b.dataset.tool);
   }
   window.addEventListener('keydown', (e) => {
     if (isTyping(e)) return;
@@ -344,8 +366,9 @@ function wireBar() {
       save();
     } else if (!e.ctrlKey && !e.metaKey && !e.altKey) {
       const tools = { v: 'select', p: 'point', c: 'curve', t: 'types', f: 'freeze', l: 'lasso', h: 'pan' };
-      if (tools[k]) ed.tools.select(tools[k]);
-      else if (k === '0') ed.map.fit();
+      if (tools[k]) tool(tools[k]);
+      else if (k === '0') fit();
+      else if (k === '3') show3d(!ed.view3d.shown);
       else ed.tools.key(e);
     }
   });
@@ -397,6 +420,13 @@ async function boot() {
   clearInterval(tick);
   ed.doc = frame.scene;
   ed.panel = new Panel(ed);
+  ed.view3d = new View3d($('view3d'), () => ({
+    heights: ed.heights,
+    image: ed.base,
+    revision: ed.revision,
+    cell: ed.cell(),
+    size: ed.frame.size,
+  }));
   ed.tools = new Tools(ed);
   wireBar();
   ed.api.onFrame = showFrame;
