@@ -20,6 +20,13 @@
 //!   G rock on slopes above 30° (fully at 45°), B snow on the top 15 % of
 //!   the relief where not rock, A wet ground where flow accumulation is in
 //!   its top quarter.
+//!
+//! For a game engine (`masks --for`), the masks are those of the heightmap
+//! as `convert --for` writes it ([`crate::io::engine`]), and the splat map
+//! takes the engine's form: Unreal paints weight-blended layers from one
+//! 8-bit weightmap per layer at the heightmap's size ([`splat_layers`]);
+//! Unity's splat (control) texture has one texel per terrain *cell*, a
+//! power of two where the heightmap has 2ⁿ + 1 vertices ([`splat_cells`]).
 
 use crate::heightfield::Heightfield;
 use crate::water::{self, WaterError};
@@ -97,6 +104,37 @@ pub fn compute(hf: &Heightfield, splat: bool) -> Result<Masks, WaterError> {
     })
 }
 
+/// The splat map's layers, in channel order (R, G, B, A).
+pub const SPLAT_LAYERS: [&str; 4] = ["grass", "rock", "snow", "wet"];
+
+/// The splat map as one 8-bit weightmap per layer ([`SPLAT_LAYERS`]
+/// order), for engines that import layers separately (Unreal).
+pub fn splat_layers(splat: &[[u8; 4]]) -> [Vec<u8>; 4] {
+    std::array::from_fn(|c| splat.iter().map(|p| p[c]).collect())
+}
+
+/// The splat map of a `w × h` grid of vertices as the `(w − 1) × (h − 1)`
+/// cells between them: each cell the mean of its four corners, R, G and B
+/// rounded down and A taking the rest, so every cell still sums to 255.
+pub fn splat_cells(splat: &[[u8; 4]], w: usize, h: usize) -> Vec<[u8; 4]> {
+    let (cw, ch) = (w.saturating_sub(1), h.saturating_sub(1));
+    (0..cw * ch)
+        .map(|k| {
+            let (x, y) = (k % cw, k / cw);
+            let corners = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
+            let mean = |c: usize| {
+                let s: u32 = corners
+                    .iter()
+                    .map(|&(i, j)| u32::from(splat[j * w + i][c]))
+                    .sum();
+                (s / 4) as u8
+            };
+            let (r, g, b) = (mean(0), mean(1), mean(2));
+            [r, g, b, 255 - r - g - b]
+        })
+        .collect()
+}
+
 /// An 8-bit PNG of `channels` samples per pixel (1 grey, 3 RGB, 4 RGBA).
 pub fn encode_png8(width: usize, height: usize, channels: usize, data: &[u8]) -> Vec<u8> {
     let mut out = Vec::new();
@@ -142,5 +180,24 @@ mod tests {
         for p in m.splat.unwrap() {
             assert_eq!(p.iter().map(|&c| c as u32).sum::<u32>(), 255);
         }
+    }
+
+    #[test]
+    fn splat_layers_and_cells_keep_every_weight() {
+        let s = vec![
+            [255, 0, 0, 0],
+            [0, 255, 0, 0],
+            [0, 0, 128, 127],
+            [85, 85, 85, 0],
+        ];
+        let l = splat_layers(&s);
+        assert_eq!(l[1], [0, 255, 0, 85]);
+        assert_eq!(l[3], [0, 0, 127, 0]);
+        // One cell between four vertices: their means, A the remainder.
+        let c = splat_cells(&s, 2, 2);
+        assert_eq!(c, [[85, 85, 53, 32]]);
+        // A uniform splat is its own cell map.
+        let u = vec![[10, 20, 30, 195]; 12];
+        assert_eq!(splat_cells(&u, 4, 3), vec![[10, 20, 30, 195]; 6]);
     }
 }

@@ -227,3 +227,78 @@ fn a_closed_stdout_ends_a_command_without_a_panic() {
         "a command that could not write succeeded"
     );
 }
+
+/// An 8-bit PNG's size, channels and samples.
+fn png8(path: &Path) -> (u32, u32, usize, Vec<u8>) {
+    let mut r = png::Decoder::new(std::io::Cursor::new(std::fs::read(path).unwrap()))
+        .read_info()
+        .unwrap();
+    let mut buf = vec![0; r.output_buffer_size().unwrap()];
+    let info = r.next_frame(&mut buf).unwrap();
+    assert_eq!(info.bit_depth, png::BitDepth::Eight, "{}", path.display());
+    buf.truncate(info.buffer_size());
+    let channels = info.color_type.samples();
+    (info.width, info.height, channels, buf)
+}
+
+/// `masks --for`: the masks of the heightmap `convert --for` writes (the
+/// engine's size), the splat as Unreal's per-layer weightmaps or Unity's
+/// per-cell control texture, each equal to the library's splat of that
+/// heightmap and summing to 255.
+#[test]
+fn masks_for_an_engine_are_at_its_size_in_its_layout() {
+    use terrasynth::io::engine::{self, Engine};
+    use terrasynth::masks;
+    let dem = repo("data/pyrenees_andorra.png");
+    let hf = terrasynth::io::read(&dem, &Default::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for (e, side) in [(Engine::Unreal, 1009u32), (Engine::Unity, 513)] {
+        let out = dir.path().join(e.name());
+        let o = terrasynth(
+            &["masks", dem.to_str().unwrap(), "--splat", "--for", e.name()]
+                .into_iter()
+                .chain(["--out-dir", out.to_str().unwrap()])
+                .collect::<Vec<_>>(),
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        let want = masks::compute(&engine::prepare(&hf, e).unwrap().heightfield, true)
+            .unwrap()
+            .splat
+            .unwrap();
+        assert_eq!(png8(&out.join("slope.png")).0, side);
+        match e {
+            Engine::Unreal => {
+                assert!(err.contains("target layers"), "{err}");
+                assert!(!out.join("splat.png").exists());
+                let layers = masks::splat_layers(&want);
+                let mut sums = vec![0u32; (side * side) as usize];
+                for (name, w) in masks::SPLAT_LAYERS.iter().zip(&layers) {
+                    let (pw, ph, ch, got) = png8(&out.join(format!("splat_{name}.png")));
+                    assert_eq!((pw, ph, ch), (side, side, 1), "{name}");
+                    assert!(&got == w, "splat_{name}.png differs from the splat's layer");
+                    for (s, &v) in sums.iter_mut().zip(&got) {
+                        *s += u32::from(v);
+                    }
+                }
+                assert!(sums.iter().all(|&s| s == 255));
+                // Mountains: some rock, some grass.
+                assert!(layers[1].iter().any(|&v| v > 128) && layers[0].iter().any(|&v| v > 128));
+            }
+            Engine::Unity => {
+                assert!(err.contains("Control Texture Resolution 512"), "{err}");
+                let (pw, ph, ch, got) = png8(&out.join("splat.png"));
+                assert_eq!((pw, ph, ch), (512, 512, 4));
+                let cells = masks::splat_cells(&want, side as usize, side as usize);
+                assert!(
+                    got == cells.as_flattened(),
+                    "splat.png differs from the cell splat"
+                );
+                assert!(
+                    got.chunks(4)
+                        .all(|p| p.iter().map(|&v| u32::from(v)).sum::<u32>() == 255)
+                );
+            }
+        }
+    }
+}

@@ -215,6 +215,15 @@ pub enum EngineArg {
     Unreal,
 }
 
+impl From<EngineArg> for terrasynth::io::engine::Engine {
+    fn from(e: EngineArg) -> Self {
+        match e {
+            EngineArg::Unity => Self::Unity,
+            EngineArg::Unreal => Self::Unreal,
+        }
+    }
+}
+
 /// Writes an output heightfield: never over one of `inputs`, with the
 /// engine's conventions and import settings when `engine` is given, and
 /// the writer's notices printed.
@@ -235,10 +244,7 @@ pub fn write_output(
     let hf = match engine {
         None => hf,
         Some(e) => {
-            let e = match e {
-                EngineArg::Unity => Engine::Unity,
-                EngineArg::Unreal => Engine::Unreal,
-            };
+            let e = Engine::from(e);
             let ext = path
                 .extension()
                 .and_then(|x| x.to_str())

@@ -2,7 +2,9 @@
 //! and a GDAL mosaic (see `terrasynth::tiles`).
 
 use crate::CliResult;
-use crate::args::{BackendArg, SynthesisArgs, load_database, parse_world_size, select_backend};
+use crate::args::{
+    BackendArg, EngineArg, SynthesisArgs, load_database, parse_world_size, select_backend,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 use terrasynth::io::engine::Engine;
@@ -73,24 +75,6 @@ pub struct Args {
     water: bool,
     #[command(flatten)]
     water_params: crate::water::Knobs,
-}
-
-/// `--for`.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-enum EngineArg {
-    /// Unreal Engine (World Partition / World Composition tiled import).
-    Unreal,
-    /// Unity (Terrain Toolbox, Import Heightmap, Batch mode).
-    Unity,
-}
-
-impl From<EngineArg> for Engine {
-    fn from(e: EngineArg) -> Engine {
-        match e {
-            EngineArg::Unreal => Engine::Unreal,
-            EngineArg::Unity => Engine::Unity,
-        }
-    }
 }
 
 /// `--format`.
