@@ -338,6 +338,38 @@ ds = None
         "GeoTIFF 3 bands (pixel-interleaved)",
         "refused without --band (names the count); --band 1..3 read exactly; --band 4 refused",
     );
+    // The same bands interleaved by plane (how gdal_translate writes
+    // multi-band files by default), in strips and in tiles.
+    for (name, opts) in [
+        ("planar.tif", "-co INTERLEAVE=BAND"),
+        (
+            "planar_tiled.tif",
+            "-co INTERLEAVE=BAND -co TILED=YES -co BLOCKXSIZE=16 -co BLOCKYSIZE=16 -co COMPRESS=DEFLATE",
+        ),
+    ] {
+        let planar = d.join(name);
+        let o = Command::new("gdal_translate")
+            .args(["-q"])
+            .args(opts.split(' '))
+            .arg(&multi)
+            .arg(&planar)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        for band in 1..=3 {
+            let opts = ReadOptions {
+                band: Some(band),
+                ..Default::default()
+            };
+            let hf = io::read(&planar, &opts).unwrap();
+            assert_same_values(&hf, &planar, band, |v| v);
+            assert_eq!(hf.get(19, 9), 100.0 * band as f32 + 199.0, "{name}");
+        }
+    }
+    case(
+        "GeoTIFF 3 bands (band-interleaved, strips and 16² tiles)",
+        "--band 1..3 read exactly",
+    );
     let hf = io::read(&scaled, &ReadOptions::default()).unwrap();
     assert_same_values(&hf, &scaled, 1, |raw| raw * 0.1 - 100.0);
     assert!((hf.get(0, 0) - 1100.0).abs() < 1e-3, "{}", hf.get(0, 0));

@@ -5,7 +5,7 @@
 //! Read:
 //! - one band: the only one, or `ReadOptions::band` (1-based, as GDAL's
 //!   `-b`) of a multi-band file, which without it is refused with the band
-//!   count;
+//!   count; pixel- or band-interleaved (planar, GDAL's `INTERLEAVE=BAND`);
 //! - `GDAL_NODATA` (tag 42113): samples equal to it become NaN; NaN float
 //!   samples are nodata regardless;
 //! - GDAL's per-band scale, offset and unit, and the vertical unit GeoKey:
@@ -67,7 +67,7 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
             });
         }
     }
-    let band = pick_band(&mut dec, band, samples)?;
+    let (band, planar) = pick_band(&mut dec, band, samples)?;
     let bytes_per_pixel = bits as u64 / 8 * samples as u64;
     check_justified(w, h, bytes_per_pixel, bytes.len(), ratio)?;
     // The decoder's limits, as a second line of defence: the image buffer
@@ -148,32 +148,56 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
         }
     };
     let n = w * h;
+    let data = if planar {
+        read_plane(&mut dec, band, samples, (w, h), &convert, nodata32(nodata))?
+    } else {
+        let image = dec.read_image().map_err(tiff_error)?;
+        heights(&image, (band, samples, n), &convert, nodata32(nodata))?
+    };
+    if data.len() < n {
+        return Err(FormatError::EndsEarly("TIFF image data"));
+    }
+    let mut hf = Heightfield::from_vec(w, h, cell, data)?;
+    hf.set_georef(georef);
+    Ok(hf)
+}
+
+/// The nodata value as Float32 samples compare with it (as GDAL does for
+/// Float32 bands).
+fn nodata32(nodata: Option<f64>) -> Option<f32> {
+    nodata.map(|v| v as f32)
+}
+
+/// Every `step`-th sample of `image` from `start`, `n` of them, as heights
+/// (`convert`; Float32 samples equal to `nodata32` are nodata).
+fn heights(
+    image: &DecodingResult,
+    (start, step, n): (usize, usize, usize),
+    convert: &dyn Fn(f64) -> f32,
+    nodata32: Option<f32>,
+) -> Result<Vec<f32>, FormatError> {
     fn pick<T: Copy>(
         v: &[T],
-        band: usize,
-        samples: usize,
-        n: usize,
+        (start, step, n): (usize, usize, usize),
         f: impl Fn(T) -> f32,
     ) -> Vec<f32> {
         v.iter()
-            .skip(band)
-            .step_by(samples)
+            .skip(start)
+            .step_by(step)
             .take(n)
             .map(|&s| f(s))
             .collect()
     }
-    let image = dec.read_image().map_err(tiff_error)?;
-    // F32 compares with the nodata value in f32, as GDAL does for Float32 bands.
-    let nodata32 = nodata.map(|v| v as f32);
-    let data: Vec<f32> = match &image {
-        DecodingResult::U8(v) => pick(v, band, samples, n, |s| convert(s as f64)),
-        DecodingResult::I8(v) => pick(v, band, samples, n, |s| convert(s as f64)),
-        DecodingResult::U16(v) => pick(v, band, samples, n, |s| convert(s as f64)),
-        DecodingResult::I16(v) => pick(v, band, samples, n, |s| convert(s as f64)),
-        DecodingResult::U32(v) => pick(v, band, samples, n, |s| convert(s as f64)),
-        DecodingResult::I32(v) => pick(v, band, samples, n, |s| convert(s as f64)),
-        DecodingResult::F64(v) => pick(v, band, samples, n, convert),
-        DecodingResult::F32(v) => pick(v, band, samples, n, |s| {
+    let at = (start, step, n);
+    Ok(match image {
+        DecodingResult::U8(v) => pick(v, at, |s| convert(s as f64)),
+        DecodingResult::I8(v) => pick(v, at, |s| convert(s as f64)),
+        DecodingResult::U16(v) => pick(v, at, |s| convert(s as f64)),
+        DecodingResult::I16(v) => pick(v, at, |s| convert(s as f64)),
+        DecodingResult::U32(v) => pick(v, at, |s| convert(s as f64)),
+        DecodingResult::I32(v) => pick(v, at, |s| convert(s as f64)),
+        DecodingResult::F64(v) => pick(v, at, convert),
+        DecodingResult::F32(v) => pick(v, at, |s| {
             if Some(s) == nodata32 {
                 f32::NAN
             } else {
@@ -185,14 +209,65 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
                 "TIFF decoded to an unexpected sample type".into(),
             ));
         }
-    };
-    drop(image);
-    if data.len() < n {
-        return Err(FormatError::EndsEarly("TIFF image data"));
+    })
+}
+
+/// Band `band` (0-based) of a band-interleaved (planar) file, decoded chunk
+/// by chunk: the band's strips or tiles are the `band`-th run of the
+/// file's chunks. Why not the decoder's whole-image read: it decodes the
+/// first plane only, and its all-planes read panicked on striped planar
+/// files (tiff 0.11.3).
+fn read_plane(
+    dec: &mut Dec,
+    band: usize,
+    samples: usize,
+    (w, h): (usize, usize),
+    convert: &dyn Fn(f64) -> f32,
+    nodata32: Option<f32>,
+) -> Result<Vec<f32>, FormatError> {
+    let tiled = matches!(dec.get_chunk_type(), tiff::decoder::ChunkType::Tile);
+    let chunks = if tiled {
+        dec.tile_count()
+    } else {
+        dec.strip_count()
     }
-    let mut hf = Heightfield::from_vec(w, h, cell, data)?;
-    hf.set_georef(georef);
-    Ok(hf)
+    .map_err(tiff_error)? as usize;
+    let per_plane = chunks / samples;
+    let (cw, ch) = dec.chunk_dimensions();
+    let (cw, ch) = (cw as usize, ch as usize);
+    if per_plane == 0 || cw == 0 || ch == 0 {
+        return Err(FormatError::Corrupt(
+            "TIFF planar layout has no chunks".into(),
+        ));
+    }
+    let across = if tiled { w.div_ceil(cw) } else { 1 };
+    let mut out = vec![f32::NAN; w * h];
+    for i in 0..per_plane {
+        let (x0, y0) = ((i % across) * cw, (i / across) * ch);
+        if x0 >= w || y0 >= h {
+            return Err(FormatError::Corrupt(format!(
+                "TIFF chunk {i} of band {} lies outside the {w}x{h} image",
+                band + 1
+            )));
+        }
+        let index = (band * per_plane + i) as u32;
+        // The decoded chunk is its data rectangle: edge tiles without their
+        // padding, except that the decoder drops the bottom padding of the
+        // first plane only, so rows past the image are cut here.
+        let (stride, data_rows) = dec.chunk_data_dimensions(index);
+        let (stride, rows) = (stride as usize, (data_rows as usize).min(h - y0));
+        let chunk = dec.read_chunk(index).map_err(tiff_error)?;
+        let v = heights(&chunk, (0, 1, stride * rows), convert, nodata32)?;
+        if stride == 0 || v.len() < stride * rows {
+            return Err(FormatError::EndsEarly("TIFF chunk"));
+        }
+        let cols = stride.min(w - x0);
+        for (r, row) in v.chunks_exact(stride).enumerate() {
+            let dst = (y0 + r) * w + x0;
+            out[dst..dst + cols].copy_from_slice(&row[..cols]);
+        }
+    }
+    Ok(out)
 }
 
 /// Metres per linear unit of a CRS (1 for degrees, which never get here).
@@ -236,10 +311,15 @@ fn compression_ratio(dec: &mut Dec) -> Result<u64, FormatError> {
     })
 }
 
-/// The 0-based band to read, checked against the file's band count.
-fn pick_band(dec: &mut Dec, band: Option<usize>, samples: usize) -> Result<usize, FormatError> {
+/// The 0-based band to read, checked against the file's band count, and
+/// whether the bands are interleaved by plane (`PlanarConfiguration` 2).
+fn pick_band(
+    dec: &mut Dec,
+    band: Option<usize>,
+    samples: usize,
+) -> Result<(usize, bool), FormatError> {
     let b = match (band, samples) {
-        (None, 1) => return Ok(0),
+        (None, 1) => return Ok((0, false)),
         (None, n) => {
             return Err(FormatError::Unsupported {
                 what: "TIFF band count",
@@ -258,14 +338,7 @@ fn pick_band(dec: &mut Dec, band: Option<usize>, samples: usize) -> Result<usize
     let planar = dec
         .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
         .map_err(tiff_error)?;
-    if planar == Some(2) && b > 0 {
-        return Err(FormatError::Unsupported {
-            what: "TIFF band layout",
-            found: format!("band {} of a band-interleaved (planar) file", b + 1),
-            supported: "the first band, or pixel-interleaved files; extract the band with gdal_translate -b N in.tif out.tif",
-        });
-    }
-    Ok(b)
+    Ok((b, planar == Some(2)))
 }
 
 type Dec<'a> = Decoder<Cursor<&'a [u8]>>;
