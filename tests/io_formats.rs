@@ -180,6 +180,58 @@ fn exr_f16_single_channel_and_y_among_many() {
         AnyChannel::new("Z", FlatSamples::F32(decoy)),
     ]);
     assert_eq!(decode(&many, Format::Exr).unwrap().data(), &values[..]);
+    // A colour image (Houdini's height in R): R is read, with a notice;
+    // RGBA too; a colour image with another channel is still refused.
+    let load = |bytes: &[u8]| {
+        io::load_bytes(
+            bytes,
+            Format::Exr,
+            &Default::default(),
+            &ReadOptions::default(),
+        )
+    };
+    let zeros = vec![0.0f32; w * h];
+    for alpha in [false, true] {
+        let mut ch = vec![
+            AnyChannel::new("B", FlatSamples::F32(zeros.clone())),
+            AnyChannel::new("G", FlatSamples::F32(zeros.clone())),
+            AnyChannel::new("R", FlatSamples::F32(values.clone())),
+        ];
+        if alpha {
+            ch.push(AnyChannel::new("A", FlatSamples::F32(vec![1.0; w * h])));
+        }
+        let l = load(&write(ch)).unwrap();
+        assert_eq!(l.heightfield.data(), &values[..]);
+        assert!(
+            l.grid.notes.iter().any(|n| n.contains("channel R")),
+            "{:?}",
+            l.grid.notes
+        );
+    }
+    let odd = write(vec![
+        AnyChannel::new("B", FlatSamples::F32(zeros.clone())),
+        AnyChannel::new("G", FlatSamples::F32(zeros.clone())),
+        AnyChannel::new("R", FlatSamples::F32(values.clone())),
+        AnyChannel::new("Z", FlatSamples::F32(zeros.clone())),
+    ]);
+    let e = load(&odd).unwrap_err().to_string();
+    assert!(e.contains("B, G, R, Z") || e.contains("R of an RGB"), "{e}");
+    // Heights in 0..1 (Gaea's Raw range) are read as metres, with a notice;
+    // a single-channel file in metres gets none.
+    let unit: Vec<f32> = (0..w * h).map(|i| i as f32 / (w * h) as f32).collect();
+    let l = load(&write(vec![AnyChannel::new(
+        "Y",
+        FlatSamples::F32(unit.clone()),
+    )]))
+    .unwrap();
+    assert_eq!(l.heightfield.data(), &unit[..]);
+    assert!(
+        l.grid.notes.iter().any(|n| n.contains("normalised")),
+        "{:?}",
+        l.grid.notes
+    );
+    let metres = write(vec![AnyChannel::new("Y", FlatSamples::F32(values.clone()))]);
+    assert!(load(&metres).unwrap().grid.notes.is_empty());
 }
 
 /// A synthetic SRTM tile: size from the byte count, big-endian, void → NaN.

@@ -225,7 +225,7 @@ def malformed():
     case("exr_bad_zip.exr", head + struct.pack("<Q", len(head) + 8) + block, "Corrupt", "EXR")
     case("exr_huge.exr", exr_header(100000, 100000, [("Y", 2)]), "Size", "100000x100000 is too large")
     case("exr_not_justified.exr", exr_header(20000, 20000, [("Y", 2)]), "SizeNotJustified", "20000x20000")
-    case("exr_rgb.exr", exr_header(2, 2, [("B", 2), ("G", 2), ("R", 2)]), "Unsupported", "EXR channels: B, G, R")
+    case("exr_rgbz.exr", exr_header(2, 2, [("B", 2), ("G", 2), ("R", 2), ("Z", 2)]), "Unsupported", "EXR channels: B, G, R, Z")
     case("exr_u32.exr", exr_header(2, 2, [("Z", 0)]), "Unsupported", "u32 in channel Z")
     key = b"cellSizeMetres\0double\0" + struct.pack("<i", 8)
     i = g.index(key) + len(key)

@@ -2,8 +2,10 @@
 //!
 //! Reading takes the single layer's channel named `Y` (OpenEXR's luminance,
 //! the usual name for greyscale data), or the only channel when there is
-//! one; any other layout is refused with the channel names listed, rather
-//! than guessing which of several channels holds heights. F16 channels are
+//! one, or `R` of an RGB(A) image — Houdini and other tools write heights
+//! into the red channel of a colour EXR (with a notice, [`RED_NOTE`]); any
+//! other layout is refused with the channel names listed, rather than
+//! guessing which of several channels holds heights. F16 channels are
 //! widened to f32 exactly; U32 channels are refused (heights are not counts,
 //! and large u32 values do not fit f32). The data window's position is
 //! ignored: the grid starts at its top-left sample.
@@ -46,7 +48,12 @@ pub(super) fn has_cell_size(bytes: &[u8]) -> bool {
         .any(|w| &w[..name.len()] == name && w[name.len()] == 0)
 }
 
-pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
+/// The notice of a height read from the `R` channel of an RGB(A) EXR.
+pub const RED_NOTE: &str =
+    "heights read from channel R of an RGB(A) EXR (as Houdini writes them); G, B and A are ignored";
+
+/// Decodes the height channel; the notice says when it was R of RGB(A).
+pub(super) fn decode(bytes: &[u8]) -> Result<(Heightfield, Option<&'static str>), FormatError> {
     if bytes.len() < MAGIC.len() || bytes[..MAGIC.len()] != MAGIC {
         return Err(FormatError::bad_magic("OpenEXR magic 76 2F 31 01", bytes));
     }
@@ -93,15 +100,22 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
         return Err(FormatError::not_justified(w, h, bytes.len()));
     }
 
+    // A colour image: channels R, G, B and maybe A, nothing else.
+    let rgb = channels.len() >= 3
+        && channels
+            .iter()
+            .all(|c| ["R", "G", "B", "A"].iter().any(|n| c.name.eq(n)));
+    let red = channels.iter().find(|c| c.name.eq("R")).filter(|_| rgb);
     let channel = match channels.iter().find(|c| c.name.eq("Y")) {
         Some(c) => c,
         None if channels.len() == 1 => &channels[0],
+        None if red.is_some() => red.expect("checked"),
         None => {
             let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
             return Err(FormatError::Unsupported {
                 what: "EXR channels",
                 found: names.join(", "),
-                supported: "a channel named Y, or exactly one channel",
+                supported: "a channel named Y, exactly one channel, or R of an RGB(A) image",
             });
         }
     };
@@ -152,7 +166,8 @@ pub(super) fn decode(bytes: &[u8]) -> Result<Heightfield, FormatError> {
             data.len()
         )));
     }
-    Ok(Heightfield::from_vec(w, h, cell, data)?)
+    let note = (red.is_some() && channel.name.eq("R")).then_some(RED_NOTE);
+    Ok((Heightfield::from_vec(w, h, cell, data)?, note))
 }
 
 /// The most a block can expand when decompressed, by codec.
@@ -366,7 +381,7 @@ mod tests {
             ours == crate_bytes(&hf),
             "compressible EXR differs from exr's"
         );
-        assert!(same_bits(&decode(&ours).unwrap(), &hf));
+        assert!(same_bits(&decode(&ours).unwrap().0, &hf));
     }
 
     #[test]
@@ -386,7 +401,7 @@ mod tests {
             theirs.len()
         );
         assert!(ours.len() < 300 * 70 * 4, "not compressed at all");
-        assert!(same_bits(&decode(&ours).unwrap(), &hf));
+        assert!(same_bits(&decode(&ours).unwrap().0, &hf));
     }
 
     #[test]
@@ -411,7 +426,7 @@ mod tests {
         })
         .unwrap();
         assert!(same_bits(
-            &decode(&encode(&hf).unwrap().bytes).unwrap(),
+            &decode(&encode(&hf).unwrap().bytes).unwrap().0,
             &hf
         ));
     }

@@ -41,7 +41,8 @@ pub const SQUARE_TOLERANCE: f64 = 0.01;
 pub struct GridReport {
     /// East–west and north–south spacing in metres as read, when known.
     pub native_spacing: Option<(f64, f64)>,
-    /// One-line notices (resampling, dropped placement).
+    /// One-line notices (resampling, dropped placement; the reader adds the
+    /// EXR channel read and a normalised 0..1 range).
     pub notes: Vec<String>,
 }
 

@@ -226,7 +226,8 @@ pub struct Loaded {
     pub heightfield: Heightfield,
     /// The cell size is the documented default (nothing in the file gave one).
     pub cell_size_default: bool,
-    /// Spacings as read and notices (resampling, dropped placement).
+    /// Spacings as read and notices (resampling, dropped placement, the
+    /// EXR channel read, a normalised 0..1 range).
     pub grid: GridReport,
 }
 
@@ -240,9 +241,14 @@ pub fn load_bytes(
 ) -> Result<Loaded, FormatError> {
     let sidecar = companions.sidecar.map(Sidecar::parse).transpose()?;
     let sc = sidecar.as_ref();
+    let mut notes = Vec::new();
     let mut hf = match format {
         Format::Png16 | Format::Png8 => png::decode(bytes, sc)?,
-        Format::Exr => exr::decode(bytes)?,
+        Format::Exr => {
+            let (hf, note) = exr::decode(bytes)?;
+            notes.extend(note.map(str::to_string));
+            hf
+        }
         Format::Tiff => tiff::decode(bytes, opts.band)?,
         Format::Hgt => hgt::decode(bytes)?,
         Format::Asc => asc::decode(bytes)?,
@@ -286,11 +292,26 @@ pub fn load_bytes(
             Format::Tiff => hf.cell_size() == DEFAULT_CELL_SIZE_M,
             Format::Hgt | Format::Asc | Format::Ter => false,
         };
-    let (heightfield, grid) = ground::square_cells(hf, opts.cell_size)?;
+    notes.extend(normalised_note(&hf));
+    let (heightfield, mut grid) = ground::square_cells(hf, opts.cell_size)?;
+    grid.notes.splice(0..0, notes);
     Ok(Loaded {
         heightfield,
         cell_size_default,
         grid,
+    })
+}
+
+/// A notice when every height lies within 0 … 1: heights normalised to that
+/// range (Gaea's "Raw" EXR, many image exports) are read as metres — a
+/// terrain under a metre high, which no exemplar resembles.
+fn normalised_note(hf: &Heightfield) -> Option<String> {
+    let s = hf.stats()?;
+    (s.min >= 0.0 && s.max <= 1.0 && s.max > s.min).then(|| {
+        format!(
+            "heights span only {:.3} .. {:.3}: a normalised 0..1 range? They are read as metres (a relief under 1 m); rescale them to metres first (e.g. gdal_translate -scale 0 1 LOW HIGH in out.tif, or a float export in metres)",
+            s.min, s.max
+        )
     })
 }
 
