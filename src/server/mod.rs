@@ -15,7 +15,7 @@
 //! are bounded; every bad request gets a 4xx JSON error naming the field.
 //! The server writes the scene file given with `--scene` (on Save,
 //! atomically) and, while a tab has unsaved changes, an autosave beside it
-//! that the next start offers to recover ([`autosave`]); exports are
+//! that the next start offers to recover (`autosave.rs`); exports are
 //! downloads.
 
 mod assets;
