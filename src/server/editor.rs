@@ -228,6 +228,13 @@ impl Handle {
             .clone()
     }
 
+    /// The last committed document, without marking the session used (the
+    /// autosave reads it, not the page).
+    pub fn committed(&self) -> Option<Value> {
+        let latest = self.latest.read().unwrap_or_else(|e| e.into_inner());
+        latest.as_ref().map(|l| l.committed.clone())
+    }
+
     /// Marks the session used now (idle sessions may be closed for others).
     pub fn touch(&self) {
         *self.last_used.lock().unwrap_or_else(|e| e.into_inner()) = Instant::now();

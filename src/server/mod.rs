@@ -13,10 +13,13 @@
 //! re-synthesizes only that, coherently. Loopback only; requests naming
 //! another host, or coming from another site, are refused; bodies
 //! are bounded; every bad request gets a 4xx JSON error naming the field.
-//! The only file the server writes is the scene file given with `--scene`
-//! (on Save, atomically); exports are downloads.
+//! The server writes the scene file given with `--scene` (on Save,
+//! atomically) and, while a tab has unsaved changes, an autosave beside it
+//! that the next start offers to recover (`autosave.rs`); exports are
+//! downloads.
 
 mod assets;
+mod autosave;
 mod doc;
 mod editor;
 mod error;
@@ -70,6 +73,11 @@ pub struct Config {
     /// A session whose page has not been heard from for this long (the
     /// page pings every quarter of it) gives its slot to another tab.
     pub idle: Duration,
+    /// How long after the last edit unsaved work is autosaved.
+    pub autosave_delay: Duration,
+    /// Where a server without `--scene` autosaves (the CLI: the user cache
+    /// dir); with `--scene`, the side file beside it. None: no autosave.
+    pub unsaved_autosave: Option<PathBuf>,
 }
 
 impl Default for Config {
@@ -83,6 +91,8 @@ impl Default for Config {
             max_sessions: 4,
             max_request_bytes: 16 << 20,
             idle: Duration::from_secs(8),
+            autosave_delay: Duration::from_secs(2),
+            unsaved_autosave: None,
         }
     }
 }
@@ -166,6 +176,8 @@ pub(crate) struct App {
     /// This run of the server: a page reloaded while it runs restores its
     /// unsaved document; after a restart the saved scene is loaded.
     instance: String,
+    /// None without `--scene` and [`Config::unsaved_autosave`].
+    autosave: Option<autosave::Autosave>,
 }
 
 /// The scene file's document as last saved, and how many saves it took.
@@ -180,6 +192,7 @@ pub struct Running {
     app: Arc<App>,
     shutdown: Option<tokio::sync::oneshot::Sender<()>>,
     thread: Option<std::thread::JoinHandle<()>>,
+    autosaver: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Running {
@@ -212,6 +225,13 @@ impl Running {
         if let Some(t) = self.thread.take() {
             let _ = t.join();
         }
+        // No edit comes any more: what is pending is written now.
+        if let Some(a) = &self.app.autosave {
+            a.stop();
+        }
+        if let Some(t) = self.autosaver.take() {
+            let _ = t.join();
+        }
         self.app.registry.close_all();
     }
 }
@@ -231,13 +251,17 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
     crate::size::check_dims(width, height)
         .map_err(|e| ServeError::Size(width, height, e.to_string()))?;
     let (mut app, source) = prepare(&config)?;
-    if let Some(scene) = &config.scene {
-        // Saves a killed server left half-written beside its scene file.
-        let n = crate::io::remove_orphans(scene);
+    // Saves and autosaves a killed server left half-written.
+    let written = config
+        .scene
+        .iter()
+        .chain(app.autosave.as_ref().map(|a| &a.path));
+    for file in written {
+        let n = crate::io::remove_orphans(file);
         if n > 0 {
             eprintln!(
                 "removed {n} temporary file(s) an interrupted save left beside {}",
-                scene.display()
+                file.display()
             );
         }
     }
@@ -259,6 +283,7 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
     ];
     let app = Arc::new(app);
     load_database(app.clone(), source);
+    let autosaver = autosave::spawn(app.clone()).map_err(ServeError::Runtime)?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -291,6 +316,7 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
         app,
         shutdown: Some(tx),
         thread: Some(thread),
+        autosaver: Some(autosaver),
     })
 }
 
@@ -385,6 +411,14 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
             _ => None,
         },
     };
+    let side = match &config.scene {
+        Some(p) => Some(autosave::side_file(p)),
+        None => config.unsaved_autosave.clone(),
+    };
+    let autosave = side.map(|side| {
+        let found = autosave::find(&side, config.scene.as_deref(), &initial);
+        autosave::Autosave::new(side, config.autosave_delay, found)
+    });
     let app = App {
         db: RwLock::new(DbState::Loading),
         progress: LoadProgress::default(),
@@ -400,6 +434,7 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
         hosts: Vec::new(),
         exemplar_previews: Mutex::new(Vec::new()),
         instance: registry::new_id(),
+        autosave,
     };
     Ok((app, source))
 }

@@ -1,6 +1,6 @@
 //! What comes out of a session besides frames: the preview and its tiles,
 //! sampled heights, exports (downloads in any writable format), the saved
-//! scene file (the only file the server writes), and exemplar previews.
+//! scene file, and exemplar previews.
 
 use super::App;
 use super::error::ApiError;
@@ -249,6 +249,9 @@ pub async fn save(
         .await
         .map_err(|e| ApiError::Internal(e.to_string()))?
         .map_err(|e| ApiError::Internal(format!("saving failed: {e}")))?;
+    if let Some(a) = &app.autosave {
+        a.saved();
+    }
     saved.doc = l.committed.clone();
     saved.revision += 1;
     h.set_base(saved.revision);

@@ -3,7 +3,7 @@
 //! | method, path | body → answer |
 //! |---|---|
 //! | `GET /`, `GET /assets/…` | the page (embedded) |
-//! | `GET /api/info` | database (types, exemplars, height range), loading progress, limits |
+//! | `GET /api/info` | database (types, exemplars, height range), loading progress, limits, `recovery` (unsaved work found at start: `{path, modified_ms}`, or null) |
 //! | `GET /api/exemplars/{i}/preview.png` | an exemplar's relief, for lassos on exemplars |
 //! | `POST /api/sessions` | none, or `{"scene": doc}` → first frame + `session` id |
 //! | `GET /api/sessions/{id}` | → the shown document (`scene`) and what its undo history holds (`history_bytes`, estimated) |
@@ -15,6 +15,8 @@
 //! | `GET /api/sessions/{id}/heights` | binary: u32 width, u32 height, u32 stride, then f32 metres (≤ 512² samples); header `x-revision` |
 //! | `GET /api/sessions/{id}/export?format=exr[&sidecar=true]` | a download (any writable format, or `preview`) |
 //! | `POST /api/sessions/{id}/save[?force=true]` | writes the `--scene` file → `{"path"}`; 409 when another tab saved after this session's document was loaded (unless forced) |
+//! | `POST /api/sessions/{id}/recovery?keep=true` | → frame + `scene`: the recovered document becomes the session's (an undo step, unsaved); 404 when no recovery is pending |
+//! | `POST /api/sessions/{id}/recovery?keep=false` | → `{"discarded": path}`: the autosave file is deleted |
 //! | `POST /api/sessions/{id}/ping`, `…/close` | the page's heartbeat (`info.sessions.heartbeat_ms`); free the slot (on page hide, by beacon) |
 //!
 //! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
@@ -60,6 +62,7 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/api/sessions/{id}/heights", get(output::heights))
         .route("/api/sessions/{id}/export", get(output::export))
         .route("/api/sessions/{id}/save", post(output::save))
+        .route("/api/sessions/{id}/recovery", post(recovery))
         .route("/api/sessions/{id}/ping", post(ping))
         .route("/api/sessions/{id}/close", post(close))
         .fallback(not_found)
@@ -183,6 +186,7 @@ async fn info(State(app): State<Arc<App>>) -> axum::Json<Value> {
         },
         "database": database,
         "scene_file": app.scene_file.as_ref().map(|p| p.display().to_string()),
+        "recovery": recovery_info(&app),
         // The page pings four times per idle time: a missed ping or two is
         // no reason to lose the slot.
         "sessions": {
@@ -193,6 +197,19 @@ async fn info(State(app): State<Arc<App>>) -> axum::Json<Value> {
         "max_request_bytes": app.max_request_bytes,
         "export_formats": Format::ALL.iter().filter(|f| f.can_write()).map(|f| f.name()).collect::<Vec<_>>(),
     }))
+}
+
+fn recovery_info(app: &App) -> Value {
+    let Some(a) = &app.autosave else {
+        return Value::Null;
+    };
+    match a.recovery() {
+        None => Value::Null,
+        Some(r) => json!({
+            "path": a.path.display().to_string(),
+            "modified_ms": r.modified.duration_since(std::time::UNIX_EPOCH).map(|d| d.as_millis() as u64).unwrap_or(0),
+        }),
+    }
 }
 
 fn database_info(app: &App, db: &Database) -> Value {
@@ -247,6 +264,8 @@ async fn create(
     let mut pending = app.registry.until_answered(&id);
     let mut frame = reply(rx).await?;
     pending.done = true;
+    // A tab reopening its unsaved document after a lost session.
+    changed(&app, &id);
     frame["session"] = json!(id);
     Ok(frame)
 }
@@ -279,20 +298,80 @@ async fn put_scene(
         ));
     }
     let (doc, scene) = app.policy.check(&body)?;
-    reply(h.submit(Task::Scene {
+    let frame = reply(h.submit(Task::Scene {
         doc,
         scene: Box::new(scene),
         commit,
     }))
-    .await
+    .await?;
+    if commit {
+        changed(&app, &id);
+    }
+    Ok(frame)
 }
 
 async fn undo(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
-    reply(app.registry.get(&id)?.submit(Task::Undo)).await
+    let frame = reply(app.registry.get(&id)?.submit(Task::Undo)).await?;
+    changed(&app, &id);
+    Ok(frame)
 }
 
 async fn redo(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
-    reply(app.registry.get(&id)?.submit(Task::Redo)).await
+    let frame = reply(app.registry.get(&id)?.submit(Task::Redo)).await?;
+    changed(&app, &id);
+    Ok(frame)
+}
+
+/// Session `id`'s committed document may have changed: the autosave
+/// thread writes it after its delay (never here, on the request path).
+fn changed(app: &App, id: &str) {
+    if let (Some(a), Ok(h)) = (&app.autosave, app.registry.get(id)) {
+        a.changed(&h);
+    }
+}
+
+/// `POST …/recovery?keep=true|false`: the artist's answer to the unsaved
+/// work found at start. Keep shows it in this session as an edit (so undo
+/// goes back to the saved scene and Save writes it); discard deletes it.
+async fn recovery(
+    State(app): State<Arc<App>>,
+    PathParam(id): PathParam,
+    RawQuery(raw): RawQuery,
+) -> Api {
+    let h = app.registry.get(&id)?;
+    let q = request::query(raw.as_deref(), &["keep"])?;
+    if request::param(&q, "keep").is_none() {
+        return Err(ApiError::malformed(
+            "keep",
+            "missing: expected true (keep the recovered work) or false (discard it)",
+        ));
+    }
+    let keep = request::flag(&q, "keep", false)?;
+    let none = || {
+        ApiError::NotFound("no unsaved work is waiting for recovery: it was kept or discarded already (in another tab?)".into())
+    };
+    let a = app.autosave.as_ref().ok_or_else(none)?;
+    let found = a.recovery().ok_or_else(none)?;
+    if !keep {
+        a.remove().map_err(|e| ApiError::Internal(e.to_string()))?;
+        a.resolved();
+        return Ok(axum::Json(
+            json!({"discarded": a.path.display().to_string()}),
+        ));
+    }
+    // A document that no longer checks (a hand-edited file, a changed
+    // database) is refused naming its field, and stays pending.
+    let scene = app.policy.check_value(&found.doc)?;
+    let mut frame = reply(h.submit(Task::Scene {
+        doc: found.doc.clone(),
+        scene: Box::new(scene),
+        commit: true,
+    }))
+    .await?;
+    a.resolved();
+    a.changed(&h);
+    frame["scene"] = found.doc;
+    Ok(frame)
 }
 
 async fn put_view(

@@ -122,6 +122,11 @@ export class Api {
     return (await check(res)).json();
   }
 
+  /** Keeps (→ a frame showing it) or discards the unsaved work found at start. */
+  async recovery(keep) {
+    return (await check(await fetch(this.url(`/recovery?keep=${keep}`), { method: 'POST' }))).json();
+  }
+
   /** Saves; `force` replaces a file another tab saved since this one loaded. */
   async save(force = false) {
     return (await check(await fetch(this.url(force ? '/save?force=true' : '/save'), { method: 'POST' }))).json();

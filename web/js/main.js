@@ -374,6 +374,34 @@ function wireBar() {
   });
 }
 
+/**
+ * Unsaved work the server autosaved before it stopped: a banner asks
+ * whether to keep it (this tab then shows it, unsaved) or discard it.
+ */
+function offerRecovery() {
+  const r = ed.info.recovery;
+  if (!r) return;
+  const banner = $('recovery');
+  $('recovery-text').textContent = `Unsaved work from ${new Date(r.modified_ms).toLocaleString()} was recovered (${r.path}).`;
+  const answer = async (keep) => {
+    await ed.api.idle();
+    try {
+      const frame = await ed.api.recovery(keep);
+      banner.hidden = true;
+      if (keep) {
+        ed.tools.cancel();
+        await showFrame(frame, { kind: 'recovery', t0: performance.now() });
+        ed.refresh();
+      }
+    } catch (e) {
+      ed.error(e);
+    }
+  };
+  $('recovery-keep').onclick = () => answer(true);
+  $('recovery-discard').onclick = () => answer(false);
+  banner.hidden = false;
+}
+
 async function boot() {
   const text = $('loading-text'), bar = $('loading-bar');
   for (;;) {
@@ -445,6 +473,7 @@ async function boot() {
   ed.map.fit();
   $('loading').hidden = true;
   ed.tools.select('select');
+  offerRecovery();
   // For tests and scripts: the page's state and coordinate mapping.
   ed.undo = () => undoRedo('undo');
   ed.redo = () => undoRedo('redo');

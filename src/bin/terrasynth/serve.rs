@@ -12,8 +12,10 @@ pub struct Args {
     /// Exemplar database (default: the scene's, else the embedded one).
     #[arg(long)]
     db: Option<PathBuf>,
-    /// Scene file: loaded at start when it exists, written by Save (the only
-    /// file the server writes). Without it, designs are downloaded.
+    /// Scene file: loaded at start when it exists, written by Save; unsaved
+    /// work is autosaved beside it (SCENE.autosave.json) and offered back at
+    /// the next start. Without it, designs are downloaded and unsaved work
+    /// is autosaved to the cache dir (TERRASYNTH_CACHE_DIR).
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Address to listen on: a loopback address (127.0.0.1 or [::1]) and a
@@ -36,10 +38,19 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
+    // Without a scene file, unsaved work is autosaved to the user cache
+    // dir (one file, shared by every scene-less server of this user).
+    let unsaved_autosave = match &a.scene {
+        None => {
+            Some(terrasynth::database::default::cache_dir().join("unsaved-scene.autosave.json"))
+        }
+        Some(_) => None,
+    };
     let config = Config {
         bind: a.bind,
         database: a.db.map(DbSource::File),
         scene: a.scene,
+        unsaved_autosave,
         size: a.size,
         seed: a.seed,
         max_sessions: a.max_sessions as usize,
