@@ -22,12 +22,13 @@
 mod common;
 
 use common::browser::{
-    click, drag, drag_screen, executables, in_chromium, js, revision, settled, shot, wait_for,
+    click, drag, drag_screen, executables, in_chromium, js, revision, screenshots, settled, shot,
+    wait_for,
 };
 use common::editor::{self, heights};
 use fantoccini::Client;
 use serde_json::{Value, json};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 use terrasynth::scene::Scene;
 use terrasynth::server::Running;
@@ -177,12 +178,7 @@ fn a_design_session_in_chromium() {
     let dir = tempfile::tempdir().unwrap();
     let scene_path = dir.path().join("design.json");
     let server = editor::serve(SIZE, Some(scene_path.clone()), 2);
-    let shots = std::env::var_os("TERRASYNTH_SCREENSHOTS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/editor-screenshots")
-        });
-    std::fs::create_dir_all(&shots).unwrap();
+    let shots = screenshots();
     let s = in_chromium(&browser, dir.path(), async |c| {
         design(c, &server, &shots).await
     });

@@ -15,13 +15,15 @@
 
 mod common;
 
-use common::browser::{click, drag, executables, in_chromium, js, revision, settled, wait_for};
+use common::browser::{
+    click, drag, executables, in_chromium, js, revision, screenshots, settled, wait_for,
+};
 use common::editor;
 use fantoccini::actions::{InputSource, KeyAction, KeyActions};
 use fantoccini::{Client, Locator};
 use image::RgbImage;
 use serde_json::json;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 /// Waits until the 3D view has drawn, after draw number `after`, the
@@ -113,12 +115,7 @@ fn the_3d_view_draws_relief_and_follows_edits() {
     let started = Instant::now();
     let dir = tempfile::tempdir().unwrap();
     let server = editor::serve(256, None, 2);
-    let shots = std::env::var_os("TERRASYNTH_SCREENSHOTS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/editor-screenshots")
-        });
-    std::fs::create_dir_all(&shots).unwrap();
+    let shots = screenshots();
     in_chromium(&browser, dir.path(), async |c| {
         c.goto(&server.url()).await.unwrap();
         settled(c, -1).await;

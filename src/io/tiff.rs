@@ -148,11 +148,13 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
         }
     };
     let n = w * h;
+    // Float32 samples compare with the nodata value in f32, as GDAL does.
+    let nodata32 = nodata.map(|v| v as f32);
     let data = if planar {
-        read_plane(&mut dec, band, samples, (w, h), &convert, nodata32(nodata))?
+        read_plane(&mut dec, band, samples, (w, h), &convert, nodata32)?
     } else {
         let image = dec.read_image().map_err(tiff_error)?;
-        heights(&image, (band, samples, n), &convert, nodata32(nodata))?
+        heights(&image, (band, samples, n), &convert, nodata32)?
     };
     if data.len() < n {
         return Err(FormatError::EndsEarly("TIFF image data"));
@@ -160,12 +162,6 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
     let mut hf = Heightfield::from_vec(w, h, cell, data)?;
     hf.set_georef(georef);
     Ok(hf)
-}
-
-/// The nodata value as Float32 samples compare with it (as GDAL does for
-/// Float32 bands).
-fn nodata32(nodata: Option<f64>) -> Option<f32> {
-    nodata.map(|v| v as f32)
 }
 
 /// Every `step`-th sample of `image` from `start`, `n` of them, as heights
@@ -241,15 +237,18 @@ fn read_plane(
         ));
     }
     let across = if tiled { w.div_ceil(cw) } else { 1 };
+    // Every sample of the band comes from a chunk: a file listing fewer
+    // chunks than cover the image is corrupt, not partly nodata.
+    let needed = across * h.div_ceil(ch);
+    if per_plane < needed {
+        return Err(FormatError::Corrupt(format!(
+            "TIFF band {} has {per_plane} chunks of {cw}x{ch}: too few to cover the {w}x{h} image",
+            band + 1
+        )));
+    }
     let mut out = vec![f32::NAN; w * h];
-    for i in 0..per_plane {
+    for i in 0..needed {
         let (x0, y0) = ((i % across) * cw, (i / across) * ch);
-        if x0 >= w || y0 >= h {
-            return Err(FormatError::Corrupt(format!(
-                "TIFF chunk {i} of band {} lies outside the {w}x{h} image",
-                band + 1
-            )));
-        }
         let index = (band * per_plane + i) as u32;
         // The decoded chunk is its data rectangle: edge tiles without their
         // padding, except that the decoder drops the bottom padding of the

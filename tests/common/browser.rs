@@ -11,6 +11,18 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// Where the browser tests put their screenshots (created):
+/// `$TERRASYNTH_SCREENSHOTS`, else `target/editor-screenshots/`.
+pub fn screenshots() -> PathBuf {
+    let dir = std::env::var_os("TERRASYNTH_SCREENSHOTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/editor-screenshots")
+        });
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// chromium and chromedriver, or why the caller should skip: a message,
 /// or a panic when `TERRASYNTH_REQUIRE_BROWSER` is set.
 pub fn executables() -> Option<(PathBuf, PathBuf)> {
