@@ -35,7 +35,7 @@ fn start(
 ) -> State {
     let pool = coarse::Pool::new(atlas, from);
     let src = coarse::Source { atlas, pool: &pool };
-    coarse::pieces(src, region, (l, side), seed, jitter)
+    coarse::pieces(src, region, (l, side), seed, jitter, None)
 }
 
 /// The level synthesis starts at, and the database's atlas there.

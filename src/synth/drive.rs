@@ -54,7 +54,7 @@ impl Synthesizer<'_> {
         // wall clock measures it; with one, stages queue back to back.
         let device_clock = b.has_device_clock();
         b.device_times()?; // forget times of earlier calls
-        let mut state = b.upload(self.initial(cone, start, seed))?;
+        let mut state = b.upload(self.initial(cone, start, seed, control))?;
         // The level above, kept through this level's correction: its
         // offsets anchor the height prior (`correct` module docs).
         let mut parent: Option<B::State> = None;

@@ -335,7 +335,13 @@ impl<'db> Synthesizer<'db> {
 
     /// The coarsest synthesized level `top` (see [`coarse`]) over the
     /// cone's top region.
-    fn initial(&self, cone: &Cone, start: Start, seed: u32) -> State {
+    fn initial(
+        &self,
+        cone: &Cone,
+        start: Start,
+        seed: u32,
+        control: Option<&Control<'_>>,
+    ) -> State {
         let (width, height) = cone.world();
         let (m, l) = (top_level(width, height), self.coarsest());
         let region = cone.region(cone.top());
@@ -356,7 +362,11 @@ impl<'db> Synthesizer<'db> {
                     }
                 };
                 let src = coarse::Source { atlas, pool };
-                coarse::pieces(src, region, (l, side), seed, self.jitter)
+                // Painted types choose the pieces they start from (issue 40).
+                let allowed = control
+                    .and_then(|c| c.guides.levels.get(l))
+                    .and_then(|g| g.allowed.as_deref());
+                coarse::pieces(src, region, (l, side), seed, self.jitter, allowed)
             }
             Start::Centre => {
                 let top = start.top(m, l);

@@ -1,10 +1,11 @@
 //! The pieces of the coarse start: where they lie, what they copy.
 
-use super::{Source, guide};
+use super::{Pool, Source, guide};
 use crate::database::layout::MARGIN;
 use crate::hash::{below, hash4};
 use crate::level::fixed::{Coord, FRAC_BITS};
 use crate::level::state::State;
+use crate::stages::common::ALL_TYPES;
 use crate::stages::upsample_jitter;
 use crate::synth::cone::Rect;
 use rayon::prelude::*;
@@ -31,14 +32,20 @@ const BAND_PER_MILLE: u32 = 20;
 /// the level's jitter (`jitter`, fixed point, the same hash as
 /// `upsample_jitter`) and offset V = 0 (its own altitude).
 ///
-/// A piece depends on the seed and its position alone, so any window of a
-/// world starts from the same pieces.
+/// Where `allowed` (the painted type sets of the region's pixels, level L)
+/// constrains a pixel, its piece is drawn the same way from the pool of
+/// those types' texels; a pixel's piece is thus a function of its own type
+/// set, not of its neighbours', so a painted edge cuts a piece in two.
+///
+/// A piece depends on the seed, its position and the pixel's type set
+/// alone, so any window of a world starts from the same pieces.
 pub fn pieces(
     src: Source<'_>,
     region: Rect,
     (l, side): (usize, i32),
     seed: u32,
     jitter: i32,
+    allowed: Option<&[u32]>,
 ) -> State {
     let (w, h) = (region.width(), region.height());
     // The pieces the region touches, and the texel each is centred on.
@@ -48,8 +55,6 @@ pub fn pieces(
         (piece(region.x1 - 1) - i0 + 1) as usize,
         (piece(region.y1 - 1) - j0 + 1) as usize,
     );
-    let n = src.pool.len();
-    let band = ((u64::from(n) * u64::from(BAND_PER_MILLE) / 1000) as u32).clamp(1, n);
     let centre_px = |i: i32| (i * side * 2 + side) << l >> 1;
     let places: Vec<(i32, i32)> = (0..ni * nj)
         .map(|k| {
@@ -57,16 +62,37 @@ pub fn pieces(
             (centre_px(i), centre_px(j))
         })
         .collect();
-    let centres: Vec<(i32, i32)> = guide::quantiles(seed, &places)
+    let quantiles = guide::quantiles(seed, &places);
+    // The pool of every type set painted in the region (the whole pool
+    // where a set has no texel at this level: type seeding then does what
+    // it can, as it did before).
+    let mut masks: Vec<u32> = allowed.map_or(Vec::new(), |a| {
+        a.iter().copied().filter(|&m| m != ALL_TYPES).collect()
+    });
+    masks.sort_unstable();
+    masks.dedup();
+    let typed: Vec<(u32, Pool)> = masks
+        .into_iter()
+        .map(|m| (m, src.pool.of_types(src.atlas, m)))
+        .filter(|(_, p)| !p.is_empty())
+        .collect();
+    let pool_of = |mask: u32| {
+        typed
+            .iter()
+            .find(|(m, _)| *m == mask)
+            .map_or(src.pool, |(_, p)| p)
+    };
+    let draw = |pool: &Pool, k: usize| {
+        draw(
+            pool,
+            quantiles[k],
+            seed,
+            (i0 + (k % ni) as i32, j0 + (k / ni) as i32),
+        )
+    };
+    let centres: Vec<(i32, i32)> = (0..ni * nj)
         .into_par_iter()
-        .enumerate()
-        .map(|(k, u)| {
-            let (i, j) = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
-            let target = ((u64::from(u) * u64::from(n - 1)) >> 16) as u32;
-            let lo = target.saturating_sub(band / 2).min(n - band);
-            src.pool
-                .at(lo + below(hash4(seed, SALT, i as u32, j as u32), band))
-        })
+        .map(|k| draw(src.pool, k))
         .collect();
     let st = State::new(w, h);
     (0..h).into_par_iter().for_each(|r| {
@@ -75,7 +101,11 @@ pub fn pieces(
         for c in 0..w {
             let x = (region.x0 + c) as i32;
             let i = x.div_euclid(side);
-            let (cx, cy) = centres[(j - j0) as usize * ni + (i - i0) as usize];
+            let k = (j - j0) as usize * ni + (i - i0) as usize;
+            let (cx, cy) = match allowed.map_or(ALL_TYPES, |a| a[r * w + c]) {
+                ALL_TYPES => centres[k],
+                mask => draw(pool_of(mask), k),
+            };
             let col = src.atlas.columns[cx as usize];
             let (x0, y0) = (col.min_x, MARGIN as i32);
             let (nx, ny) = (col.max_x - x0 + 1, col.max_y - y0 + 1);
@@ -90,6 +120,17 @@ pub fn pieces(
         }
     });
     st
+}
+
+/// The texel piece (i, j) copies from `pool`: drawn by a hash of the seed
+/// and (i, j) among the [`BAND_PER_MILLE`] of the pool around the guide's
+/// quantile `u` (in 1/2^16).
+fn draw(pool: &Pool, u: u32, seed: u32, (i, j): (i32, i32)) -> (i32, i32) {
+    let n = pool.len();
+    let band = ((u64::from(n) * u64::from(BAND_PER_MILLE) / 1000) as u32).clamp(1, n);
+    let target = ((u64::from(u) * u64::from(n - 1)) >> 16) as u32;
+    let lo = target.saturating_sub(band / 2).min(n - band);
+    pool.at(lo + below(hash4(seed, SALT, i as u32, j as u32), band))
 }
 
 /// Texel `t` of an axis of `n` interior texels, mirrored at both ends

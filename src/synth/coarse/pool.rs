@@ -77,6 +77,20 @@ impl Pool {
     pub fn at(&self, r: u32) -> (i32, i32) {
         self.ranked[r as usize]
     }
+
+    /// The texels of `self` whose terrain type (at the level of `a`) is in
+    /// the set `mask` (bit t = type t), in the same order: the pool of a
+    /// place painted with those types.
+    pub fn of_types(&self, a: &AtlasLevel<'_>, mask: u32) -> Pool {
+        Pool {
+            ranked: self
+                .ranked
+                .iter()
+                .copied()
+                .filter(|&(x, y)| mask >> a.level.types[a.index(x, y)] & 1 == 1)
+                .collect(),
+        }
+    }
 }
 
 /// A summed-area table of an `nx × ny` grid.
