@@ -19,7 +19,9 @@
 //! ([`Pool::of_types`]): correction sees types only at levels ≥ 2 and
 //! replaces an unfitting piece pixel by pixel, so a painted region started
 //! from the wrong landforms kept much of their relief (issue 40: a painted
-//! disc had its type's local relief on 0–61 % of its area; 67–83 % now).
+//! disc had its type's local relief on 0–61 % of its area; 73–84 % now,
+//! with the guide's rank pulled halfway to the median there, see
+//! `pieces.rs`).
 //!
 //! Why pieces smaller than the novelty measure's window (64 px, `eval
 //! novelty`): what a person recognises as a landform is its shape at that
