@@ -13,9 +13,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::path::Path;
 use terrasynth::io::{self, ReadOptions};
-use terrasynth::patch::costs::{FEATURE_TRANSFORMS, feature_cost};
+use terrasynth::patch::input::sketch::{Kind, Sketch};
 use terrasynth::patch::merge::{self, Canvas, Window};
-use terrasynth::patch::sketch::{Kind, Sketch};
+use terrasynth::patch::place::costs::{FEATURE_TRANSFORMS, feature_cost};
 use terrasynth::patch::{self, Library, Params, sketch_field, sketch_graph};
 use terrasynth::progress::Silent;
 

@@ -142,8 +142,8 @@ fn scene_session_matches_end_to_end() {
 #[test]
 fn sketch_synthesis_matches_end_to_end() {
     use terrasynth::backend::Choice;
-    use terrasynth::patch::fill_ssd::FillCost;
-    use terrasynth::patch::sketch::Sketch;
+    use terrasynth::patch::fill::fill_ssd::FillCost;
+    use terrasynth::patch::input::sketch::Sketch;
     use terrasynth::patch::{self, Library, Params};
     use terrasynth::progress::Silent;
     if common::gpu::context().is_none() {

@@ -4,8 +4,9 @@
 
 use std::path::Path;
 use terrasynth::Heightfield;
-use terrasynth::patch::sketch::Sketch;
-use terrasynth::patch::{self, Library, Params, cache};
+use terrasynth::patch::input::cache;
+use terrasynth::patch::input::sketch::Sketch;
+use terrasynth::patch::{self, Library, Params};
 use terrasynth::progress::Silent;
 
 mod common;

@@ -2,7 +2,7 @@
 //! against brute force on small constructed cases.
 
 use proptest::prelude::*;
-use terrasynth::patch::graphcut::{Label, min_cut};
+use terrasynth::patch::merge::graphcut::{Label, min_cut};
 
 /// Cost of a labelling: the sum of costs of neighbour pairs that differ.
 fn seam_cost(w: usize, h: usize, new: &[bool], ch: &[i64], cv: &[i64]) -> i64 {

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 use terrasynth::Heightfield;
-use terrasynth::patch::sketch::{Kind, Sketch, SketchError};
+use terrasynth::patch::input::sketch::{Kind, Sketch, SketchError};
 use terrasynth::patch::{self, Library, Params};
 use terrasynth::progress::Silent;
 
@@ -165,7 +165,7 @@ fn an_image_sketch_means_the_same_as_its_strokes() {
         assert!((a - b).abs() < 0.02, "{a} vs {b}");
     }
     // Ridge and valley masks of the image agree with the strokes' centres.
-    let ridge = terrasynth::patch::sketch::stroke_mask(&read, Kind::Ridge, 160, 160, 3.0);
+    let ridge = terrasynth::patch::input::sketch::stroke_mask(&read, Kind::Ridge, 160, 160, 3.0);
     assert!(ridge[90 * 160 + 80] && !ridge[5 * 160 + 5]);
     let e = Sketch::from_image(b"not a png", Path::new("x.png")).unwrap_err();
     assert!(e.to_string().contains("x.png"), "{e}");

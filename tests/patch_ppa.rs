@@ -3,9 +3,10 @@
 
 use proptest::prelude::*;
 use std::path::Path;
-use terrasynth::patch::graph::FeatureGraph;
-use terrasynth::patch::sketch::{Kind, Sketch, Stroke};
-use terrasynth::patch::{ppa, sketch_field, sketch_graph, sketch_ppa_params};
+use terrasynth::patch::input::graph::FeatureGraph;
+use terrasynth::patch::input::ppa;
+use terrasynth::patch::input::sketch::{Kind, Sketch, Stroke};
+use terrasynth::patch::{sketch_field, sketch_graph, sketch_ppa_params};
 
 const PATCH: usize = 64;
 

@@ -22,7 +22,7 @@ use std::path::Path;
 use terrasynth::Heightfield;
 use terrasynth::eval;
 use terrasynth::io::{self, ReadOptions};
-use terrasynth::patch::sketch::Sketch;
+use terrasynth::patch::input::sketch::Sketch;
 use terrasynth::patch::{self, Library, Params};
 use terrasynth::progress::Silent;
 

@@ -7,9 +7,9 @@
 //! cell is clamped.
 
 use proptest::prelude::*;
-use terrasynth::patch::candidates::{COARSE, PreparedSource};
-use terrasynth::patch::costs::ssd_dc;
-use terrasynth::patch::hole_fill::user_cells;
+use terrasynth::patch::fill::hole_fill::user_cells;
+use terrasynth::patch::place::candidates::{COARSE, PreparedSource};
+use terrasynth::patch::place::costs::ssd_dc;
 use terrasynth::stages::fill_ssd::{FILL_CLAMP, centre_cells};
 
 mod common;
@@ -47,7 +47,7 @@ proptest! {
         assert_agree(&variants::fill_ssd(&[user], &[mask], &cand, k), "one window");
     }
 
-    /// Centring leaves the DC-corrected SSD (`patch::costs::ssd_dc`, the
+    /// Centring leaves the DC-corrected SSD (`patch::place::costs::ssd_dc`, the
     /// unclamped definition) unchanged while no cell is clamped, on every
     /// variant.
     #[test]
@@ -73,7 +73,7 @@ proptest! {
 }
 
 /// The user's `m × m` cells permuted into every transform's frame, as
-/// `patch::hole_fill` builds them.
+/// `patch::fill::hole_fill` builds them.
 fn perms(cells: &[i32], valid: &[bool], m: usize) -> (Vec<Vec<i32>>, Vec<Vec<i32>>, i64) {
     user_cells(&mut cells.to_vec(), valid, m)
 }

@@ -2,7 +2,7 @@
 //! Source-feature cache entries: any bytes either decode or are refused
 //! (then rebuilt), never a panic; what decodes re-encodes to the same bytes.
 use libfuzzer_sys::fuzz_target;
-use terrasynth::patch::cache::{decode, encode};
+use terrasynth::patch::input::cache::{decode, encode};
 
 fuzz_target!(|data: &[u8]| {
     // The key the entry claims (bytes 8..16), so the fuzzer reaches the payload.

@@ -3,7 +3,7 @@
 //! that parses must rasterise.
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
-use terrasynth::patch::sketch::Sketch;
+use terrasynth::patch::input::sketch::Sketch;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(s) = Sketch::from_json(data, Path::new("fuzz")) {

@@ -2,14 +2,16 @@
 //! patches (round one, round two, merge), hands the rest to hole filling,
 //! and gives the result its broad shape and level.
 
-use super::control_point::{ACROSS, ALONG, UNIT};
-use super::costs::{FEATURE_TRANSFORMS as FEATURE_TRANSFORMS_COUNT, feature_cost};
+use super::fill::{fill_ssd, hole_fill};
+use super::input::control_point::{ACROSS, ALONG, UNIT};
+use super::input::graph;
+use super::input::sketch::{Kind, Sketch};
 use super::merge::{self, Canvas, Window};
-use super::sketch::{Kind, Sketch};
+use super::place::costs::{FEATURE_TRANSFORMS as FEATURE_TRANSFORMS_COUNT, feature_cost};
 use super::{
     Library, PatchError, Scored, Stats, Synthesis, Timings, deform_by_sketch, detrend,
-    feature_warp, fill_ssd, graph, hole_fill, remove_drift, round2_cost, sample_warped, select,
-    sketch_field, user_patches, user_window,
+    feature_warp, remove_drift, round2_cost, sample_warped, select, sketch_field, user_patches,
+    user_window,
 };
 use crate::Heightfield;
 use crate::poisson::SolveOptions;

@@ -31,37 +31,24 @@
 //! per-candidate results that are reduced in index order with ties broken
 //! by index, so the bytes do not depend on the thread count.
 
-pub mod cache;
-pub mod candidates;
-pub mod control_point;
-pub mod costs;
-pub mod fill_ssd;
-pub mod graph;
-pub mod graphcut;
-pub mod hole_fill;
+pub mod fill;
+pub mod input;
 pub mod merge;
-pub mod ppa;
-pub mod sketch;
+pub mod place;
 
-mod adherence;
-mod broad_shape;
 mod driver;
-mod library;
 mod params;
-mod placement;
 mod report;
-mod round2;
-mod warp;
 
-pub use adherence::adherence;
-pub use broad_shape::{deform_by_sketch, remove_drift};
 pub(crate) use driver::solve_opts;
 pub use driver::{synthesize, synthesize_with};
-pub use library::Library;
+pub use input::library::Library;
+pub use merge::broad_shape::{deform_by_sketch, remove_drift};
 pub use params::{Params, PatchError, Weights};
-pub use placement::{
+pub use place::placement::{
     UserPatch, sketch_field, sketch_graph, sketch_merge_len, sketch_ppa_params, user_patches,
 };
+pub(crate) use place::round2::{Scored, round2_cost, select, user_window};
+pub use place::warp::{detrend, feature_warp, sample_warped};
+pub use report::adherence::adherence;
 pub use report::{Stats, Synthesis, Timings};
-pub(crate) use round2::{Scored, round2_cost, select, user_window};
-pub use warp::{detrend, feature_warp, sample_warped};

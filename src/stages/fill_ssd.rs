@@ -4,7 +4,7 @@
 //! reduced grid. Integer throughout so that `kernels/fill_ssd.wgsl` gives
 //! the same table: [`fill_ssd_scalar`] is the oracle, [`fill_ssd`] its
 //! explicit-SIMD twin, [`fill_ssd_table`] the data-parallel loop over
-//! candidates. Where it runs (CPU or GPU) is `patch::fill_ssd::FillCost`.
+//! candidates. Where it runs (CPU or GPU) is `patch::fill::fill_ssd::FillCost`.
 
 use bytemuck::{Pod, Zeroable};
 

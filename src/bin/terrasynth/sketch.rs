@@ -6,7 +6,9 @@ use crate::args::{BackendArg, Input, parse_size};
 use crate::progress::Bar;
 use std::path::PathBuf;
 use terrasynth::io::{self, WriteOptions};
-use terrasynth::patch::{self, Library, Params, fill_ssd::FillCost, sketch::Sketch};
+use terrasynth::patch::fill::fill_ssd::FillCost;
+use terrasynth::patch::input::sketch::Sketch;
+use terrasynth::patch::{self, Library, Params};
 use terrasynth::render::{self, RenderOptions};
 
 const ABOUT: &str = "\

@@ -2,11 +2,11 @@
 //! blurred sketch field, PPA and the feature graphs on it, and the user
 //! patches placed breadth-first along the sketch's features.
 
-use super::broad_shape::box_blur;
-use super::candidates::{self, FeatureNode};
-use super::graph::FeatureGraph;
-use super::ppa;
-use super::sketch::{Kind, Sketch};
+use crate::patch::input::graph::FeatureGraph;
+use crate::patch::input::ppa;
+use crate::patch::input::sketch::{Kind, Sketch};
+use crate::patch::merge::broad_shape::box_blur;
+use crate::patch::place::candidates::{self, FeatureNode};
 
 /// A user patch: where, what kind, and its description on the sketch.
 #[derive(Debug, Clone)]

@@ -10,7 +10,7 @@
 //!   junction (a thick stroke's crossing yields two or three close ones),
 //!   and a new patch centre closer than patch/4 to a placed one is skipped.
 
-use super::ppa::Tree;
+use crate::patch::input::ppa::Tree;
 
 /// A polyline between two key nodes; `points` runs from `a`'s position to `b`'s.
 #[derive(Debug, Clone, PartialEq)]

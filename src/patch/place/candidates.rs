@@ -5,19 +5,19 @@
 //! grid of non-feature candidates with their noise statistics, and a
 //! 8×-reduced integer copy for the first round of hole-filling costs.
 //! Preparing is the expensive part (PPA on the whole DEM); it is done once
-//! per source and the value is kept by the caller — the [`super::Library`]
+//! per source and the value is kept by the caller — the [`crate::patch::Library`]
 //! caches it in memory for as many sketches as are synthesized with it
 //! (the bench and the CLI synthesize several sketches from one library),
 //! and, as seed 004 §5.4 does, the expensive part ([`Features`]) is kept
-//! on disk between processes by [`super::cache`] (about a second per 800²
+//! on disk between processes by [`crate::patch::input::cache`] (about a second per 800²
 //! source on 2 cores to compute, milliseconds to read).
 
-use super::Params;
-use super::control_point::{ACROSS, ALONG, Cp, TURN, UNIT};
-use super::costs::noise_levels;
-use super::graph::{FeatureGraph, dist, point_at};
-use super::ppa::{self, PpaParams};
-use super::sketch::Kind;
+use crate::patch::Params;
+use crate::patch::input::control_point::{ACROSS, ALONG, Cp, TURN, UNIT};
+use crate::patch::input::graph::{FeatureGraph, dist, point_at};
+use crate::patch::input::ppa::{self, PpaParams};
+use crate::patch::input::sketch::Kind;
+use crate::patch::place::costs::noise_levels;
 use crate::resample::bilinear;
 use crate::stages::fill_ssd::centre_cells;
 use rayon::prelude::*;
@@ -121,7 +121,7 @@ pub const COARSE: usize = 8;
 pub const FILL_TRANSFORMS: usize = 6;
 
 /// The part of a [`PreparedSource`] that is costly to compute and is
-/// cached on disk ([`super::cache`]).
+/// cached on disk ([`crate::patch::input::cache`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Features {
     pub ridges: Vec<FeatureNode>,
@@ -235,7 +235,7 @@ pub fn relief(v: &[f32]) -> f32 {
 
 impl PreparedSource {
     /// Extracts features and candidates from one DEM whose heights are
-    /// first multiplied by `scale` (see [`super::Library::prepare`]).
+    /// first multiplied by `scale` (see [`crate::patch::Library::prepare`]).
     pub fn prepare(
         name: &str,
         hf: &crate::Heightfield,
@@ -245,7 +245,7 @@ impl PreparedSource {
         Self::build(name, hf, params, scale, None)
     }
 
-    /// What [`super::cache`] stores: the expensive part of [`Self::prepare`]
+    /// What [`crate::patch::input::cache`] stores: the expensive part of [`Self::prepare`]
     /// (PPA on the whole DEM, candidate noise statistics).
     pub fn features(&self) -> Features {
         Features {

@@ -2,9 +2,9 @@
 //! warp onto a user patch, sampling the warped source, and the removal of
 //! the tilt every patch brings from its source.
 
-use super::candidates::{FeatureNode, PreparedSource};
-use super::costs::{Tps, transform_angle};
-use super::merge::Window;
+use crate::patch::merge::Window;
+use crate::patch::place::candidates::{FeatureNode, PreparedSource};
+use crate::patch::place::costs::{Tps, transform_angle};
 use crate::resample::bilinear;
 
 /// Builds the warp of a feature candidate onto a user patch: a TPS from
@@ -111,9 +111,9 @@ pub fn sample_warped(
 /// feature's broad shape is the sketch's to give ([`deform_by_sketch`]).
 /// Fill patches are not detrended: removing a patch's tilt reverses every
 /// channel that falls less steeply than it, which makes closed pits
-/// ([`super::hole_fill`] says how many).
+/// ([`crate::patch::fill::hole_fill`] says how many).
 ///
-/// [`deform_by_sketch`]: super::deform_by_sketch
+/// [`deform_by_sketch`]: crate::patch::deform_by_sketch
 pub fn detrend(patch: &mut [f32], n: usize) {
     let c = (n as f64 - 1.0) / 2.0;
     let (mut sx, mut sy, mut sxx) = (0.0f64, 0.0f64, 0.0f64);

@@ -5,8 +5,8 @@
 //! every source's candidate cells uploaded once per synthesis. Both give
 //! the same table, so the same terrain bytes.
 
-use super::{Library, PatchError};
 use crate::backend::Choice;
+use crate::patch::{Library, PatchError};
 use crate::stages::fill_ssd::fill_ssd_table;
 
 /// The backend of stage `fill_ssd`.
@@ -36,7 +36,7 @@ impl FillCost {
                     Err(e) => return Ok((FillCost::Cpu, Some(format!("{e}; using the CPU")))),
                 },
             };
-            let m = lib.params.patch / super::candidates::COARSE;
+            let m = lib.params.patch / crate::patch::place::candidates::COARSE;
             let sources = lib
                 .sources
                 .iter()

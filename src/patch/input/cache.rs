@@ -15,9 +15,9 @@
 //! concurrent reader never sees half a file). A cache that cannot be
 //! written only costs a rebuild next time.
 
-use super::candidates::{FeatureNode, Features, FillCand, PreparedSource};
-use super::control_point::{ACROSS, ALONG, Cp};
-use super::{Params, PatchError};
+use crate::patch::input::control_point::{ACROSS, ALONG, Cp};
+use crate::patch::place::candidates::{FeatureNode, Features, FillCand, PreparedSource};
+use crate::patch::{Params, PatchError};
 use std::path::{Path, PathBuf};
 
 /// Bump when the file layout changes.
@@ -28,17 +28,17 @@ const MAGIC: &[u8; 8] = b"TSPSRC\r\n";
 /// The source text of the code that computes [`Features`]: part of the
 /// key, so that a changed algorithm never reads an old entry.
 const CODE: [&str; 11] = [
-    include_str!("candidates.rs"),
+    include_str!("../place/candidates.rs"),
     include_str!("ppa.rs"),
     include_str!("graph.rs"),
     include_str!("control_point.rs"),
-    include_str!("costs.rs"),
+    include_str!("../place/costs.rs"),
     include_str!("cache.rs"),
-    include_str!("../nodata.rs"),
-    include_str!("../poisson/mod.rs"),
-    include_str!("../poisson/cascadic.rs"),
-    include_str!("../poisson/pcg.rs"),
-    include_str!("../poisson/multigrid.rs"),
+    include_str!("../../nodata.rs"),
+    include_str!("../../poisson/mod.rs"),
+    include_str!("../../poisson/cascadic.rs"),
+    include_str!("../../poisson/pcg.rs"),
+    include_str!("../../poisson/multigrid.rs"),
 ];
 
 /// FNV-1a, 64-bit: stable across platforms and Rust versions (unlike
@@ -113,8 +113,8 @@ pub fn prepare(
         let n = params.patch;
         let fits = |c: &FillCand| {
             let (x, y) = (c.x as usize, c.y as usize);
-            x % super::candidates::COARSE == 0
-                && y % super::candidates::COARSE == 0
+            x % crate::patch::place::candidates::COARSE == 0
+                && y % crate::patch::place::candidates::COARSE == 0
                 && x + n <= hf.width()
                 && y + n <= hf.height()
         };

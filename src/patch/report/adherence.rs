@@ -1,8 +1,8 @@
 //! Feature adherence (issue 7), a measure of a result against its sketch,
 //! not a stage of the synthesis.
 
-use super::sketch::{self, Kind, Sketch};
 use crate::Heightfield;
+use crate::patch::input::sketch::{self, Kind, Sketch};
 
 /// Feature adherence (issue 7): mean output height within `radius` of the
 /// sketched ridge strokes minus that near the valley strokes, divided by the

@@ -11,13 +11,13 @@
 //! (four 90° rotations and two mirrors, which need no resampling). Round
 //! one is integer and data-parallel: DC-corrected SSD against the window's
 //! fully filled 8×8 cells on the 8× reduced grid (stage `fill_ssd`, explicit
-//! SIMD or the GPU: [`super::fill_ssd`]), plus the noise-variance difference; the user window is permuted
+//! SIMD or the GPU: [`crate::patch::fill::fill_ssd`]), plus the noise-variance difference; the user window is permuted
 //! into each transform's frame once, and every candidate's cells are stored
 //! contiguously, so the kernel streams both. The best 5 per
-//! source go to round two and the graph-cut finalists ([`super::select`]).
+//! source go to round two and the graph-cut finalists ([`crate::patch::select`]).
 //!
 //! A fill patch enters as its source has it, tilt included (feature patches
-//! are detrended, [`super::detrend`]): round two's offset-free SSD then
+//! are detrended, [`crate::patch::detrend`]): round two's offset-free SSD then
 //! prefers patches whose slope continues the window's. Detrending them
 //! too turned every valley floor that falls less steeply than its patch's
 //! mean tilt into a chain of closed dimples: from the Pyrenees alone, the
@@ -28,13 +28,13 @@
 //! against the DEM 1.40 → 1.17 on average; from the 8 shared DEMs, 3.02 →
 //! 2.61 against the dominant source; feature adherence unchanged (0.515 →
 //! 0.519). The broad drift the kept tilts add is what
-//! [`super::remove_drift`] takes out.
+//! [`crate::patch::remove_drift`] takes out.
 
-use super::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
-use super::costs::noise_cost;
-use super::fill_ssd::FillCost;
-use super::merge::{self, Canvas, Window};
-use super::{
+use crate::patch::fill::fill_ssd::FillCost;
+use crate::patch::merge::{self, Canvas, Window};
+use crate::patch::place::candidates::{COARSE, FILL_TRANSFORMS, fill_map};
+use crate::patch::place::costs::noise_cost;
+use crate::patch::{
     Library, PatchError, Scored, Stats, Timings, round2_cost, select, solve_opts, user_window,
 };
 use crate::progress::Progress;

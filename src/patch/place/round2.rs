@@ -2,10 +2,10 @@
 //! patch against what the canvas already holds, and the choice of the
 //! winner among the finalists by their graph-cut seam cost.
 
-use super::costs::{self, noise_levels};
-use super::graphcut;
-use super::merge::{self, Canvas, Window};
-use super::{Params, Weights};
+use crate::patch::merge::graphcut;
+use crate::patch::merge::{self, Canvas, Window};
+use crate::patch::place::costs::{self, noise_levels};
+use crate::patch::{Params, Weights};
 use rayon::prelude::*;
 
 /// Second-round scoring shared by feature and fill candidates.

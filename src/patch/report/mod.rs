@@ -1,8 +1,10 @@
 //! What a finished synthesis hands back: the heightfield and sketch graphs
 //! ([`Synthesis`]) with the wall time per stage and the counts of the run.
 
-use super::graph::FeatureGraph;
+pub(crate) mod adherence;
+
 use crate::Heightfield;
+use crate::patch::input::graph::FeatureGraph;
 use std::time::Duration;
 
 /// Wall time per stage.
@@ -48,6 +50,6 @@ pub struct Synthesis {
     /// (row-major, an index into [`Library::sources`]), for measuring a
     /// result against the DEMs it is made of.
     ///
-    /// [`Library::sources`]: super::Library::sources
+    /// [`Library::sources`]: crate::patch::Library::sources
     pub sources: Vec<u32>,
 }

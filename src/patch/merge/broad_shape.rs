@@ -2,7 +2,7 @@
 //! merges add is removed and the sketch's broad shape added, both through
 //! a prefix-sum box blur.
 
-use super::candidates;
+use crate::patch::place::candidates;
 use rayon::prelude::*;
 
 /// The sketch's height profile deforms the merged terrain (seed 004 §4.1:
@@ -51,7 +51,7 @@ pub fn deform_by_sketch(
 /// tilt. Ridges and valleys are narrower than this scale and stay; the
 /// broad shape is the sketch's to give ([`deform_by_sketch`]).
 ///
-/// [`detrend`]: super::detrend
+/// [`detrend`]: crate::patch::detrend
 pub fn remove_drift(heights: &mut [f32], w: usize, h: usize, patch: usize) {
     let mut broad = heights.to_vec();
     for _ in 0..3 {
@@ -63,7 +63,7 @@ pub fn remove_drift(heights: &mut [f32], w: usize, h: usize, patch: usize) {
     }
 }
 
-pub(super) fn box_blur(v: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
+pub(crate) fn box_blur(v: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
     let pass = |src: &[f32], w: usize, h: usize| -> Vec<f32> {
         // Horizontal box of radius r with clamped ends, then transpose. Each
         // row's prefix sums (f64, so the differences stay exact enough) make

@@ -2,9 +2,10 @@
 //! relief and prepared once (features and candidates, optionally through
 //! the disk cache), then reused across sketches.
 
-use super::candidates::{self, PreparedSource};
-use super::{Params, PatchError, cache};
 use crate::Heightfield;
+use crate::patch::input::cache;
+use crate::patch::place::candidates::{self, PreparedSource};
+use crate::patch::{Params, PatchError};
 use crate::progress::Progress;
 use crate::resample::resample;
 use std::borrow::Cow;
@@ -18,8 +19,8 @@ pub struct Library {
     /// noise statistic ([`costs::noise_levels`], decimetres) of every
     /// source's non-feature candidates; see [`Weights::detail`].
     ///
-    /// [`costs::noise_levels`]: super::costs::noise_levels
-    /// [`Weights::detail`]: super::Weights::detail
+    /// [`costs::noise_levels`]: crate::patch::place::costs::noise_levels
+    /// [`Weights::detail`]: crate::patch::Weights::detail
     pub noise_ref: [u32; 3],
 }
 

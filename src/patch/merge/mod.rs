@@ -1,5 +1,5 @@
 //! Merging a chosen patch into the output (seed 004 §4.3; seed 001 §5):
-//! 1. a graph-cut seam over the window ([`super::graphcut`]), on the patch
+//! 1. a graph-cut seam over the window ([`crate::patch::merge::graphcut`]), on the patch
 //!    shifted by its mean difference to the overlap (the gradient-domain
 //!    merge removes that offset anyway, so it must not drive the seam);
 //! 2. Shepard interpolation of the gradient mismatch along the seam into
@@ -10,8 +10,11 @@
 //!    Dirichlet values (the crate's multigrid-preconditioned solver for
 //!    small grids, [`crate::poisson::Method::Multigrid`], started from the patch).
 
-use super::graphcut::{Label, Seam, kwatra, min_cut};
+pub(crate) mod broad_shape;
+pub mod graphcut;
+
 use crate::blend::gradient_domain::guided_rhs;
+use crate::patch::merge::graphcut::{Label, Seam, kwatra, min_cut};
 use crate::poisson::{Method, SolveOptions, SolveReport, solve};
 
 /// The output being synthesized.
@@ -23,7 +26,7 @@ pub struct Canvas {
     pub filled: Vec<bool>,
     /// Which source each filled pixel came from (index into the library's
     /// sources; [`Canvas::NO_SOURCE`] where nothing is placed): the
-    /// coherence cost of round two reads it ([`super::Weights::coherence`]).
+    /// coherence cost of round two reads it ([`crate::patch::Weights::coherence`]).
     pub source: Vec<u32>,
 }
 

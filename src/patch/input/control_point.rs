@@ -1,5 +1,5 @@
 //! A feature node's control point ([`Cp`]) and the units of its angle and
-//! profiles: what [`super::candidates`] extracts and [`super::costs`]
+//! profiles: what [`crate::patch::place::candidates`] extracts and [`crate::patch::place::costs`]
 //! compares. It is its own module so that neither of those two depends on
 //! the other for these definitions.
 

@@ -8,7 +8,7 @@
 //! hole-filling SSD of round one is the data-parallel stage `fill_ssd`
 //! (`stages::fill_ssd`, mirrored in WGSL).
 
-use super::control_point::{ACROSS, ALONG, Cp};
+use crate::patch::input::control_point::{ACROSS, ALONG, Cp};
 
 /// The 10 feature transforms of seed 004 §4.2: rotations by `k·45°`
 /// (k = 0..8), then mirror in x (`x → −x`) and mirror in y (`y → −y`).
@@ -134,7 +134,7 @@ pub fn noise_levels(n: usize, vals: &[i32], valid: &[bool]) -> [u32; 3] {
 /// Noise cost: `Σ_l (σ_u,l − σ_c,l)²` (dm²). Seed 004 Listing 6.3 takes a
 /// square root and a scale whose glyphs were lost; we keep the squared form
 /// so it adds to the SSD in the same units (both are mean squares of
-/// height differences), and weight it in [`super::Params`].
+/// height differences), and weight it in [`crate::patch::Params`].
 pub fn noise_cost(u: &[u32; 3], c: &[u32; 3]) -> u64 {
     u.iter()
         .zip(c)
