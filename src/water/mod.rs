@@ -124,14 +124,19 @@ pub struct Timings {
     pub fill: Duration,
     pub flats: Duration,
     pub d8: Duration,
+    /// Accumulation and lakes run side by side (each is one sequential
+    /// walk, and neither needs the other): each one's own time.
     pub accumulate: Duration,
     pub lakes: Duration,
     pub rivers: Duration,
+    /// The whole of [`compute`]: less than the stages' sum.
+    pub wall: Duration,
 }
 
 impl Timings {
+    /// The wall time of the whole computation.
     pub fn total(&self) -> Duration {
-        self.fill + self.flats + self.d8 + self.accumulate + self.lakes + self.rivers
+        self.wall
     }
 }
 
@@ -218,6 +223,13 @@ fn threshold_cells(area_km2: f64, cell_size: f64) -> u32 {
         .clamp(1.0, u32::MAX as f64) as u32
 }
 
+/// `f`'s result and how long it took.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
+    let clock = Instant::now();
+    let v = f();
+    (v, clock.elapsed())
+}
+
 /// Computes the water of a heightfield. Refuses nodata, invalid
 /// parameters, and grids whose working memory exceeds what is available.
 pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
@@ -229,38 +241,49 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
         BYTES_PER_CELL * (w * h) as u64,
     )?;
     let data = hf.data();
-    let mut t = Timings::default();
-    let mut clock = Instant::now();
-    let mut lap = |d: &mut Duration| {
-        let now = Instant::now();
-        *d = now - clock;
-        clock = now;
-    };
-    let sea = params.sea_level.map(|l| sea::mask(data, w, h, l));
+    let start = Instant::now();
+    let (filled, fill_time) = timed(|| {
+        let sea = params.sea_level.map(|l| sea::mask(data, w, h, l));
+        let filled = fill::priority_flood(data, w, h, sea.as_deref().zip(params.sea_level));
+        (filled, sea)
+    });
+    let (filled, sea) = filled;
     let sea = sea.as_deref();
-    let filled = fill::priority_flood(data, w, h, sea.zip(params.sea_level));
-    lap(&mut t.fill);
-    let grad = flats::gradient(&filled, w, h, sea);
-    lap(&mut t.flats);
-    let receivers = d8::receivers(
-        &surface(&filled, w, h, grad.as_deref(), sea),
-        d8::Edges::Inside,
-    );
+    let (grad, flats_time) = timed(|| flats::gradient(&filled, w, h, sea));
+    let (receivers, d8_time) = timed(|| {
+        d8::receivers(
+            &surface(&filled, w, h, grad.as_deref(), sea),
+            d8::Edges::Inside,
+        )
+    });
     drop(grad);
-    lap(&mut t.d8);
-    let accumulation = d8::accumulate(&receivers);
-    lap(&mut t.accumulate);
-    let bodies = lakes::find(data, &filled, (w, h, cell), sea, params.lakes);
-    let filled_cells = filled
-        .iter()
-        .zip(data)
-        .zip(&bodies.class)
-        .filter(|((f, z), c)| f > z && **c != lakes::SEA)
-        .count();
-    lap(&mut t.lakes);
+    let ((accumulation, accumulate_time), ((bodies, filled_cells), lakes_time)) = rayon::join(
+        || timed(|| d8::accumulate(&receivers)),
+        || {
+            timed(|| {
+                let bodies = lakes::find(data, &filled, (w, h, cell), sea, params.lakes);
+                let filled_cells = filled
+                    .iter()
+                    .zip(data)
+                    .zip(&bodies.class)
+                    .filter(|((f, z), c)| f > z && **c != lakes::SEA)
+                    .count();
+                (bodies, filled_cells)
+            })
+        },
+    );
     let threshold = threshold_cells(params.river_area_km2, cell);
-    let rivers = rivers::trace(&receivers, &accumulation, &bodies.class, threshold);
-    lap(&mut t.rivers);
+    let (rivers, rivers_time) =
+        timed(|| rivers::trace(&receivers, &accumulation, &bodies.class, threshold));
+    let t = Timings {
+        fill: fill_time,
+        flats: flats_time,
+        d8: d8_time,
+        accumulate: accumulate_time,
+        lakes: lakes_time,
+        rivers: rivers_time,
+        wall: start.elapsed(),
+    };
     Ok(Water {
         width: w,
         height: h,
