@@ -26,7 +26,9 @@ fn terrain(w: usize, h: usize) -> Vec<f32> {
             let z = 60.0 * (x / 41.0).sin() * (y / 29.0).cos()
                 + 20.0 * (y / 97.0).sin()
                 + 8.0 * noise(i, 1);
-            (z * 2.0).round() / 2.0
+            // + 0.0: no -0.0, which both floods raise to a 0.0 level (its
+            // bits change) where this reference's `<` leaves it.
+            (z * 2.0).round() / 2.0 + 0.0
         })
         .collect()
 }

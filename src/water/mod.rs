@@ -26,6 +26,7 @@ pub mod fill;
 pub mod flats;
 pub mod geojson;
 pub mod lakes;
+pub mod mfd;
 pub mod preview;
 pub mod rivers;
 pub mod sea;
@@ -113,6 +114,17 @@ impl Params {
     }
 }
 
+/// How `flow.tif`'s accumulation is routed ([`compute_with`]). Rivers,
+/// their Strahler orders and [`Water::receivers`] are D8 whichever it is.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Routing {
+    /// All of a cell's flow to its steepest neighbour ([`d8`]).
+    #[default]
+    D8,
+    /// Shared among its lower neighbours by slope ([`mfd`]).
+    Mfd,
+}
+
 /// Bytes per cell [`compute`] holds at its peak (heights excluded): the
 /// filled surface, receivers, accumulation, the flats' gradient, labels
 /// and classes, depths, and the rivers' orders.
@@ -152,8 +164,10 @@ pub struct Water {
     pub filled: Vec<f32>,
     /// D8 receiver of every cell on the filled surface, or [`d8::OUTLET`].
     pub receivers: Vec<u32>,
-    /// Upstream area of every cell, in cells (itself included).
+    /// D8 upstream area of every cell, in cells (itself included).
     pub accumulation: Vec<u32>,
+    /// MFD upstream area of every cell in cells, with [`Routing::Mfd`].
+    pub mfd_accumulation: Option<Vec<f32>>,
     /// Lakes, sea and water depth.
     pub bodies: lakes::Bodies,
     pub rivers: rivers::Rivers,
@@ -230,15 +244,30 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
     (v, clock.elapsed())
 }
 
-/// Computes the water of a heightfield. Refuses nodata, invalid
-/// parameters, and grids whose working memory exceeds what is available.
+/// Computes the water of a heightfield with D8 routing. Refuses nodata,
+/// invalid parameters, and grids whose working memory exceeds what is
+/// available.
 pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
+    compute_with(hf, params, Routing::D8)
+}
+
+/// [`compute`], with the accumulation also routed by `routing`
+/// ([`Water::mfd_accumulation`]).
+pub fn compute_with(
+    hf: &Heightfield,
+    params: &Params,
+    routing: Routing,
+) -> Result<Water, WaterError> {
     params.check()?;
     check_heights(hf)?;
     let (w, h, cell) = (hf.width(), hf.height(), hf.cell_size());
+    let per_cell = match routing {
+        Routing::D8 => BYTES_PER_CELL,
+        Routing::Mfd => BYTES_PER_CELL + mfd::BYTES_PER_CELL,
+    };
     crate::io::check_memory(
         &format!("water on a {w}x{h} heightfield"),
-        BYTES_PER_CELL * (w * h) as u64,
+        per_cell * (w * h) as u64,
     )?;
     let data = hf.data();
     let start = Instant::now();
@@ -250,12 +279,11 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
     let (filled, sea) = filled;
     let sea = sea.as_deref();
     let (grad, flats_time) = timed(|| flats::gradient(&filled, w, h, sea));
-    let (receivers, d8_time) = timed(|| {
-        d8::receivers(
-            &surface(&filled, w, h, grad.as_deref(), sea),
-            d8::Edges::Inside,
-        )
-    });
+    let routed = surface(&filled, w, h, grad.as_deref(), sea);
+    let (receivers, d8_time) = timed(|| d8::receivers(&routed, d8::Edges::Inside));
+    // MFD's time counts as accumulation's.
+    let (mfd_accumulation, mfd_time) =
+        timed(|| (routing == Routing::Mfd).then(|| mfd::accumulate(&routed)));
     drop(grad);
     let ((accumulation, accumulate_time), ((bodies, filled_cells), lakes_time)) = rayon::join(
         || timed(|| d8::accumulate(&receivers)),
@@ -279,7 +307,7 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
         fill: fill_time,
         flats: flats_time,
         d8: d8_time,
-        accumulate: accumulate_time,
+        accumulate: accumulate_time + mfd_time,
         lakes: lakes_time,
         rivers: rivers_time,
         wall: start.elapsed(),
@@ -292,6 +320,7 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
         filled,
         receivers,
         accumulation,
+        mfd_accumulation,
         bodies,
         rivers,
         filled_cells,
@@ -300,6 +329,15 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
 }
 
 impl Water {
+    /// What `flow.tif` holds: the MFD accumulation when it was asked for,
+    /// else D8's, in cells.
+    pub fn flow(&self) -> Vec<f32> {
+        match &self.mfd_accumulation {
+            Some(m) => m.clone(),
+            None => self.accumulation.iter().map(|&a| a as f32).collect(),
+        }
+    }
+
     /// The rivers' threshold in cells.
     pub fn river_threshold_cells(&self) -> u32 {
         threshold_cells(self.params.river_area_km2, self.cell_size)
