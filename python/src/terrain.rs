@@ -66,13 +66,14 @@ pub fn water<'py>(
         })
         .map_err(err)?;
     let shape = (w.height, w.width);
+    let flow = w.flow();
     let out = PyDict::new(py);
     fn grid<T>(shape: (usize, usize), v: Vec<T>) -> Array2<T> {
         Array2::from_shape_vec(shape, v).expect("one value per cell")
     }
     out.set_item("filled", grid(shape, w.filled).into_pyarray(py))?;
     out.set_item("depth", grid(shape, w.bodies.depth).into_pyarray(py))?;
-    out.set_item("flow", grid(shape, w.flow()).into_pyarray(py))?;
+    out.set_item("flow", grid(shape, flow).into_pyarray(py))?;
     out.set_item("accumulation", grid(shape, w.accumulation).into_pyarray(py))?;
     let receivers: Vec<i64> = w
         .receivers

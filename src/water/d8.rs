@@ -118,17 +118,16 @@ fn steepest(s: &Surface<'_>, i: usize, around: [Option<usize>; 8]) -> u32 {
 fn steepest_inside(s: &Surface<'_>, i: usize, offsets: [isize; 8]) -> u32 {
     let z = s.heights[i] as f64;
     let around = offsets.map(|o| i.wrapping_add_signed(o));
-    let mut dz = [0.0f64; 8];
-    for j in 0..8 {
+    let dz: [f64; 8] = std::array::from_fn(|j| {
         let d = z - s.heights[around[j]] as f64;
         // A cardinal's distance is 1: the division would change nothing.
-        dz[j] = if j % 2 == 0 { d } else { d / CLOCKWISE[j].2 };
-    }
+        if j % 2 == 0 { d } else { d / CLOCKWISE[j].2 }
+    });
     let top = dz.iter().fold(0.0f64, |m, &v| if v > m { v } else { m });
     let mut ties = 0;
     let mut first = 0;
-    for j in (0..8).rev() {
-        let eq = dz[j] == top;
+    for (j, &v) in dz.iter().enumerate().rev() {
+        let eq = v == top;
         ties += eq as u32;
         first = if eq { j } else { first };
     }
@@ -140,10 +139,10 @@ fn steepest_inside(s: &Surface<'_>, i: usize, offsets: [isize; 8]) -> u32 {
     let grad = |i: usize| s.gradient.map_or(0.0, |g| g[i] as f64);
     let g = grad(i);
     let (mut best_dg, mut best) = (f64::NEG_INFINITY, 0);
-    for j in 0..8 {
-        let d = g - grad(around[j]);
+    for (j, (&k, &v)) in around.iter().zip(&dz).enumerate() {
+        let d = g - grad(k);
         let dg = if j % 2 == 0 { d } else { d / CLOCKWISE[j].2 };
-        let dg = if dz[j] == top { dg } else { f64::NEG_INFINITY };
+        let dg = if v == top { dg } else { f64::NEG_INFINITY };
         if dg > best_dg {
             (best_dg, best) = (dg, j);
         }

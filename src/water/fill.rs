@@ -234,8 +234,10 @@ fn solve(
         start[a as usize + 1] += 1;
         start[b as usize + 1] += 1;
     }
-    for i in 0..nodes {
-        start[i + 1] += start[i];
+    let mut sum = 0;
+    for v in start.iter_mut() {
+        sum += *v;
+        *v = sum;
     }
     let mut next = start.clone();
     let mut adj = vec![(0u32, 0.0f32); 2 * edges.len()];

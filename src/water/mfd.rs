@@ -23,8 +23,8 @@ use crate::procedural::grid::neighbour;
 use rayon::prelude::*;
 
 /// Bytes per cell [`accumulate`] holds beyond D8's (receiver bits, donor
-/// counts, the f64 sums and the f32 result).
-pub const BYTES_PER_CELL: u64 = 14;
+/// counts, the f64 sums, at most every cell waiting, the f32 result).
+pub const BYTES_PER_CELL: u64 = 18;
 
 /// The neighbours of cell `i` of a `w × h` grid, clockwise from north,
 /// `None` off the grid.
@@ -88,8 +88,12 @@ pub fn accumulate(s: &Surface<'_>) -> Vec<f32> {
         }
     }
     let mut acc = vec![1.0f64; n];
-    let mut ready: Vec<usize> = (0..n).rev().filter(|&i| pending[i] == 0).collect();
+    let mut ready: Vec<u32> = (0..n as u32)
+        .rev()
+        .filter(|&i| pending[i as usize] == 0)
+        .collect();
     while let Some(c) = ready.pop() {
+        let c = c as usize;
         if sends[c] == 0 {
             continue;
         }
@@ -101,7 +105,7 @@ pub fn accumulate(s: &Surface<'_>) -> Vec<f32> {
                 acc[k] += a * (wt[j] / total);
                 pending[k] -= 1;
                 if pending[k] == 0 {
-                    ready.push(k);
+                    ready.push(k as u32);
                 }
             }
         }

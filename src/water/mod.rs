@@ -7,11 +7,11 @@
 //! ```
 //!
 //! Every stage is exact and deterministic (no floating-point sums decide
-//! anything; the fill copies heights), so the same input gives the same
-//! rasters on any thread count. The whole chain is O(n) but for the fill's
-//! queue, which is a radix heap ([`fill`]); a 4096² synthesis took 5.3 s
-//! on this project's shared two cores, half of it the sequential fill
-//! (README, `water`).
+//! anything; the fill copies heights; the optional MFD accumulation adds
+//! in one fixed order), so the same input gives the same rasters on any
+//! thread count. The whole chain is O(n) but for the fill's queues, radix
+//! heaps ([`fill`]). The fill runs in strips side by side, accumulation
+//! beside lakes: see the README's `water` section for the times.
 //!
 //! [`tiled`] computes the same rasters on a world cut into tiles, bit for
 //! bit, holding a few tiles at a time (`terrasynth tiles --water`).
