@@ -15,16 +15,20 @@ use pyo3::types::PyDict;
 /// ``cell_size`` in metres. ``sea_level``: cells joined to the border at or
 /// below it are sea. A filled depression is a lake when at least
 /// ``lake_min_depth`` metres deep and ``lake_min_area_km2`` large; rivers
-/// drain at least ``river_area_km2``.
+/// drain at least ``river_area_km2``. ``routing``: ``"d8"`` or ``"mfd"``
+/// (flow shared among lower neighbours by slope), for ``flow``; rivers
+/// follow D8 either way.
 ///
 /// Returns a dict of (rows, columns) arrays — ``filled`` (float32: the
 /// water surface), ``depth`` (float32: lake and sea water depth),
-/// ``accumulation`` (uint32: D8 upstream area in cells), ``receivers``
+/// ``accumulation`` (uint32: D8 upstream area in cells), ``flow``
+/// (float32: upstream area in cells routed by ``routing``, what
+/// ``flow.tif`` holds), ``receivers``
 /// (int64: the flat index each cell drains to, -1 at outlets), ``rivers``
 /// (uint8: Strahler order of river cells) — and ``summary`` (the dict
 /// ``terrasynth water --json`` prints).
 #[pyfunction]
-#[pyo3(signature = (heights, cell_size, *, sea_level=None, river_area_km2=5.0, lake_min_depth=2.0, lake_min_area_km2=0.1))]
+#[pyo3(signature = (heights, cell_size, *, sea_level=None, river_area_km2=5.0, lake_min_depth=2.0, lake_min_area_km2=0.1, routing="d8"))]
 pub fn water<'py>(
     py: Python<'py>,
     heights: &Bound<'py, PyAny>,
@@ -33,8 +37,18 @@ pub fn water<'py>(
     river_area_km2: f64,
     lake_min_depth: f64,
     lake_min_area_km2: f64,
+    routing: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use terrasynth::water::{self, Params, Thresholds};
+    use terrasynth::water::{self, Params, Routing, Thresholds};
+    let routing = match routing {
+        "d8" => Routing::D8,
+        "mfd" => Routing::Mfd,
+        other => {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "routing {other:?} is invalid: expected \"d8\" or \"mfd\""
+            )));
+        }
+    };
     let hf = heightfield(heights, cell_size, "heights")?;
     let params = Params {
         sea_level,
@@ -46,18 +60,20 @@ pub fn water<'py>(
     };
     let (w, summary) = py
         .allow_threads(|| -> Result<_, String> {
-            let w = water::compute(&hf, &params).map_err(|e| e.to_string())?;
+            let w = water::compute_with(&hf, &params, routing).map_err(|e| e.to_string())?;
             let s = serde_json::to_string(&w.summary()).map_err(|e| e.to_string())?;
             Ok((w, s))
         })
         .map_err(err)?;
     let shape = (w.height, w.width);
+    let flow = w.flow();
     let out = PyDict::new(py);
     fn grid<T>(shape: (usize, usize), v: Vec<T>) -> Array2<T> {
         Array2::from_shape_vec(shape, v).expect("one value per cell")
     }
     out.set_item("filled", grid(shape, w.filled).into_pyarray(py))?;
     out.set_item("depth", grid(shape, w.bodies.depth).into_pyarray(py))?;
+    out.set_item("flow", grid(shape, flow).into_pyarray(py))?;
     out.set_item("accumulation", grid(shape, w.accumulation).into_pyarray(py))?;
     let receivers: Vec<i64> = w
         .receivers

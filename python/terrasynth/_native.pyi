@@ -96,8 +96,9 @@ def water(
     river_area_km2: float = 5.0,
     lake_min_depth: float = 2.0,
     lake_min_area_km2: float = 0.1,
+    routing: str = "d8",
 ) -> Dict[str, Any]:
-    """`terrasynth water`: filled, depth, accumulation, receivers, rivers (arrays) and summary."""
+    """`terrasynth water`: filled, depth, accumulation, flow (routed by `routing`: "d8" or "mfd"), receivers, rivers (arrays) and summary."""
 
 def erode(
     heights: Union[npt.NDArray[np.float32], npt.NDArray[np.float64]],

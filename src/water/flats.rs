@@ -28,6 +28,9 @@ pub(super) const FLAT: u8 = 1;
 pub(super) const DRAINS: u8 = 2;
 pub(super) const HIGHER: u8 = 4;
 
+/// What the sweeps' arrays hold outside the flats.
+const NOT_FLAT: u32 = u32::MAX;
+
 /// A filled surface with its cells classified.
 struct Grid<'a> {
     filled: &'a [f32],
@@ -39,8 +42,20 @@ struct Grid<'a> {
 }
 
 impl Grid<'_> {
-    fn is_flat(&self, k: usize) -> bool {
-        self.class[k] & FLAT != 0
+    /// A sweep's array: 0 on flat cells (not reached yet), [`NOT_FLAT`]
+    /// elsewhere, so a sweep reads one array per neighbour, not two.
+    fn sweep_array(&self) -> Vec<u32> {
+        let mut v = vec![0u32; self.class.len()];
+        v.par_chunks_mut(self.w)
+            .zip(self.class.par_chunks(self.w))
+            .for_each(|(v, c)| {
+                for (v, c) in v.iter_mut().zip(c) {
+                    if c & FLAT == 0 {
+                        *v = NOT_FLAT;
+                    }
+                }
+            });
+        v
     }
 
     /// The neighbours of an interior cell.
@@ -52,7 +67,7 @@ impl Grid<'_> {
     /// height, or the higher one would have a lower neighbour), and their
     /// count.
     fn label(&self, flats: &[u32]) -> (Vec<u32>, u32) {
-        let mut label = vec![0u32; self.class.len()];
+        let mut label = self.sweep_array();
         let mut labels = 0u32;
         let mut stack = Vec::new();
         for &f in flats {
@@ -64,7 +79,7 @@ impl Grid<'_> {
             stack.push(f as usize);
             while let Some(c) = stack.pop() {
                 for k in self.around(c) {
-                    if self.is_flat(k) && label[k] == 0 {
+                    if label[k] == 0 {
                         label[k] = labels;
                         stack.push(k);
                     }
@@ -74,15 +89,19 @@ impl Grid<'_> {
         (label, labels)
     }
 
-    /// Steps from the low edges (1 on them), breadth-first into the flats.
+    /// Steps from the low edges (1 on them), breadth-first into the flats,
+    /// doubled (the gradient's weight of 2).
     fn towards_lower(&self, flats: &[u32]) -> Vec<u32> {
-        let mut grad = vec![0u32; self.class.len()];
+        let mut grad = self.sweep_array();
         let mut ring: Vec<usize> = Vec::new();
         for &f in flats {
             let f = f as usize;
             for k in self.around(f) {
-                if self.class[k] & DRAINS != 0 && self.filled[k] == self.filled[f] && grad[k] == 0 {
-                    grad[k] = 1;
+                if self.class[k] & DRAINS != 0
+                    && self.filled[k] == self.filled[f]
+                    && grad[k] == NOT_FLAT
+                {
+                    grad[k] = 2;
                     ring.push(k);
                 }
             }
@@ -94,11 +113,10 @@ impl Grid<'_> {
             let (x, y) = (c % self.w, c / self.w);
             for &(dx, dy, _) in &CLOCKWISE {
                 if let Some(k) = neighbour(x, y, dx, dy, self.w, self.h)
-                    && self.is_flat(k)
                     && grad[k] == 0
                     && self.filled[k] == self.filled[c]
                 {
-                    grad[k] = 2;
+                    grad[k] = 4;
                     next.push(k);
                 }
             }
@@ -108,10 +126,13 @@ impl Grid<'_> {
         let mut step = 2;
         while !ring.is_empty() {
             step += 1;
-            for &c in &ring {
+            for (j, &c) in ring.iter().enumerate() {
+                if let Some(&ahead) = ring.get(j + PREFETCH) {
+                    prefetch(&grad, ahead, self.w);
+                }
                 for k in self.around(c) {
-                    if self.is_flat(k) && grad[k] == 0 {
-                        grad[k] = step;
+                    if grad[k] == 0 {
+                        grad[k] = 2 * step;
                         next.push(k);
                     }
                 }
@@ -125,7 +146,7 @@ impl Grid<'_> {
     /// Steps from the high edges (1 on them), breadth-first through the
     /// flats; 0 where none is reached.
     fn away_from_higher(&self, flats: &[u32]) -> Vec<u32> {
-        let mut higher = vec![0u32; self.class.len()];
+        let mut higher = self.sweep_array();
         let mut ring: Vec<usize> = flats
             .iter()
             .map(|&f| f as usize)
@@ -138,9 +159,12 @@ impl Grid<'_> {
         let mut step = 1;
         while !ring.is_empty() {
             step += 1;
-            for &c in &ring {
+            for (j, &c) in ring.iter().enumerate() {
+                if let Some(&ahead) = ring.get(j + PREFETCH) {
+                    prefetch(&higher, ahead, self.w);
+                }
                 for k in self.around(c) {
-                    if self.is_flat(k) && higher[k] == 0 {
+                    if higher[k] == 0 {
                         higher[k] = step;
                         next.push(k);
                     }
@@ -151,6 +175,27 @@ impl Grid<'_> {
         }
         higher
     }
+}
+
+/// How many cells ahead of the one a sweep expands it asks for memory.
+const PREFETCH: usize = 16;
+
+/// Asks the CPU to fetch the rows above and below cell `i` of a sweep's
+/// array: a ring of a sweep runs along a flat's contour, every cell on
+/// other cache lines, and the sweeps waited for memory most of their time.
+#[inline]
+fn prefetch(v: &[u32], i: usize, w: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        for j in [i - w, i + w] {
+            // SAFETY: prefetching is a hint with no memory access of its
+            // own; ring cells are interior, so the pointers are in bounds.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(v.as_ptr().add(j).cast()) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (v, i, w);
 }
 
 /// The class of an interior cell at height `z` (not the sea) from its
@@ -203,15 +248,11 @@ pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Opt
         w,
         h,
     };
-    // Three independent sweeps: two cores run them side by side.
-    let ((label, labels), (mut grad, higher)) = rayon::join(
-        || grid.label(&flats),
-        || {
-            rayon::join(
-                || grid.towards_lower(&flats),
-                || grid.away_from_higher(&flats),
-            )
-        },
+    // Three independent sweeps: two cores run them side by side, the
+    // longest (away from higher ground) against the other two.
+    let (higher, ((label, labels), mut grad)) = rayon::join(
+        || grid.away_from_higher(&flats),
+        || rayon::join(|| grid.label(&flats), || grid.towards_lower(&flats)),
     );
     let mut top = vec![0u32; labels as usize + 1];
     for &f in &flats {
@@ -220,15 +261,16 @@ pub fn gradient(filled: &[f32], w: usize, h: usize, sea: Option<&[bool]>) -> Opt
         top[l] = top[l].max(higher[f]);
     }
     // Low edges (not flat) keep 2 × 1; flat cells add the inverted climb.
-    for g in grad.iter_mut() {
-        *g *= 2;
-    }
-    for &f in &flats {
-        let f = f as usize;
-        if higher[f] > 0 {
-            grad[f] += top[label[f] as usize] - higher[f];
+    grad.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, g) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            if *g == NOT_FLAT {
+                *g = 0; // neither flat nor a low edge
+            } else if higher[i] != NOT_FLAT && higher[i] > 0 {
+                *g += top[label[i] as usize] - higher[i];
+            }
         }
-    }
+    });
     Some(grad)
 }
 

@@ -7,11 +7,11 @@
 //! ```
 //!
 //! Every stage is exact and deterministic (no floating-point sums decide
-//! anything; the fill copies heights), so the same input gives the same
-//! rasters on any thread count. The whole chain is O(n) but for the fill's
-//! queue, which is a radix heap ([`fill`]); a 4096² synthesis took 5.3 s
-//! on this project's shared two cores, half of it the sequential fill
-//! (README, `water`).
+//! anything; the fill copies heights; the optional MFD accumulation adds
+//! in one fixed order), so the same input gives the same rasters on any
+//! thread count. The whole chain is O(n) but for the fill's queues, radix
+//! heaps ([`fill`]). The fill runs in strips side by side, accumulation
+//! beside lakes: see the README's `water` section for the times.
 //!
 //! [`tiled`] computes the same rasters on a world cut into tiles, bit for
 //! bit, holding a few tiles at a time (`terrasynth tiles --water`).
@@ -26,6 +26,7 @@ pub mod fill;
 pub mod flats;
 pub mod geojson;
 pub mod lakes;
+pub mod mfd;
 pub mod preview;
 pub mod rivers;
 pub mod sea;
@@ -113,6 +114,17 @@ impl Params {
     }
 }
 
+/// How `flow.tif`'s accumulation is routed ([`compute_with`]). Rivers,
+/// their Strahler orders and [`Water::receivers`] are D8 whichever it is.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Routing {
+    /// All of a cell's flow to its steepest neighbour ([`d8`]).
+    #[default]
+    D8,
+    /// Shared among its lower neighbours by slope ([`mfd`]).
+    Mfd,
+}
+
 /// Bytes per cell [`compute`] holds at its peak (heights excluded): the
 /// filled surface, receivers, accumulation, the flats' gradient, labels
 /// and classes, depths, and the rivers' orders.
@@ -124,14 +136,19 @@ pub struct Timings {
     pub fill: Duration,
     pub flats: Duration,
     pub d8: Duration,
+    /// Accumulation and lakes run side by side (each is one sequential
+    /// walk, and neither needs the other): each one's own time.
     pub accumulate: Duration,
     pub lakes: Duration,
     pub rivers: Duration,
+    /// The whole of [`compute`]: less than the stages' sum.
+    pub wall: Duration,
 }
 
 impl Timings {
+    /// The wall time of the whole computation.
     pub fn total(&self) -> Duration {
-        self.fill + self.flats + self.d8 + self.accumulate + self.lakes + self.rivers
+        self.wall
     }
 }
 
@@ -147,8 +164,10 @@ pub struct Water {
     pub filled: Vec<f32>,
     /// D8 receiver of every cell on the filled surface, or [`d8::OUTLET`].
     pub receivers: Vec<u32>,
-    /// Upstream area of every cell, in cells (itself included).
+    /// D8 upstream area of every cell, in cells (itself included).
     pub accumulation: Vec<u32>,
+    /// MFD upstream area of every cell in cells, with [`Routing::Mfd`].
+    pub mfd_accumulation: Option<Vec<f32>>,
     /// Lakes, sea and water depth.
     pub bodies: lakes::Bodies,
     pub rivers: rivers::Rivers,
@@ -218,49 +237,81 @@ fn threshold_cells(area_km2: f64, cell_size: f64) -> u32 {
         .clamp(1.0, u32::MAX as f64) as u32
 }
 
-/// Computes the water of a heightfield. Refuses nodata, invalid
-/// parameters, and grids whose working memory exceeds what is available.
+/// `f`'s result and how long it took.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
+    let clock = Instant::now();
+    let v = f();
+    (v, clock.elapsed())
+}
+
+/// Computes the water of a heightfield with D8 routing. Refuses nodata,
+/// invalid parameters, and grids whose working memory exceeds what is
+/// available.
 pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
+    compute_with(hf, params, Routing::D8)
+}
+
+/// [`compute`], with the accumulation also routed by `routing`
+/// ([`Water::mfd_accumulation`]).
+pub fn compute_with(
+    hf: &Heightfield,
+    params: &Params,
+    routing: Routing,
+) -> Result<Water, WaterError> {
     params.check()?;
     check_heights(hf)?;
     let (w, h, cell) = (hf.width(), hf.height(), hf.cell_size());
+    let per_cell = match routing {
+        Routing::D8 => BYTES_PER_CELL,
+        Routing::Mfd => BYTES_PER_CELL + mfd::BYTES_PER_CELL,
+    };
     crate::io::check_memory(
         &format!("water on a {w}x{h} heightfield"),
-        BYTES_PER_CELL * (w * h) as u64,
+        per_cell * (w * h) as u64,
     )?;
     let data = hf.data();
-    let mut t = Timings::default();
-    let mut clock = Instant::now();
-    let mut lap = |d: &mut Duration| {
-        let now = Instant::now();
-        *d = now - clock;
-        clock = now;
-    };
-    let sea = params.sea_level.map(|l| sea::mask(data, w, h, l));
+    let start = Instant::now();
+    let (filled, fill_time) = timed(|| {
+        let sea = params.sea_level.map(|l| sea::mask(data, w, h, l));
+        let filled = fill::priority_flood(data, w, h, sea.as_deref().zip(params.sea_level));
+        (filled, sea)
+    });
+    let (filled, sea) = filled;
     let sea = sea.as_deref();
-    let filled = fill::priority_flood(data, w, h, sea.zip(params.sea_level));
-    lap(&mut t.fill);
-    let grad = flats::gradient(&filled, w, h, sea);
-    lap(&mut t.flats);
-    let receivers = d8::receivers(
-        &surface(&filled, w, h, grad.as_deref(), sea),
-        d8::Edges::Inside,
-    );
+    let (grad, flats_time) = timed(|| flats::gradient(&filled, w, h, sea));
+    let routed = surface(&filled, w, h, grad.as_deref(), sea);
+    let (receivers, d8_time) = timed(|| d8::receivers(&routed, d8::Edges::Inside));
+    // MFD's time counts as accumulation's.
+    let (mfd_accumulation, mfd_time) =
+        timed(|| (routing == Routing::Mfd).then(|| mfd::accumulate(&routed)));
     drop(grad);
-    lap(&mut t.d8);
-    let accumulation = d8::accumulate(&receivers);
-    lap(&mut t.accumulate);
-    let bodies = lakes::find(data, &filled, (w, h, cell), sea, params.lakes);
-    let filled_cells = filled
-        .iter()
-        .zip(data)
-        .zip(&bodies.class)
-        .filter(|((f, z), c)| f > z && **c != lakes::SEA)
-        .count();
-    lap(&mut t.lakes);
+    let ((accumulation, accumulate_time), ((bodies, filled_cells), lakes_time)) = rayon::join(
+        || timed(|| d8::accumulate(&receivers)),
+        || {
+            timed(|| {
+                let bodies = lakes::find(data, &filled, (w, h, cell), sea, params.lakes);
+                let filled_cells = filled
+                    .iter()
+                    .zip(data)
+                    .zip(&bodies.class)
+                    .filter(|((f, z), c)| f > z && **c != lakes::SEA)
+                    .count();
+                (bodies, filled_cells)
+            })
+        },
+    );
     let threshold = threshold_cells(params.river_area_km2, cell);
-    let rivers = rivers::trace(&receivers, &accumulation, &bodies.class, threshold);
-    lap(&mut t.rivers);
+    let (rivers, rivers_time) =
+        timed(|| rivers::trace(&receivers, &accumulation, &bodies.class, threshold));
+    let t = Timings {
+        fill: fill_time,
+        flats: flats_time,
+        d8: d8_time,
+        accumulate: accumulate_time + mfd_time,
+        lakes: lakes_time,
+        rivers: rivers_time,
+        wall: start.elapsed(),
+    };
     Ok(Water {
         width: w,
         height: h,
@@ -269,6 +320,7 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
         filled,
         receivers,
         accumulation,
+        mfd_accumulation,
         bodies,
         rivers,
         filled_cells,
@@ -277,6 +329,15 @@ pub fn compute(hf: &Heightfield, params: &Params) -> Result<Water, WaterError> {
 }
 
 impl Water {
+    /// What `flow.tif` holds: the MFD accumulation when it was asked for,
+    /// else D8's, in cells.
+    pub fn flow(&self) -> Vec<f32> {
+        match &self.mfd_accumulation {
+            Some(m) => m.clone(),
+            None => self.accumulation.iter().map(|&a| a as f32).collect(),
+        }
+    }
+
     /// The rivers' threshold in cells.
     pub fn river_threshold_cells(&self) -> u32 {
         threshold_cells(self.params.river_area_km2, self.cell_size)

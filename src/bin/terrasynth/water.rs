@@ -4,7 +4,7 @@
 use crate::{CliResult, args::Input};
 use std::path::{Path, PathBuf};
 use terrasynth::io::{self, WriteOptions, write_atomic};
-use terrasynth::water::{self, Params, Thresholds};
+use terrasynth::water::{self, Params, Routing, Thresholds};
 
 const ABOUT_THE_FILES: &str = "\
 Files written to --out-dir, in the input's grid and georeference (GeoTIFF,
@@ -13,8 +13,10 @@ float32):
                   (priority-flood), the sea at sea level, elsewhere the ground
   lakes.tif       water depth in metres: lakes (filled - ground, where deep and
                   wide enough) and the sea; 0 on land
-  flow.tif        D8 flow accumulation on the filled surface, in cells
-                  (upstream area = value x cell area)
+  flow.tif        flow accumulation on the filled surface, in cells
+                  (upstream area = value x cell area): D8, or with
+                  --routing mfd shared among lower neighbours by slope
+                  (rivers and their orders follow D8 either way)
   rivers.tif      Strahler order of river cells, 0 elsewhere
   rivers.geojson  river segments as LineStrings (strahler, upstream_area_km2,
                   length_m, end), in the input's CRS, or in terrasynth's local
@@ -23,7 +25,8 @@ float32):
 Examples:
   terrasynth water dem.tif --out-dir water/
   terrasynth water coast.png --out-dir water/ --sea-level 0 --json
-  terrasynth water world.png --out-dir water/ --river-area 20 --preview water.png";
+  terrasynth water world.png --out-dir water/ --river-area 20 --preview water.png
+  terrasynth water dem.tif --out-dir water/ --routing mfd";
 
 #[derive(clap::Args)]
 #[command(after_help = ABOUT_THE_FILES)]
@@ -36,6 +39,11 @@ pub struct Args {
     out_dir: PathBuf,
     #[command(flatten)]
     params: Knobs,
+    /// How flow.tif's accumulation is routed: d8 (all to the steepest
+    /// neighbour) or mfd (shared among lower neighbours by slope, as
+    /// pysheds' routing='mfd'). Rivers follow D8 either way.
+    #[arg(long, value_enum, default_value_t = RoutingArg::D8)]
+    routing: RoutingArg,
     /// Print the summary (lakes, sea, river length by order) as JSON.
     #[arg(long)]
     json: bool,
@@ -48,6 +56,12 @@ pub struct Args {
     preview_size: usize,
     #[command(flatten)]
     read: Input,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum RoutingArg {
+    D8,
+    Mfd,
 }
 
 /// Refuses to replace the input (or its companions' data file).
@@ -108,18 +122,21 @@ pub fn run(a: Args) -> CliResult {
     let hf = a.read.read(&a.input)?;
     let params = a.params.params();
     let name = a.input.display().to_string();
-    let w = water::compute(&hf, &params).map_err(|e| format!("{name}: {e}"))?;
+    let routing = match a.routing {
+        RoutingArg::D8 => Routing::D8,
+        RoutingArg::Mfd => Routing::Mfd,
+    };
+    let w = water::compute_with(&hf, &params, routing).map_err(|e| format!("{name}: {e}"))?;
     std::fs::create_dir_all(&a.out_dir)
         .map_err(|e| format!("cannot create {}: {e}", a.out_dir.display()))?;
     let opts = WriteOptions {
         inputs: vec![a.input.clone()],
         ..Default::default()
     };
-    let to_f32 = |v: &[u32]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
     let rasters: [(&str, Vec<f32>); 4] = [
         ("filled.tif", w.filled.clone()),
         ("lakes.tif", w.bodies.depth.clone()),
-        ("flow.tif", to_f32(&w.accumulation)),
+        ("flow.tif", w.flow()),
         (
             "rivers.tif",
             w.rivers.order.iter().map(|&o| o as f32).collect(),
