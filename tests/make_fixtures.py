@@ -248,7 +248,31 @@ def malformed():
     case("tiff_i64.tif", tiff(gray_tags(2, 2, 64, 2), [b"\0" * 32]), "Unsupported", "64-bit Int")
     t = dict(small)
     t[259] = (3, [34887])
-    case("tiff_lerc.tif", tiff(t, pix), "Unsupported", "LERC (34887)")
+    case("tiff_lerc.tif", tiff(t, pix), "Corrupt", "LERC strip 0: blob 1 is not a complete Lerc2 header")
+    case("tiff_lerc_wrong_size.tif", tiff(t, [lerc2_constant(3, 3, 3, 5.0)]), "Corrupt",
+         "LERC strip 0: its Lerc2 blob is 3x3, the chunk 2x2")
+    bad = bytearray(lerc2_constant(2, 2, 3, 5.0))
+    bad[-1] ^= 0x40
+    case("tiff_lerc_checksum.tif", tiff(t, [bytes(bad)]), "Corrupt", "LERC strip 0: Lerc2")
+    case("tiff_lerc_past_end.tif", lerc_strip_past_end(t), "Corrupt",
+         "LERC strip 0: bytes 8..1000008 lie past the end")
+    tz = dict(t)
+    tz[50674] = (4, [4, 2])
+    case("tiff_lerc_zstd_garbage.tif", tiff(tz, [b"\x28\xb5\x2f\xfd" + b"\xff" * 12]), "Corrupt",
+         "LERC strip 0: its zstd layer")
+    td = dict(t)
+    td[50674] = (4, [4, 1])
+    # A zlib stream of 2000 bytes where a 2x2 uint16 chunk allows 266.
+    case("tiff_lerc_deflate_long.tif", tiff(td, [zlib.compress(b"\0" * 2000)]), "Corrupt",
+         "LERC strip 0: its deflate layer")
+    tw = dict(t)
+    tw[50674] = (4, [4, 7])
+    case("tiff_lerc_unknown_layer.tif", tiff(tw, [lerc2_constant(2, 2, 3, 5.0)]), "Unsupported",
+         "7 (LercParameters, tag 50674)")
+    big = gray_tags(20000, 20000, 16, 1)
+    big[259] = (3, [34887])
+    case("tiff_lerc_not_justified.tif", tiff(big, [lerc2_constant(20000, 20000, 3, 5.0)]),
+         "SizeNotJustified", "20000x20000")
     case("tiff_float16.tif", tiff(gray_tags(2, 2, 16, 3), pix), "Unsupported", "16-bit IEEEFP")
     t = dict(small)
     t[42113] = (2, "abc")
@@ -332,6 +356,51 @@ def tiff_strip_cut():
         tag = struct.unpack_from("<H", data, e)[0]
         if tag == 273:
             struct.pack_into("<I", data, e + 8, len(data) - 10)
+    return bytes(data)
+
+
+def fletcher32(data):
+    """Lerc2's checksum of a blob's bytes after its first 14."""
+    s1 = s2 = 0xFFFF
+    words = len(data) // 2
+    i = 0
+    while words:
+        n = min(words, 359)
+        words -= n
+        for _ in range(n):
+            s1 += data[i] << 8
+            s1 += data[i + 1]
+            s2 += s1
+            i += 2
+        s1 = (s1 & 0xFFFF) + (s1 >> 16)
+        s2 = (s2 & 0xFFFF) + (s2 >> 16)
+    if len(data) & 1:
+        s1 += data[i] << 8
+        s2 += s1
+    s1 = (s1 & 0xFFFF) + (s1 >> 16)
+    s2 = (s2 & 0xFFFF) + (s2 >> 16)
+    return (s2 << 16 | s1) & 0xFFFFFFFF
+
+
+def lerc2_constant(w, h, dtype, z):
+    """A Lerc2 v3 blob of a constant w x h chunk (no mask, no data block):
+    dtype is Lerc2's type code (1 byte, 3 uint16, 6 float32)."""
+    body = struct.pack("<6i", h, w, w * h, 8, 0, dtype) + struct.pack("<3d", 0.5, z, z)
+    body += struct.pack("<i", 0)
+    size = 6 + 4 + 4 + len(body)
+    body = struct.pack("<6i", h, w, w * h, 8, size, dtype) + body[24:]
+    return b"Lerc2 " + struct.pack("<i", 3) + struct.pack("<I", fletcher32(body)) + body
+
+
+def lerc_strip_past_end(tags):
+    """A 2x2 LERC image whose strip byte count claims a million bytes."""
+    data = bytearray(tiff(tags, [lerc2_constant(2, 2, 3, 5.0)]))
+    ifd = struct.unpack_from("<I", data, 4)[0]
+    n = struct.unpack_from("<H", data, ifd)[0]
+    for k in range(n):
+        e = ifd + 2 + 12 * k
+        if struct.unpack_from("<H", data, e)[0] == 279:
+            struct.pack_into("<I", data, e + 8, 1_000_000)
     return bytes(data)
 
 

@@ -16,6 +16,12 @@ pub const LZW_RATIO: u64 = 3641;
 /// ZSTD: an RLE block spends 4 bytes (3-byte header, 1 byte) on at most
 /// 128 KiB of output (RFC 8878, Block_Maximum_Size).
 pub const ZSTD_RATIO: u64 = 32768;
+/// LERC (TIFF 34887): a constant chunk is one Lerc2 header whatever its
+/// size (70 bytes as GDAL writes it, 50 with its deflate layer), so the
+/// ratio is bounded only by the chunk size. With its 8 bytes of offset and
+/// byte count, a constant 1024² Float64 tile (8 MiB, the largest block of
+/// the COGs that use LERC) costs 58 bytes of file: 144 631×, rounded up.
+pub const LERC_RATIO: u64 = 1 << 18;
 /// PackBits: a 2-byte run emits at most 128 bytes.
 pub const PACKBITS_RATIO: u64 = 64;
 /// Fixed allowance for headers, tables and block padding, so that tiny

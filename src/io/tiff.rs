@@ -1,6 +1,7 @@
 //! GeoTIFF / TIFF heightfields: read any greyscale or multi-band image of
 //! 8-, 16- or 32-bit integers or 32- or 64-bit floats, in strips or tiles,
-//! uncompressed or LZW, Deflate, PackBits or ZSTD; write float32.
+//! uncompressed or LZW, Deflate, PackBits, ZSTD or LERC (with or without its
+//! deflate or zstd layer, [`lerc`]); write float32.
 //!
 //! Read:
 //! - one band: the only one, or `ReadOptions::band` (1-based, as GDAL's
@@ -14,9 +15,11 @@
 //!   pixel size in metres for projected files; geographic files keep their
 //!   degree geometry here and are resampled to square metric cells by
 //!   [`super::ground`];
-//! - LERC (34887) and LZMA (34925) are refused with the GDAL command that
-//!   rewrites the file in a codec we read: no maintained pure-Rust decoder is
-//!   wired into the `tiff` crate for them.
+//! - LERC (34887) chunks are decoded by [`lerc`] (the `tiff` crate has no
+//!   LERC codec), its validity mask as nodata;
+//! - LZMA (34925) is refused with the GDAL command that rewrites the file in
+//!   a codec we read: no maintained pure-Rust decoder is wired into the
+//!   `tiff` crate for it.
 //!
 //! Written: float32, uncompressed strips (every GeoTIFF reader opens them),
 //! NaN for nodata with `GDAL_NODATA = "nan"`, and the georeference with its
@@ -24,8 +27,12 @@
 //! correct cell size and its lower-left corner at (0, 0), named as such
 //! ([`Georef::local`]), never an invented EPSG code.
 
+mod lerc;
+
 use super::geotiff::{self, GeoKeys};
-use super::limits::{DEFLATE_RATIO, LZW_RATIO, PACKBITS_RATIO, ZSTD_RATIO, check_justified};
+use super::limits::{
+    DEFLATE_RATIO, LERC_RATIO, LZW_RATIO, PACKBITS_RATIO, ZSTD_RATIO, check_justified,
+};
 use super::sidecar::DEFAULT_CELL_SIZE_M;
 use super::{Encoded, FormatError};
 use crate::georef::Georef;
@@ -45,7 +52,7 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
     let (w, h) = dec.dimensions().map_err(tiff_error)?;
     let (w, h) = (w as usize, h as usize);
     check_dims(w, h)?;
-    let ratio = compression_ratio(&mut dec)?;
+    let (ratio, is_lerc) = compression_ratio(&mut dec)?;
     let color = dec.colortype().map_err(tiff_error)?;
     let (bits, samples) = (color.bit_depth(), color.num_samples().max(1) as usize);
     let format = match dec.find_tag_unsigned_vec::<u16>(Tag::SampleFormat) {
@@ -150,7 +157,18 @@ pub(super) fn decode(bytes: &[u8], band: Option<usize>) -> Result<Heightfield, F
     let n = w * h;
     // Float32 samples compare with the nodata value in f32, as GDAL does.
     let nodata32 = nodata.map(|v| v as f32);
-    let data = if planar {
+    let data = if is_lerc {
+        let band = lerc::Band {
+            index: band,
+            samples,
+            planar,
+            bits,
+            format,
+            convert: &convert,
+            nodata32,
+        };
+        lerc::read_band(&mut dec, bytes, &band, (w, h))?
+    } else if planar {
         read_plane(&mut dec, band, samples, (w, h), &convert, nodata32)?
     } else {
         let image = dec.read_image().map_err(tiff_error)?;
@@ -284,30 +302,34 @@ fn cell_size(g: &Georef, rows: usize) -> f64 {
     g.ground_spacing(rows).1
 }
 
-/// The best compression ratio of the file's codec; refuses codecs we cannot
+/// The best compression ratio of the file's codec, and whether it is LERC
+/// (decoded by [`lerc`], not the `tiff` crate); refuses codecs we cannot
 /// decode with the command that rewrites the file.
-fn compression_ratio(dec: &mut Dec) -> Result<u64, FormatError> {
+fn compression_ratio(dec: &mut Dec) -> Result<(u64, bool), FormatError> {
     let code = dec
         .find_tag_unsigned::<u16>(Tag::Compression)
         .map_err(tiff_error)?;
     let refuse = |name: &'static str| FormatError::Unsupported {
         what: "TIFF compression",
         found: format!("{name} ({})", code.unwrap_or(0)),
-        supported: "none, LZW, Deflate, PackBits or ZSTD; rewrite the file with gdal_translate -co COMPRESS=DEFLATE in.tif out.tif",
+        supported: "none, LZW, Deflate, PackBits, ZSTD or LERC; rewrite the file with gdal_translate -co COMPRESS=DEFLATE in.tif out.tif",
     };
-    Ok(match code {
+    if code == Some(34887) {
+        return Ok((LERC_RATIO, true));
+    }
+    let ratio = match code {
         None | Some(1) => 1,
         Some(32773) => PACKBITS_RATIO,
         Some(8 | 32946) => DEFLATE_RATIO,
         Some(5) => LZW_RATIO,
         Some(50000) => ZSTD_RATIO,
-        Some(34887) => return Err(refuse("LERC")),
         Some(34925) => return Err(refuse("LZMA")),
         Some(7) => return Err(refuse("JPEG (lossy, not for heights)")),
         Some(50001) => return Err(refuse("WEBP (lossy, not for heights)")),
         // Whatever else the decoder accepts: the loosest bound.
         Some(_) => ZSTD_RATIO,
-    })
+    };
+    Ok((ratio, false))
 }
 
 /// The 0-based band to read, checked against the file's band count, and
@@ -546,7 +568,7 @@ fn tiff_error(e: tiff::TiffError) -> FormatError {
         E::UnsupportedError(u) => FormatError::Unsupported {
             what: "TIFF feature",
             found: u.to_string(),
-            supported: "strips or tiles, uncompressed, LZW, Deflate, PackBits or ZSTD; rewrite other files with gdal_translate -co COMPRESS=DEFLATE in.tif out.tif",
+            supported: "strips or tiles, uncompressed, LZW, Deflate, PackBits, ZSTD or LERC; rewrite other files with gdal_translate -co COMPRESS=DEFLATE in.tif out.tif",
         },
         E::LimitsExceeded => FormatError::Corrupt(
             "TIFF strips or tiles decode to more data than the image size".into(),
