@@ -29,6 +29,7 @@ use pyo3::types::PyDict;
 /// ``terrasynth water --json`` prints).
 #[pyfunction]
 #[pyo3(signature = (heights, cell_size, *, sea_level=None, river_area_km2=5.0, lake_min_depth=2.0, lake_min_area_km2=0.1, routing="d8"))]
+#[allow(clippy::too_many_arguments)] // one Rust argument per Python keyword
 pub fn water<'py>(
     py: Python<'py>,
     heights: &Bound<'py, PyAny>,
