@@ -392,30 +392,31 @@ def lerc2_constant(w, h, dtype, z):
     return b"Lerc2 " + struct.pack("<i", 3) + struct.pack("<I", fletcher32(body)) + body
 
 
-def lerc_strip_past_end(tags):
-    """A 2x2 LERC image whose strip byte count claims a million bytes."""
-    data = bytearray(tiff(tags, [lerc2_constant(2, 2, 3, 5.0)]))
+def patch_entry(data, tag, at, value):
+    """`data` (a one-IFD little-endian TIFF) with the u32 `at` bytes into
+    `tag`'s IFD entry (4: its count, 8: its value or offset) set to `value`."""
+    data = bytearray(data)
     ifd = struct.unpack_from("<I", data, 4)[0]
     n = struct.unpack_from("<H", data, ifd)[0]
     for k in range(n):
         e = ifd + 2 + 12 * k
-        if struct.unpack_from("<H", data, e)[0] == 279:
-            struct.pack_into("<I", data, e + 8, 1_000_000)
+        if struct.unpack_from("<H", data, e)[0] == tag:
+            struct.pack_into("<I", data, e + at, value)
     return bytes(data)
+
+
+def lerc_strip_past_end(tags):
+    """A 2x2 LERC image whose strip byte count claims a million bytes."""
+    data = tiff(tags, [lerc2_constant(2, 2, 3, 5.0)])
+    return patch_entry(data, 279, 8, 1_000_000)
 
 
 def tiff_tag_past_end():
     """A 2x2 image whose ImageDescription claims a million bytes."""
     t = gray_tags(2, 2, 16, 1)
     t[270] = (2, "x" * 8)
-    data = bytearray(tiff(t, [b"\1\0\2\0\3\0\4\0"]))
-    ifd = struct.unpack_from("<I", data, 4)[0]
-    n = struct.unpack_from("<H", data, ifd)[0]
-    for k in range(n):
-        e = ifd + 2 + 12 * k
-        if struct.unpack_from("<H", data, e)[0] == 270:
-            struct.pack_into("<I", data, e + 4, 1_000_000)
-    return bytes(data)
+    data = tiff(t, [b"\1\0\2\0\3\0\4\0"])
+    return patch_entry(data, 270, 4, 1_000_000)
 
 
 if __name__ == "__main__":
