@@ -82,17 +82,12 @@ pub fn pieces(
             .find(|(m, _)| *m == mask)
             .map_or(src.pool, |(_, p)| p)
     };
-    let draw = |pool: &Pool, k: usize| {
-        draw(
-            pool,
-            quantiles[k],
-            seed,
-            (i0 + (k % ni) as i32, j0 + (k / ni) as i32),
-        )
-    };
     let centres: Vec<(i32, i32)> = (0..ni * nj)
         .into_par_iter()
-        .map(|k| draw(src.pool, k))
+        .map(|k| {
+            let ij = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
+            draw(src.pool, quantiles[k], seed, ij)
+        })
         .collect();
     let st = State::new(w, h);
     (0..h).into_par_iter().for_each(|r| {
@@ -104,7 +99,7 @@ pub fn pieces(
             let k = (j - j0) as usize * ni + (i - i0) as usize;
             let (cx, cy) = match allowed.map_or(ALL_TYPES, |a| a[r * w + c]) {
                 ALL_TYPES => centres[k],
-                mask => self::draw(pool_of(mask), painted(quantiles[k]), seed, (i, j)),
+                mask => draw(pool_of(mask), painted(quantiles[k]), seed, (i, j)),
             };
             let col = src.atlas.columns[cx as usize];
             let (x0, y0) = (col.min_x, MARGIN as i32);
