@@ -19,7 +19,7 @@ use terrasynth::io::{self, ReadOptions};
 use terrasynth::{Heightfield, io::Format};
 
 mod common;
-use common::have_gdal;
+use common::{gdal_python, have_gdal};
 
 /// Runs a GDAL tool; panics with its stderr on failure.
 fn run(tool: &str, args: &[&str]) -> String {
@@ -30,19 +30,6 @@ fn run(tool: &str, args: &[&str]) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// Runs Debian's Python (the one with `osgeo`) on a script.
-fn python(script: &str) {
-    let out = Command::new("/usr/bin/python3")
-        .args(["-c", script])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "python: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
 }
 
 fn s(p: &Path) -> &str {
@@ -284,7 +271,7 @@ fn bands_and_scale_offset() {
     let d = dir.path();
     let multi = d.join("multi.tif");
     let scaled = d.join("scaled.tif");
-    python(&format!(
+    gdal_python(&format!(
         r#"
 from osgeo import gdal, osr
 srs = osr.SpatialReference(); srs.ImportFromEPSG(32633)
@@ -387,7 +374,7 @@ fn geographic_geotiff_and_srtm_tile() {
     let d = dir.path();
     // A 3″ grid at 49.5° N, heights by row only (resampling east–west keeps them).
     let geo = d.join("geo.tif");
-    python(&format!(
+    gdal_python(&format!(
         r#"
 from osgeo import gdal, osr
 import struct
@@ -476,7 +463,7 @@ ds = None
     );
     // An SRTM tile written by GDAL: placed by its name, resampled.
     let tile_src = d.join("tile.tif");
-    python(&format!(
+    gdal_python(&format!(
         r#"
 from osgeo import gdal, osr
 import struct

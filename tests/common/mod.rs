@@ -140,6 +140,21 @@ pub fn have_gdal() -> bool {
     ok
 }
 
+/// Runs a script with Debian's Python (the one `python3-gdal` installs
+/// into); panics with its stderr on failure; its stdout.
+pub fn gdal_python(script: &str) -> String {
+    let out = Command::new("/usr/bin/python3")
+        .args(["-c", script])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "python: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
 /// Pearson's correlation of pairs.
 pub fn correlation(p: &[(f64, f64)]) -> f64 {
     let n = p.len() as f64;
