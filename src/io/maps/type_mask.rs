@@ -4,8 +4,10 @@
 //! On disk: an 8-bit greyscale PNG of the heightfield's size, and names in a
 //! JSON beside it (`<stem>.json`) in the layout of `../shared/dem/*_types.json`:
 //! `{"types": {"0": "sea", "1": "flat", …}, …}` (other keys are ignored on
-//! read). Index 255 means "no type". This is the one reader and writer of the
-//! format; the database, the renderer and the procedural styles all use it.
+//! read). Index 255 means "no type". This is the one reader of the format,
+//! and the writer of every mask but a classification of a terrain by its own
+//! heights ([`crate::procedural::types::TypeClassification`], a fixed set of
+//! typed classes, which writes the same layout itself).
 
 use crate::io::{FormatError, IoError, write_atomic};
 use std::collections::BTreeMap;

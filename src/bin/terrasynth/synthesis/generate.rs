@@ -48,7 +48,7 @@ pub fn run(a: Args) -> CliResult {
     eprintln!(
         "wrote {} and {} ({} x {}, {} style, seed {})",
         out.display(),
-        terrasynth::procedural::TypeMask::path_for(&out).display(),
+        terrasynth::procedural::TypeClassification::path_for(&out).display(),
         hf.width(),
         hf.height(),
         style.name(),

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use terrasynth::io::engine::{self, Engine};
 use terrasynth::io::write_atomic;
 use terrasynth::masks::{self, encode_png8};
-use terrasynth::procedural::TypeMask;
+use terrasynth::procedural::TypeClassification;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -54,7 +54,7 @@ pub fn run(a: Args) -> CliResult {
     let hf = prepared.as_ref().map_or(&hf, |p| &p.heightfield);
     let (w, h) = (hf.width(), hf.height());
     let m = masks::compute(hf, a.splat)?;
-    let types = TypeMask::classify(hf);
+    let types = TypeClassification::classify(hf);
     let name = a.input.display().to_string();
     let mut files = vec![
         ("slope.png".to_string(), encode_png8(w, h, 1, &m.slope)),
