@@ -59,6 +59,18 @@ enum Only {
     Erode,
 }
 
+impl Only {
+    /// The sizes to time for this part: `sizes`, or none when `--only`
+    /// names another part.
+    fn sizes(self, only: Option<Only>, sizes: &[(usize, usize)]) -> &[(usize, usize)] {
+        if only.is_some_and(|o| o != self) {
+            &[]
+        } else {
+            sizes
+        }
+    }
+}
+
 /// One size's median `erode` time.
 #[derive(Serialize)]
 struct ErodeReport {
@@ -136,11 +148,7 @@ pub fn run(a: Args) -> CliResult {
     let mut synth = Synthesizer::new(&db, Params::default())?;
     select_backend(&mut synth, a.backend)?;
     let mut sizes = Vec::new();
-    let synth_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Synth) {
-        &[]
-    } else {
-        &a.sizes
-    };
+    let synth_sizes = Only::Synth.sizes(a.only, &a.sizes);
     for &(w, h) in synth_sizes {
         synth.run(w, h, a.seed)?; // warm-up: page in the database, spin up threads
         let timings: Vec<Timings> = (0..a.runs)
@@ -194,11 +202,7 @@ pub fn run(a: Args) -> CliResult {
         sizes.push(report);
     }
     let mut water = Vec::new();
-    let water_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Water) {
-        &[]
-    } else {
-        &a.water_sizes
-    };
+    let water_sizes = Only::Water.sizes(a.only, &a.water_sizes);
     for &(w, h) in water_sizes {
         let hf = synth.run(w, h, a.seed)?.heightfield;
         let params = terrasynth::water::Params::default();
@@ -243,11 +247,7 @@ pub fn run(a: Args) -> CliResult {
         water.push(report);
     }
     let mut erode = Vec::new();
-    let erode_sizes: &[(usize, usize)] = if a.only.is_some_and(|o| o != Only::Erode) {
-        &[]
-    } else {
-        &a.erode_sizes
-    };
+    let erode_sizes = Only::Erode.sizes(a.only, &a.erode_sizes);
     for &(w, h) in erode_sizes {
         let hf = synth.run(w, h, a.seed)?.heightfield;
         let strength = terrasynth::erode::DEFAULT_STRENGTH;
