@@ -3,7 +3,7 @@
 //! Two layers:
 //! - [`decode`] / [`encode`] work on bytes and return a [`FormatError`]; they
 //!   never touch the file system, so the fuzz targets call them directly.
-//! - [`read`] / [`write`] add paths: sidecar lookup, format choice by
+//! - [`read`] / [`write()`] add paths: sidecar lookup, format choice by
 //!   extension, and atomic output (temporary file, then rename — a failed
 //!   write never leaves a partial file behind). Their [`IoError`] names the file.
 //!
@@ -408,7 +408,7 @@ pub fn write(hf: &Heightfield, path: &Path, opts: &WriteOptions) -> Result<(), I
     write_noted(hf, path, opts).map(|_| ())
 }
 
-/// [`write`], returning one-line notices for the user (a CRS that the
+/// [`write()`], returning one-line notices for the user (a CRS that the
 /// format cannot carry).
 ///
 /// Every file it would write — the data file, its sidecar, its `.prj` — is
