@@ -25,7 +25,7 @@ use std::hint::black_box;
 use std::path::Path;
 use terrasynth::backend::{Backend, cpu::Cpu};
 use terrasynth::database::{Database, default};
-use terrasynth::io::type_mask::TypeMask;
+use terrasynth::io::maps::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::state::State;
 use terrasynth::patch::fill::hole_fill::user_cells;

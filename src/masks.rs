@@ -12,7 +12,7 @@
 //!   grid like any other.
 //!   `value = round(255 × ln(cells) / ln(all cells))`, so a single cell is
 //!   0 and a river draining the whole grid 255;
-//! - **types**: [`crate::procedural::types::TypeMask::classify`] (ridge,
+//! - **types**: [`crate::procedural::types::TypeClassification::classify`] (ridge,
 //!   slope, valley floor, plateau, cliff), the local classes of the
 //!   procedural styles' masks (the embedded database's masks are regional
 //!   — sea, flat, hills, mountains — and come with its DEMs);

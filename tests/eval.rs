@@ -12,7 +12,7 @@ use terrasynth::eval::drainage::d8_area;
 use terrasynth::eval::{self, Reference, Value, describe, id};
 use terrasynth::io::CoordsMap;
 use terrasynth::io::TypeMask;
-use terrasynth::io::coords_map::{NO_EXEMPLAR, Source};
+use terrasynth::io::maps::coords_map::{NO_EXEMPLAR, Source};
 use terrasynth::progress::Silent;
 use terrasynth::synth::source_map::source_map;
 use terrasynth::synth::{Params, Synthesizer};

@@ -3,7 +3,7 @@
 //! exactly as the target runs them: a CRS or a typed error, never a panic.
 
 fn run(data: &[u8]) -> Option<terrasynth::Heightfield> {
-    terrasynth::io::ground::fuzz_georef(data)
+    terrasynth::io::place::ground::fuzz_georef(data)
         .ok()
         .map(|l| l.heightfield)
 }

@@ -284,7 +284,7 @@ fn types_follow_the_terrain() {
         }
     })
     .unwrap();
-    let mask = TypeMask::classify(&hf);
+    let mask = TypeClassification::classify(&hf);
     assert_eq!(mask.get(20, 80), TerrainType::Plateau);
     assert_eq!(mask.get(62, 80), TerrainType::Cliff);
     assert_eq!(mask.get(120, 80), TerrainType::ValleyFloor);

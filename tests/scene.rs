@@ -255,7 +255,7 @@ fn type_strokes_paint_database_indices_and_unknown_names_fail() {
 
 #[test]
 fn mask_images_must_match_the_scene_size() {
-    use terrasynth::io::type_mask::TypeMask;
+    use terrasynth::io::maps::type_mask::TypeMask;
     let dir = tempfile::tempdir().unwrap();
     let mut mask = TypeMask::new(128, 96, vec![255; 128 * 96]).unwrap();
     mask.indices[5] = 1;

@@ -14,7 +14,7 @@ use proptest::prelude::*;
 use std::path::Path;
 use terrasynth::database::c2;
 use terrasynth::database::layout;
-use terrasynth::io::type_mask::TypeMask;
+use terrasynth::io::maps::type_mask::TypeMask;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::state::{State, level_size};
 use terrasynth::stages::common::ALL_TYPES;

@@ -11,7 +11,7 @@
 use proptest::prelude::*;
 use std::path::Path;
 use terrasynth::backend::{Backend, cpu::Cpu};
-use terrasynth::io::type_mask::TypeMask;
+use terrasynth::io::maps::type_mask::TypeMask;
 use terrasynth::level::state::level_size;
 use terrasynth::stages::common::ALL_TYPES;
 use terrasynth::synth::control::UNCONSTRAINED;

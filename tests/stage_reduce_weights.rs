@@ -9,7 +9,7 @@
 use proptest::prelude::*;
 use std::path::Path;
 use terrasynth::backend::{Backend, cpu::Cpu};
-use terrasynth::io::type_mask::TypeMask;
+use terrasynth::io::maps::type_mask::TypeMask;
 use terrasynth::stages::correct::W_FREE;
 
 mod common;

@@ -6,5 +6,5 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = terrasynth::io::ground::fuzz_georef(data);
+    let _ = terrasynth::io::place::ground::fuzz_georef(data);
 });

@@ -3,13 +3,13 @@
 //! Two layers:
 //! - [`decode`] / [`encode`] work on bytes and return a [`FormatError`]; they
 //!   never touch the file system, so the fuzz targets call them directly.
-//! - [`read`] / [`write`] add paths: sidecar lookup, format choice by
+//! - [`read`] / [`write()`] add paths: sidecar lookup, format choice by
 //!   extension, and atomic output (temporary file, then rename — a failed
 //!   write never leaves a partial file behind). Their [`IoError`] names the file.
 //!
 //! Every reader checks declared sizes against [`crate::size::check_dims`]
 //! and against what the file's length can justify *before* allocating
-//! (see `limits.rs`).
+//! (see `guard/limits.rs`).
 //!
 //! | format | ext | read | write | samples | nodata | metadata kept | round-trip precision |
 //! |---|---|---|---|---|---|---|---|
@@ -27,38 +27,27 @@
 //! true spacings differ (geographic DEMs, ESRI `dx` ≠ `dy`) to square metric
 //! cells, so nothing is ever stretched; [`load`] reports what it did.
 
-mod asc;
-mod atomic;
-pub mod coords_map;
 pub mod engine;
 mod error;
-mod exr;
-mod geotiff;
-pub mod ground;
-mod hgt;
-mod limits;
-mod memory;
-mod png;
-mod quantize;
-mod raw;
-mod sidecar;
-mod ter;
-mod tiff;
-pub mod type_mask;
-pub mod wkt;
+mod format;
+mod guard;
+pub mod maps;
+pub mod place;
 
-pub use atomic::{remove_orphans, write_atomic};
-pub use coords_map::CoordsMap;
 pub use error::{FormatError, IoError};
-pub use exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
-pub use ground::GridReport;
-pub use hgt::ARC_SECOND_M;
-pub use memory::{available_memory, check_memory};
-pub use sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
-pub use tiff::METRES_PER_DEGREE;
-pub use type_mask::TypeMask;
+pub use format::exr::CELL_SIZE_ATTRIBUTE as EXR_CELL_SIZE_ATTRIBUTE;
+pub use format::hgt::ARC_SECOND_M;
+pub use format::sidecar::{DEFAULT_CELL_SIZE_M, HeightMapping, Sidecar};
+pub use format::tiff::METRES_PER_DEGREE;
+pub use guard::atomic::{remove_orphans, write_atomic};
+pub use guard::memory::{available_memory, check_memory};
+pub use maps::coords_map::CoordsMap;
+pub use maps::type_mask::TypeMask;
+pub use place::ground::GridReport;
 
 use crate::heightfield::Heightfield;
+use format::{asc, exr, hgt, png, raw, ter, tiff};
+use place::{ground, wkt};
 use std::path::{Path, PathBuf};
 
 /// A heightfield file format.
@@ -419,7 +408,7 @@ pub fn write(hf: &Heightfield, path: &Path, opts: &WriteOptions) -> Result<(), I
     write_noted(hf, path, opts).map(|_| ())
 }
 
-/// [`write`], returning one-line notices for the user (a CRS that the
+/// [`write()`], returning one-line notices for the user (a CRS that the
 /// format cannot carry).
 ///
 /// Every file it would write — the data file, its sidecar, its `.prj` — is

@@ -40,5 +40,5 @@ pub use hydraulic::{Boundary, Budget, Hydraulic, HydraulicParams, hydraulic_erod
 pub use noise::gradient_noise;
 pub use styles::Style;
 pub use thermal::{ThermalParams, thermal_erode};
-pub use types::TypeMask;
+pub use types::TypeClassification;
 pub use warp::Warp;

@@ -25,7 +25,7 @@ use super::grid::upsample2;
 use super::noise::pcg;
 use super::remap;
 use super::thermal::{ThermalParams, thermal_erode};
-use super::types::TypeMask;
+use super::types::TypeClassification;
 use super::warp::Warp;
 use crate::heightfield::Heightfield;
 use crate::progress::Progress;
@@ -105,7 +105,7 @@ impl Style {
         size: usize,
         seed: u32,
         progress: &dyn Progress,
-    ) -> Result<(Heightfield, TypeMask), ProceduralError> {
+    ) -> Result<(Heightfield, TypeClassification), ProceduralError> {
         check_dims(size, size)?;
         if size < MIN_SIZE {
             return Err(ProceduralError::Param {
@@ -143,7 +143,7 @@ impl Style {
             }
         }
         progress.finish();
-        let mask = TypeMask::classify(&hf);
+        let mask = TypeClassification::classify(&hf);
         Ok((hf, mask))
     }
 }

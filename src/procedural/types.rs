@@ -52,7 +52,7 @@ impl TerrainType {
     }
 }
 
-/// Thresholds of [`TypeMask::classify`]. Slopes are rise over run; the
+/// Thresholds of [`TypeClassification::classify`]. Slopes are rise over run; the
 /// topographic position `z` is the height above the mean of a disc-like
 /// window of radius `window_m`, in units of the local relief (the standard
 /// deviation of height in that window, at least `min_relief_m`).
@@ -68,9 +68,12 @@ const MIN_RELIEF_M: f64 = 15.0;
 const MAJORITY_RADIUS: usize = 3;
 const MAJORITY_PASSES: usize = 3;
 
-/// A type index per pixel.
+/// A terrain classified from its own heights: one [`TerrainType`] per
+/// pixel (the discriminant), what [`TypeClassification::classify`] finds.
+/// It is written in the shared DEMs' mask layout, and reads back as the
+/// general mask of any type indices and names, [`crate::io::TypeMask`].
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct TypeMask {
+pub struct TypeClassification {
     width: usize,
     height: usize,
     data: Vec<u8>,
@@ -112,7 +115,7 @@ impl BoxSum {
     }
 }
 
-impl TypeMask {
+impl TypeClassification {
     pub fn width(&self) -> usize {
         self.width
     }
@@ -132,7 +135,7 @@ impl TypeMask {
     /// is valley floor; `z > 0.6` is ridge; the rest is slope. Slope is taken
     /// from a 3×3 mean to ignore single-pixel roughness. Then three passes of
     /// a 7×7 majority filter turn the classes into regions.
-    pub fn classify(hf: &Heightfield) -> TypeMask {
+    pub fn classify(hf: &Heightfield) -> TypeClassification {
         let (w, h) = (hf.width(), hf.height());
         let cell = hf.cell_size();
         let heights: Vec<f64> = hf
@@ -175,7 +178,7 @@ impl TypeMask {
             };
             t as u8
         });
-        let mut mask = TypeMask {
+        let mut mask = TypeClassification {
             width: w,
             height: h,
             data,
@@ -189,7 +192,7 @@ impl TypeMask {
     /// Each pixel takes the most frequent type in its (2r+1)² window; on a
     /// tie it keeps its own type if that is among the most frequent, else the
     /// lowest index.
-    fn majority(&self, r: usize) -> TypeMask {
+    fn majority(&self, r: usize) -> TypeClassification {
         let (w, h) = (self.width, self.height);
         let mut data = vec![0u8; w * h];
         sweep(&mut data, w, |x, y| {
@@ -207,7 +210,7 @@ impl TypeMask {
                 counts.iter().position(|&c| c == best).expect("max exists") as u8
             }
         });
-        TypeMask {
+        TypeClassification {
             width: w,
             height: h,
             data,

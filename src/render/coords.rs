@@ -3,7 +3,7 @@
 //! 0..=255. Smooth gradients are patches copied whole; confetti is pixels
 //! drawn from everywhere. Unmapped pixels are black.
 
-use crate::io::coords_map::{CoordsMap, NO_EXEMPLAR};
+use crate::io::maps::coords_map::{CoordsMap, NO_EXEMPLAR};
 use image::{Rgba, RgbaImage};
 
 /// The picture of `map`, given each exemplar's (width, height) in

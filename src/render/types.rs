@@ -1,7 +1,7 @@
 //! The colours the preview shows terrain types in (the masks themselves are
 //! [`crate::io::TypeMask`]).
 
-use crate::io::type_mask::{NO_TYPE, TypeMask};
+use crate::io::maps::type_mask::{NO_TYPE, TypeMask};
 /// Default opacity of type colours over the terrain tint.
 pub const DEFAULT_OPACITY: u8 = 150;
 

@@ -12,7 +12,7 @@
 
 use super::{PasteSource, Scene, SceneEdits, SceneError};
 use crate::heightfield::Heightfield;
-use crate::io::type_mask::{NO_TYPE, TypeMask};
+use crate::io::maps::type_mask::{NO_TYPE, TypeMask};
 use crate::render::{self, Marker, RenderOptions, TypeOverlay};
 use image::{Rgba, RgbaImage};
 

@@ -2,7 +2,7 @@
 //! from strokes or from images (checked against the scene and database).
 
 use super::*;
-use crate::io::type_mask::{NO_TYPE, TypeMask};
+use crate::io::maps::type_mask::{NO_TYPE, TypeMask};
 use crate::synth::cone::Rect;
 use rayon::prelude::*;
 

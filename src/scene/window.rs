@@ -12,7 +12,7 @@ use super::raster::paint_strokes;
 use super::{Freeze, Scene, SceneEdits, SceneError, Stroke, TypePaint};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
-use crate::io::type_mask::NO_TYPE;
+use crate::io::maps::type_mask::NO_TYPE;
 use crate::synth::cone::Rect;
 use crate::synth::control::{Constraint, Paste};
 use crate::synth::session::Edit;

@@ -10,7 +10,7 @@
 
 use crate::database::Database;
 use crate::heightfield::Heightfield;
-use crate::io::type_mask::TypeMask;
+use crate::io::maps::type_mask::TypeMask;
 use crate::render::{self, Contours, Grid, RenderOptions, Sea, TypeOverlay};
 use crate::scene::SceneEdits;
 use image::RgbaImage;
@@ -107,7 +107,7 @@ impl Style {
         for c in o
             .colours
             .iter_mut()
-            .take(crate::io::type_mask::NO_TYPE as usize)
+            .take(crate::io::maps::type_mask::NO_TYPE as usize)
         {
             c[3] = crate::scene::overlay::TYPE_OPACITY;
         }

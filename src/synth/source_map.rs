@@ -3,7 +3,7 @@
 //! for type usage).
 
 use crate::database::Database;
-use crate::io::coords_map::{CoordsMap, NO_EXEMPLAR, Source};
+use crate::io::maps::coords_map::{CoordsMap, NO_EXEMPLAR, Source};
 use crate::level::fixed::{Coord, round};
 
 /// The sources of the `width × height` output from level-0 coordinates

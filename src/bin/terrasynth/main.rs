@@ -1,26 +1,14 @@
-//! The `terrasynth` command-line tool: one file per subcommand.
+//! The `terrasynth` command-line tool: one file per subcommand, grouped by
+//! family (`synthesis/`, `editing/`, `terrain/`, `data/`, `measure/`);
+//! `args.rs` holds the argument pieces several share.
 
 mod args;
-mod bench;
-mod convert;
-mod db;
-mod edit;
-mod erode;
-mod eval;
-mod generate;
-mod info;
-mod masks;
-mod mesh;
-mod normals;
+mod data;
+mod editing;
+mod measure;
 mod progress;
-mod render;
-#[cfg(feature = "serve")]
-mod serve;
-mod sketch;
-mod suite;
-mod synth;
-mod tiles;
-mod water;
+mod synthesis;
+mod terrain;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -39,50 +27,50 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Print a heightfield's size, cell size, height range and nodata count.
-    Info(info::Args),
+    Info(data::info::Args),
     /// Convert a heightfield between formats (chosen by extension).
-    Convert(convert::Args),
+    Convert(data::convert::Args),
     /// Write slope, flow accumulation, terrain-type and splat masks of a heightfield.
-    Masks(masks::Args),
+    Masks(terrain::masks::Args),
     /// Write a triangle mesh (glTF, GLB or OBJ) of a heightfield: regular
     /// or adaptive (error-bounded), with LODs, tiles, skirts, normals, UVs.
-    Mesh(mesh::Args),
+    Mesh(terrain::mesh::Args),
     /// Write a tangent-space normal map (PNG, OpenGL or DirectX Y) of a
     /// heightfield, for the UVs of `mesh --uv`.
-    Normals(normals::Args),
+    Normals(terrain::normals::Args),
     /// Fill depressions and route water: filled surface, lakes (water
     /// depth), flow accumulation, rivers (raster and GeoJSON lines).
-    Water(water::Args),
+    Water(terrain::water::Args),
     /// Erode a heightfield: a few local steps of stream-power incision and
     /// hillslope creep (windows of a world erode like crops of it).
-    Erode(erode::Args),
+    Erode(terrain::erode::Args),
     /// Time synthesis: median ms per size, level and stage, and memory per pixel.
-    Bench(bench::Args),
+    Bench(measure::bench::Args),
     /// Build or inspect an exemplar database.
     #[command(subcommand)]
-    Db(db::Command),
+    Db(data::db::Command),
     /// Synthesize a terrain from real exemplars (the embedded ones by default).
-    Synth(synth::Args),
+    Synth(synthesis::synth::Args),
     /// Write a whole world as a directory of tiles (each a window of it,
     /// exactly), a manifest and a GDAL mosaic; resumable.
-    Tiles(tiles::Args),
+    Tiles(synthesis::tiles::Args),
     /// Apply scene files in order as edits of one session, writing every
     /// frame, its preview and a report of where the terrain changed.
-    Edit(edit::Args),
+    Edit(editing::edit::Args),
     /// Draw a shaded relief map (PNG) of a heightfield.
-    Render(render::Args),
+    Render(terrain::render::Args),
     /// Generate a procedural terrain in a default exemplar style (see --list).
-    Generate(generate::Args),
+    Generate(synthesis::generate::Args),
     /// Turn a ridge/valley sketch into terrain made of real DEM patches.
-    Sketch(sketch::Args),
+    Sketch(synthesis::sketch::Args),
     /// The interactive editor: a web page on this machine where you sketch,
     /// paint and drag constraints and see the terrain change.
     #[cfg(feature = "serve")]
-    Serve(serve::Args),
+    Serve(editing::serve::Args),
     /// Measure how real a synthesis is against a real DEM (descriptor
     /// distances, realism ratio, type usage), or run the realism protocol
     /// over a folder of DEMs (--suite).
-    Eval(eval::Args),
+    Eval(measure::eval::Args),
 }
 
 /// What every subcommand returns: a message for the user on failure.
@@ -98,24 +86,24 @@ fn main() -> ExitCode {
         default_sigpipe();
     }
     let result = match cli.command {
-        Command::Info(a) => info::run(a),
-        Command::Convert(a) => convert::run(a),
-        Command::Masks(a) => masks::run(a),
-        Command::Mesh(a) => mesh::run(a),
-        Command::Normals(a) => normals::run(a),
-        Command::Water(a) => water::run(a),
-        Command::Erode(a) => erode::run(a),
-        Command::Bench(a) => bench::run(a),
-        Command::Db(c) => db::run(c),
-        Command::Render(a) => render::run(a),
-        Command::Synth(a) => synth::run(a),
-        Command::Tiles(a) => tiles::run(a),
-        Command::Edit(a) => edit::run(a),
-        Command::Generate(a) => generate::run(a),
-        Command::Sketch(a) => sketch::run(a),
+        Command::Info(a) => data::info::run(a),
+        Command::Convert(a) => data::convert::run(a),
+        Command::Masks(a) => terrain::masks::run(a),
+        Command::Mesh(a) => terrain::mesh::run(a),
+        Command::Normals(a) => terrain::normals::run(a),
+        Command::Water(a) => terrain::water::run(a),
+        Command::Erode(a) => terrain::erode::run(a),
+        Command::Bench(a) => measure::bench::run(a),
+        Command::Db(c) => data::db::run(c),
+        Command::Render(a) => terrain::render::run(a),
+        Command::Synth(a) => synthesis::synth::run(a),
+        Command::Tiles(a) => synthesis::tiles::run(a),
+        Command::Edit(a) => editing::edit::run(a),
+        Command::Generate(a) => synthesis::generate::run(a),
+        Command::Sketch(a) => synthesis::sketch::run(a),
         #[cfg(feature = "serve")]
-        Command::Serve(a) => serve::run(a),
-        Command::Eval(a) => eval::run(a),
+        Command::Serve(a) => editing::serve::run(a),
+        Command::Eval(a) => measure::eval::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
