@@ -71,7 +71,9 @@ fn each_brush_changes_the_terrain_where_painted_and_nowhere_else() {
             let stroke = js(c, &format!("return window.terrasynth.doc.sculpt[{k}]")).await;
             assert_eq!(stroke["brush"], json!(brush), "{stroke}");
             assert!(
-                stroke["targets"]["heights_m"].as_array().is_some_and(|a| !a.is_empty()),
+                stroke["targets"]["heights_m"]
+                    .as_array()
+                    .is_some_and(|a| !a.is_empty()),
                 "the page keeps the baked targets: {stroke}"
             );
             let (mut near, mut near_changed, mut far, mut far_changed) = (0, 0, 0, 0);
@@ -96,9 +98,18 @@ fn each_brush_changes_the_terrain_where_painted_and_nowhere_else() {
             eprintln!(
                 "{brush}: {near_changed} of {near} pixels under the stroke changed (mean {mean:+.1} m); beyond r + {MARGIN}: {far_changed} of {far}, max {far_max:.2} m"
             );
-            assert!(near_changed * 10 > near * 9, "{brush}: {near_changed} of {near} under the stroke changed");
-            assert!((far_changed as f64) < 0.01 * far as f64, "{brush}: {far_changed} of {far} beyond its reach changed");
-            assert!(far_max < 0.01 * relief, "{brush}: {far_max:.1} m beyond its reach");
+            assert!(
+                near_changed * 10 > near * 9,
+                "{brush}: {near_changed} of {near} under the stroke changed"
+            );
+            assert!(
+                (far_changed as f64) < 0.01 * far as f64,
+                "{brush}: {far_changed} of {far} beyond its reach changed"
+            );
+            assert!(
+                far_max < 0.01 * relief,
+                "{brush}: {far_max:.1} m beyond its reach"
+            );
             match *brush {
                 "raise" => assert!(mean > 0.05 * relief, "raise: {mean:+.1} m"),
                 "lower" => assert!(mean < -0.05 * relief, "lower: {mean:+.1} m"),

@@ -98,8 +98,8 @@ pub use sculpt::targets_json;
 pub use window::WindowedScene;
 
 use crate::synth::control::Lift;
-use crate::synth::control::sculpt::{BrushStroke, TargetGrid};
 use crate::synth::control::curve::{CurveSpec, JunctionHeight};
+use crate::synth::control::sculpt::{BrushStroke, TargetGrid};
 use glam::DVec2;
 use std::path::{Path, PathBuf};
 

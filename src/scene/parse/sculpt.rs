@@ -90,7 +90,11 @@ fn grid(r: &Reader, v: &Value, path: &str) -> R<TargetGrid> {
         Some(a) if a.len() == size.0 * size.1 => a,
         _ => {
             let n = size.0 * size.1;
-            return Err(r.invalid(&hp, hv, format!("an array of size[0]·size[1] = {n} heights")));
+            return Err(r.invalid(
+                &hp,
+                hv,
+                format!("an array of size[0]·size[1] = {n} heights"),
+            ));
         }
     };
     let heights_m = heights

@@ -154,7 +154,11 @@ fn blur(v: &[f64], w: usize, h: usize, sigma: f64) -> Vec<f64> {
 /// The target grid of `stroke` painted on `terrain`, over the strokes of
 /// `below`. Deterministic (fixed order f64; heights rounded to 1 cm, the
 /// precision a scene stores).
-pub fn bake(stroke: &BrushStroke, terrain: &Heightfield, below: Option<&SculptLayer>) -> TargetGrid {
+pub fn bake(
+    stroke: &BrushStroke,
+    terrain: &Heightfield,
+    below: Option<&SculptLayer>,
+) -> TargetGrid {
     let step = stroke.brush.step(stroke.radius_px);
     let [bx0, by0, bx1, by1] = capsule_bounds(&stroke.points, stroke.radius_px);
     // Smoothing reads the base beyond the stroke: a margin of nodes.
@@ -178,7 +182,9 @@ pub fn bake(stroke: &BrushStroke, terrain: &Heightfield, below: Option<&SculptLa
             .and_then(|l| l.target(p.x, p.y))
             .unwrap_or_else(|| gauss(terrain, p, sigma))
     };
-    let base: Vec<f64> = (0..ew * eh).map(|k| base_at(node(k % ew, k / ew))).collect();
+    let base: Vec<f64> = (0..ew * eh)
+        .map(|k| base_at(node(k % ew, k / ew)))
+        .collect();
     let aim: Vec<f64> = match stroke.brush {
         Brush::Raise => base.iter().map(|b| b + stroke.strength).collect(),
         Brush::Lower => base.iter().map(|b| b - stroke.strength).collect(),
@@ -222,8 +228,14 @@ fn erode_aim(
     let world = (terrain.width(), terrain.height());
     let [bx0, by0, bx1, by1] = capsule_bounds(&stroke.points, stroke.radius_px);
     let clip = |v: f64, n: usize| (v.max(0.0) as usize).min(n);
-    let (x0, y0) = (clip(bx0.floor() - 2.0, world.0), clip(by0.floor() - 2.0, world.1));
-    let (x1, y1) = (clip(bx1.ceil() + 2.0, world.0), clip(by1.ceil() + 2.0, world.1));
+    let (x0, y0) = (
+        clip(bx0.floor() - 2.0, world.0),
+        clip(by0.floor() - 2.0, world.1),
+    );
+    let (x1, y1) = (
+        clip(bx1.ceil() + 2.0, world.0),
+        clip(by1.ceil() + 2.0, world.1),
+    );
     if x1 <= x0 || y1 <= y0 {
         return base.to_vec();
     }
@@ -266,7 +278,10 @@ mod tests {
         };
         let raised = bake(&s(Brush::Raise, 100.0), &hf, None);
         assert!((raised.at(32.0, 32.0) - (31.5 + 100.0)).abs() < 0.6);
-        assert!((raised.at(16.0, 32.0) - 15.5).abs() < 1.0, "no change at the rim");
+        assert!(
+            (raised.at(16.0, 32.0) - 15.5).abs() < 1.0,
+            "no change at the rim"
+        );
         let flat = bake(&s(Brush::Flatten, 1.0), &hf, None);
         assert!((flat.at(26.0, 32.0) - flat.at(38.0, 32.0)).abs() < 0.5);
         assert_eq!(bake(&s(Brush::Smooth, 1.0), &hf, None).width, raised.width);

@@ -137,7 +137,14 @@ impl SculptLayer {
         let bounds = strokes
             .iter()
             .map(|s| s.bounds())
-            .reduce(|a, b| [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])])
+            .reduce(|a, b| {
+                [
+                    a[0].min(b[0]),
+                    a[1].min(b[1]),
+                    a[2].max(b[2]),
+                    a[3].max(b[3]),
+                ]
+            })
             .expect("non-empty");
         let cells = |a: f64, b: f64| ((b - a) / BUCKET).floor() as usize + 1;
         let (columns, rows) = (cells(bounds[0], bounds[2]), cells(bounds[1], bounds[3]));
@@ -191,7 +198,14 @@ impl SculptLayer {
             .iter()
             .chain(&b[same..])
             .map(|s| s.bounds())
-            .reduce(|a, b| [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])])
+            .reduce(|a, b| {
+                [
+                    a[0].min(b[0]),
+                    a[1].min(b[1]),
+                    a[2].max(b[2]),
+                    a[3].max(b[3]),
+                ]
+            })
     }
 }
 
@@ -217,7 +231,10 @@ impl Constraint for SculptLayer {
             .iter()
             .map(|s| {
                 let [x0, y0, x1, y1] = s.bounds();
-                (x0 - x).max(x - x1).max(0.0).hypot((y0 - y).max(y - y1).max(0.0))
+                (x0 - x)
+                    .max(x - x1)
+                    .max(0.0)
+                    .hypot((y0 - y).max(y - y1).max(0.0))
             })
             .fold(f64::INFINITY, f64::min);
         DISTANCE_PX + gap
@@ -246,7 +263,12 @@ pub struct Within<'a> {
 impl Constraint for Within<'_> {
     fn bounds(&self) -> [f64; 4] {
         let (a, b) = (self.layer.bounds, self.rect);
-        [a[0].max(b[0]), a[1].max(b[1]), a[2].min(b[2]), a[3].min(b[3])]
+        [
+            a[0].max(b[0]),
+            a[1].max(b[1]),
+            a[2].min(b[2]),
+            a[3].min(b[3]),
+        ]
     }
 
     fn sample(&self, x: f64, y: f64) -> Option<Sample> {
