@@ -336,6 +336,36 @@ fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
     assert!((rise(&cli) - strength).abs() < 0.35 * strength);
 }
 
+/// Windows of a sculpted scene are the same bytes as crops of the whole
+/// (`synth --scene --window`): the layer is one more constraint there.
+#[test]
+fn windows_of_a_sculpted_scene_are_crops_of_the_whole() {
+    let Some((db, relief)) = db() else { return };
+    let (_, _, sc) = sculpted(db, &doc_with("raise", (0.1 * relief).round()));
+    let mut edits = SceneEdits::new();
+    let mut session = Session::new(db, SceneEdits::params(&sc), SIZE, SIZE, 5).unwrap();
+    let all = session
+        .apply(edits.edits(&sc, db).unwrap())
+        .unwrap()
+        .heightfield;
+    let ws = terrasynth::scene::WindowedScene::new(&sc, db).unwrap();
+    let synth = terrasynth::synth::Synthesizer::new(db, ws.params()).unwrap();
+    for win in [
+        terrasynth::synth::cone::Rect::new(90, 100, 64, 64),
+        terrasynth::synth::cone::Rect::new(140, 0, 116, 140),
+    ] {
+        let got = ws.synthesize_window(&synth, win).unwrap();
+        let want = all.crop(win.x0, win.y0, win.width(), win.height()).unwrap();
+        assert!(
+            got.data()
+                .iter()
+                .zip(want.data())
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "window {win:?} differs from the crop"
+        );
+    }
+}
+
 #[test]
 fn malformed_sculpt_strokes_are_errors_naming_the_field() {
     let bad = |patch: Value| {

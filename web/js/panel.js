@@ -36,7 +36,7 @@ export class Panel {
     // The controls' counts are in the key: the Scene summary shows them
     // (issue 43: it said "0 freeze strokes" after three).
     const n = (list) => (list || []).length;
-    const counts = [ed.doc.points, ed.doc.curves, ed.doc.pastes, ed.doc.types && ed.doc.types.strokes, ed.doc.freeze && ed.doc.freeze.strokes].map(n);
+    const counts = [ed.doc.points, ed.doc.curves, ed.doc.pastes, ed.doc.types && ed.doc.types.strokes, ed.doc.freeze && ed.doc.freeze.strokes, ed.doc.sculpt].map(n);
     const key = JSON.stringify([t.tool, s, !!t.pending, t.opts, ed.doc.size, (ed.frame && ed.frame.overlay.junctions.length) || 0, counts]);
     if (key !== this.key) {
       this.key = key;
@@ -257,7 +257,7 @@ export class Panel {
       const count = (list, what) => `${(list || []).length} ${what}${(list || []).length === 1 ? '' : 's'}`;
       const strokes = (layer) => layer && layer.strokes;
       return [h('h3', {}, 'Scene'), h('p', { class: 'note' },
-        `${count(doc.points, 'point')}, ${count(doc.curves, 'curve')}, ${count(doc.pastes, 'paste')}; ${count(strokes(doc.types), 'type stroke')}, ${count(strokes(doc.freeze), 'freeze stroke')}. Click a control to edit it.`)];
+        `${count(doc.points, 'point')}, ${count(doc.curves, 'curve')}, ${count(doc.pastes, 'paste')}; ${count(strokes(doc.types), 'type stroke')}, ${count(strokes(doc.freeze), 'freeze stroke')}, ${count(doc.sculpt, 'sculpt stroke')}. Click a control to edit it.`)];
     }
     const del = (label) => h('div', { class: 'buttons' }, h('button', { onclick: () => t.remove() }, label));
     if (s.kind === 'point') {

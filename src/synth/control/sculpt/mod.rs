@@ -118,10 +118,12 @@ pub fn polyline_distance(points: &[DVec2], p: DVec2) -> f64 {
 pub struct SculptLayer {
     strokes: Vec<Arc<SculptStroke>>,
     bounds: [f64; 4],
-    /// Per [`BUCKET`]² cell of `bounds`, the strokes whose capsule box
+    /// Per bucket (a square cell of `bounds`), the strokes whose capsule box
     /// reaches it (ascending), so a sample looks at a few strokes.
     buckets: Vec<Vec<u32>>,
     columns: usize,
+    /// A bucket's side, output pixels ([`BUCKET`] or more).
+    side: f64,
 }
 
 impl PartialEq for SculptLayer {
@@ -146,7 +148,9 @@ impl SculptLayer {
                 ]
             })
             .expect("non-empty");
-        let cells = |a: f64, b: f64| ((b - a) / BUCKET).floor() as usize + 1;
+        // At most ~256 buckets a side, whatever the extent.
+        let side = BUCKET.max((bounds[2] - bounds[0]).max(bounds[3] - bounds[1]) / 256.0);
+        let cells = |a: f64, b: f64| ((b - a) / side).floor() as usize + 1;
         let (columns, rows) = (cells(bounds[0], bounds[2]), cells(bounds[1], bounds[3]));
         let mut buckets = vec![Vec::new(); columns * rows];
         for (k, s) in strokes.iter().enumerate() {
@@ -164,6 +168,7 @@ impl SculptLayer {
             bounds,
             buckets,
             columns,
+            side,
         }
     }
 
@@ -177,8 +182,8 @@ impl SculptLayer {
         if !(x >= bx0 && y >= by0 && x <= bx1 && y <= by1) {
             return None;
         }
-        let c = ((x - bx0) / BUCKET).floor() as usize;
-        let r = ((y - by0) / BUCKET).floor() as usize;
+        let c = ((x - bx0) / self.side).floor() as usize;
+        let r = ((y - by0) / self.side).floor() as usize;
         self.buckets[r * self.columns + c]
             .iter()
             .rev()
