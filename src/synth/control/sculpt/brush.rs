@@ -16,7 +16,8 @@
 //!   w;
 //! - **erode**: towards the terrain eroded by [`crate::erode`] (at
 //!   [`ERODE_FILTER_STRENGTH`]) under the same Gaussian, by strength · w;
-//!   its grid is finer (2 px), since the valleys erosion cuts are narrow.
+//!   its grid is finer (radius/16, at least 2 px), since the valleys
+//!   erosion cuts are narrow.
 
 use super::{SculptLayer, TargetGrid, capsule_bounds, polyline_distance};
 use crate::heightfield::Heightfield;
@@ -26,6 +27,10 @@ use glam::DVec2;
 /// The erosion filter's strength behind the erode brush (its own 0–10
 /// scale; the brush's strength blends towards the result).
 pub const ERODE_FILTER_STRENGTH: f32 = 4.0;
+
+/// Most nodes a baked grid has (~2.5 MB of scene JSON), so that a long,
+/// wide stroke on a large terrain stays a document an editor can send.
+pub const MAX_BAKED_NODES: f64 = 250_000.0;
 
 /// What a stroke does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,12 +72,15 @@ impl Brush {
     }
 
     /// Spacing of its target grid, output pixels: a quarter of the radius
-    /// (2–16 px), 2 px for erosion.
+    /// (2–16 px); for erosion, whose valleys are narrow, a sixteenth (2–16
+    /// px). [`bake`] widens it for a stroke so large that the grid would
+    /// pass [`MAX_BAKED_NODES`].
     pub fn step(self, radius_px: f64) -> f64 {
-        match self {
-            Brush::Erode => 2.0,
-            _ => (radius_px / 4.0).round().clamp(2.0, 16.0),
-        }
+        let share = match self {
+            Brush::Erode => 16.0,
+            _ => 4.0,
+        };
+        (radius_px / share).round().clamp(2.0, 16.0)
     }
 }
 
@@ -103,6 +111,14 @@ impl BrushStroke {
             t * t * (3.0 - 2.0 * t)
         }
     }
+}
+
+/// The node spacing of a stroke's grid: its brush's
+/// [`Brush::step`], widened so the grid has at most [`MAX_BAKED_NODES`].
+pub fn grid_step(stroke: &BrushStroke) -> f64 {
+    let [bx0, by0, bx1, by1] = capsule_bounds(&stroke.points, stroke.radius_px);
+    let area = (bx1 - bx0 + 2.0) * (by1 - by0 + 2.0);
+    (stroke.brush.step(stroke.radius_px)).max((area / MAX_BAKED_NODES).sqrt().ceil())
 }
 
 /// The Gaussian-weighted mean of `hf` around output position `p` (σ in
@@ -159,8 +175,8 @@ pub fn bake(
     terrain: &Heightfield,
     below: Option<&SculptLayer>,
 ) -> TargetGrid {
-    let step = stroke.brush.step(stroke.radius_px);
     let [bx0, by0, bx1, by1] = capsule_bounds(&stroke.points, stroke.radius_px);
+    let step = grid_step(stroke);
     // Smoothing reads the base beyond the stroke: a margin of nodes.
     let margin = match stroke.brush {
         Brush::Smooth => (stroke.radius_px / step).ceil() as usize,
@@ -176,7 +192,9 @@ pub fn bake(
             y0 + (j as f64 - margin as f64) * step,
         )
     };
-    let sigma = step / 2.0;
+    // (At most 8 px: a grid widened for a huge stroke would otherwise
+    // average thousands of pixels per node.)
+    let sigma = (step / 2.0).min(8.0);
     let base_at = |p: DVec2| {
         below
             .and_then(|l| l.target(p.x, p.y))
@@ -285,6 +303,16 @@ mod tests {
         let flat = bake(&s(Brush::Flatten, 1.0), &hf, None);
         assert!((flat.at(26.0, 32.0) - flat.at(38.0, 32.0)).abs() < 0.5);
         assert_eq!(bake(&s(Brush::Smooth, 1.0), &hf, None).width, raised.width);
+        // A stroke across a huge world stays a grid a document can carry.
+        let mut huge = s(Brush::Raise, 10.0);
+        huge.points = vec![DVec2::new(0.0, 0.0), DVec2::new(60000.0, 60000.0)];
+        huge.radius_px = 4096.0;
+        let step = grid_step(&huge);
+        let side = ((60000.0 + 2.0 * 4096.0) / step).ceil() + 1.0;
+        assert!(
+            step > 16.0 && side * side <= MAX_BAKED_NODES * 1.01,
+            "{step} {side}"
+        );
         for b in Brush::ALL {
             assert_eq!(Brush::from_name(b.name()), Some(b));
         }
