@@ -336,6 +336,72 @@ fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
     assert!((rise(&cli) - strength).abs() < 0.35 * strength);
 }
 
+/// `terrasynth edit` bakes a stroke written without targets on the frame
+/// before, as the editor does, and raises the ground there only.
+#[test]
+fn cli_edit_bakes_new_strokes_on_the_frame_before() {
+    let Some((db, relief)) = db() else { return };
+    let relief = *relief;
+    let dir = tempfile::tempdir().unwrap();
+    db.save(&dir.path().join("db.tsdb")).unwrap();
+    let strength = (0.1 * relief).round();
+    let mut base = base_doc();
+    base["database"] = json!("db.tsdb");
+    let mut edit = doc_with("raise", strength);
+    edit["database"] = json!("db.tsdb");
+    std::fs::write(dir.path().join("base.json"), base.to_string()).unwrap();
+    std::fs::write(dir.path().join("e1.json"), edit.to_string()).unwrap();
+    // The same stroke again, and a second one: the first keeps its targets.
+    let mut e2 = edit.clone();
+    let mut second = e2["sculpt"][0].clone();
+    second["points"] = json!([[128, 200]]);
+    e2["sculpt"].as_array_mut().unwrap().push(second);
+    std::fs::write(dir.path().join("e2.json"), e2.to_string()).unwrap();
+    let frames = dir.path().join("frames");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_terrasynth"))
+        .arg("edit")
+        .args([
+            "base.json",
+            "e1.json",
+            "e2.json",
+            "--ext",
+            "tif",
+            "--out-dir",
+        ])
+        .arg(&frames)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let read = |k: usize| {
+        terrasynth::io::read(
+            &frames.join(format!("frame_{k:03}.tif")),
+            &Default::default(),
+        )
+        .unwrap()
+    };
+    let (h0, h1, h2) = (read(0), read(1), read(2));
+    let inner = pixels(|d| d <= RADIUS * (1.0 - FALLOFF));
+    let rise = mean(
+        &(inner.iter())
+            .map(|&(x, y)| (h1.get(x, y) - h0.get(x, y)) as f64)
+            .collect::<Vec<_>>(),
+    );
+    eprintln!("terrasynth edit: raise {strength} m -> {rise:+.1} m under the stroke");
+    assert!((rise - strength).abs() < 0.35 * strength);
+    // Frame 2 re-synthesized only around the second stroke (at y = 200):
+    // the first stroke's ground is as frame 1 left it.
+    let moved = inner
+        .iter()
+        .filter(|&&(x, y)| h1.get(x, y).to_bits() != h2.get(x, y).to_bits())
+        .count();
+    assert_eq!(moved, 0, "{moved} pixels under the first stroke moved");
+}
+
 /// Windows of a sculpted scene are the same bytes as crops of the whole
 /// (`synth --scene --window`): the layer is one more constraint there.
 #[test]

@@ -62,6 +62,21 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// [`Scene::bake_sculpt`] for the next scene of a session (`terrasynth
+    /// edit`): a stroke `prev` has at the same index, as painted, keeps the
+    /// targets it was baked into there; the others are baked against
+    /// `terrain`, the frame `prev` made.
+    pub fn bake_sculpt_over(&mut self, prev: &Scene, terrain: &Heightfield) -> Vec<usize> {
+        for (s, p) in self.sculpt.iter_mut().zip(&prev.sculpt) {
+            if s.targets.is_none() && s.stroke == p.stroke {
+                s.targets = p.targets.clone();
+            }
+        }
+        self.bake_sculpt(terrain)
+    }
+}
+
 /// A baked stroke's `"targets"` as the scene format writes it.
 pub fn targets_json(s: &SculptSpec) -> Value {
     match &s.targets {
