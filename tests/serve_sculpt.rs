@@ -5,7 +5,8 @@
 //! radius + 24 px, fewer than 1 % of the pixels move, by less than 1 % of
 //! the relief); raise and lower move the ground under the stroke up and
 //! down; each stroke's targets are baked into the page's document; undo
-//! takes the last stroke away.
+//! takes the last stroke away. The server's baking and undo are also
+//! tested over the API alone (no browser needed).
 //!
 //! Without chromium and chromedriver the test says so and passes, unless
 //! `TERRASYNTH_REQUIRE_BROWSER` is set.
@@ -25,6 +26,80 @@ fn distance(line: &[(f64, f64)], x: usize, y: usize) -> f64 {
     let p = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let pts: Vec<glam::DVec2> = line.iter().map(|q| glam::DVec2::new(q.0, q.1)).collect();
     terrasynth::synth::control::sculpt::polyline_distance(&pts, p)
+}
+
+/// The server's side, without a browser: a document with a stroke the
+/// page has not baked comes back with its targets (`baked`), the session's
+/// committed document keeps them, the terrain changes under the stroke and
+/// not beyond its reach, undo takes the stroke away, and a malformed
+/// stroke is a 422 naming its field.
+#[test]
+fn the_server_bakes_a_new_stroke_and_undo_removes_it() {
+    use common::editor::{N, create, doc, expect_error, put_scene};
+    let server = editor::serve(N, None, 2);
+    let addr = server.addr;
+    let (s, _) = create(addr);
+    let h0 = heights(addr, &s);
+    let mut d = doc();
+    d["sculpt"] = json!([{"brush": "raise", "points": [[20, 30], [30, 30]], "radius_px": 8, "strength": 200}]);
+    let r = put_scene(addr, &s, &d, true);
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+    let frame = r.json();
+    assert_eq!(frame["baked"][0]["index"], json!(0), "{frame}");
+    let targets = &frame["baked"][0]["targets"];
+    assert!(
+        targets["heights_m"]
+            .as_array()
+            .is_some_and(|a| !a.is_empty()),
+        "{frame}"
+    );
+    let shown = common::http::get(addr, &format!("/api/sessions/{s}")).json();
+    assert_eq!(&shown["scene"]["sculpt"][0]["targets"], targets);
+    let h1 = heights(addr, &s);
+    let line = [(20.0, 30.0), (30.0, 30.0)];
+    let (mut under, mut far) = (Vec::new(), 0);
+    for y in 0..N {
+        for x in 0..N {
+            let d = distance(&line, x, y);
+            let (a, b) = (h0[y * N + x], h1[y * N + x]);
+            if d <= 4.0 {
+                under.push((b - a) as f64);
+            } else if d > 8.0 + MARGIN {
+                far += (a.to_bits() != b.to_bits()) as usize;
+            }
+        }
+    }
+    let mean = under.iter().sum::<f64>() / under.len() as f64;
+    eprintln!(
+        "raise 200 m over the API: {mean:+.1} m under the stroke, {far} pixels beyond its reach changed"
+    );
+    assert!(mean > 100.0, "{mean:+.1} m");
+    assert_eq!(far, 0);
+    let undone = common::http::post(addr, &format!("/api/sessions/{s}/undo"), None).json();
+    assert!(
+        undone["scene"]["sculpt"]
+            .as_array()
+            .is_none_or(|a| a.is_empty()),
+        "{undone}"
+    );
+    // The stroke with its targets (as the page keeps it): nothing to bake.
+    let mut again = d.clone();
+    again["sculpt"][0]["targets"] = targets.clone();
+    let f = put_scene(addr, &s, &again, true).json();
+    assert!(f.get("baked").is_none(), "{f}");
+    // (Re-synthesized after the undo, so not the same bits: raised again.)
+    let h2 = heights(addr, &s);
+    let again_mean = (0..N * N)
+        .filter(|k| distance(&line, k % N, k / N) <= 4.0)
+        .map(|k| (h2[k] - h0[k]) as f64)
+        .sum::<f64>()
+        / under.len() as f64;
+    assert!(again_mean > 100.0, "{again_mean:+.1} m");
+    let mut bad = doc();
+    bad["sculpt"] =
+        json!([{"brush": "sharpen", "points": [[20, 30]], "radius_px": 8, "strength": 1}]);
+    expect_error(&put_scene(addr, &s, &bad, true), 422, "sculpt[0].brush");
+    server.stop();
 }
 
 #[test]
