@@ -126,7 +126,7 @@ fn each_brush_changes_the_terrain_where_painted_and_nowhere_else() {
         click(c, "[data-tool=sculpt]").await;
         js(
             c,
-            &format!("window.terrasynth.tools.opts.sculptRadius = {RADIUS}; return true"),
+            &format!("const o = window.terrasynth.tools.opts; o.sculptRadius = {RADIUS}; o.falloff = 0.5; return true"),
         )
         .await;
         for (k, (brush, line)) in strokes.iter().enumerate() {

@@ -32,7 +32,8 @@ export class Tools {
       sculptRadius: Math.round(side * 0.05),
       // Per brush: metres for raise/lower, a share 0–1 for the others.
       strength: { raise: 150, lower: 150, smooth: 0.8, flatten: 0.8, erode: 1 },
-      falloff: 0.5,
+      // Hills, not mesas: the effect fades over most of the radius.
+      falloff: 0.8,
     };
     this.frozenLayer = document.createElement('canvas');
     this.map.handler = this;
