@@ -2,7 +2,8 @@
 //! re-synthesized coherently with the previous frame.
 //!
 //! Per frame, W⁰ (quarters) is 4 (unweighted) inside the influence of the
-//! constraints, type paint and pastes edited in this step, 1 (coherent,
+//! constraints, type paint and pastes edited in this step (and where a
+//! sculpt edit changed the target), 1 (coherent,
 //! 0.25) elsewhere and 0 where frozen (freezing brush, pasted regions);
 //! W^i follows by `reduce_weights`. The previous frame's per-pass results
 //! are the coherence candidates, and with [`Session::restrict`] only the
