@@ -41,6 +41,7 @@ struct Applied {
     /// the file may have changed.)
     type_strokes: Option<TypePaint>,
     freeze_strokes: Option<Freeze>,
+    sculpt: Vec<SculptSpec>,
 }
 
 /// A stroke form (not an image), which fully determines its raster.
@@ -258,6 +259,12 @@ impl SceneEdits {
         if next.freeze != self.applied.freeze {
             edits.push(Edit::Freeze(next.freeze.clone()));
         }
+
+        // Sculpt strokes: one layer, swapped where its strokes changed.
+        if scene.sculpt != self.applied.sculpt {
+            edits.push(Edit::Sculpt(scene.sculpt_layer()?));
+        }
+        next.sculpt = scene.sculpt.clone();
 
         // Pastes: earlier ones must stay as they were.
         for (i, old) in self.applied.pastes.iter().enumerate() {

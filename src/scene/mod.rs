@@ -55,6 +55,19 @@
 //!                                       // terrain along its lasso (the median step there is 0), then by δ, exactly to the
 //!                                       // lasso; "source" (default in version 1) keeps the source's own heights, δ rising
 //!                                       // over 16 px inside the lasso (synth::control::Lift)
+//!   }],
+//!   "sculpt": [{                        // optional: sculpt brush strokes, painted in order (later over earlier)
+//!     "brush": "raise",                 // "raise", "lower", "smooth", "flatten" or "erode"
+//!     "points": [[300, 300], [340, 310]],  // >= 1, the stroke's polyline
+//!     "radius_px": 40,                  // 0 < r <= 4096
+//!     "strength": 150,                  // raise/lower: metres, 0 < s <= 20000; the others: 0 < s <= 1, the share of the way to the brush's aim
+//!     "falloff": 0.5,                   // optional, 0..=1: the outer share of the radius over which the effect fades
+//!     "targets": {                      // the target heights baked from the terrain the stroke was painted on (the editor writes them)
+//!       "at": [260, 260],               // node (0, 0), output pixels; node (i, j) is at + step·(i, j)
+//!       "step_px": 10,                  // 0 < step <= 256
+//!       "size": [14, 10],               // nodes across, down (each >= 1, at most 1000000 in all)
+//!       "heights_m": [812.5, 813.1]     // size[0]·size[1] heights, row by row, -20000..=20000
+//!     }
 //!   }]
 //! }
 //! ```
@@ -75,15 +88,18 @@ mod error;
 pub mod overlay;
 mod parse;
 mod raster;
+mod sculpt;
 mod window;
 
 pub use controls::{SceneEdits, polygon_centroid};
 pub use error::{SceneError, SceneErrorKind};
 pub use raster::stroke_mask;
+pub use sculpt::targets_json;
 pub use window::WindowedScene;
 
 use crate::synth::control::Lift;
 use crate::synth::control::curve::{CurveSpec, JunctionHeight};
+use crate::synth::control::sculpt::{BrushStroke, TargetGrid};
 use glam::DVec2;
 use std::path::{Path, PathBuf};
 
@@ -110,6 +126,18 @@ pub struct Scene {
     pub types: Option<TypePaint>,
     pub freeze: Option<Freeze>,
     pub pastes: Vec<PasteSpec>,
+    /// Sculpt brush strokes, in order (later ones paint over earlier ones).
+    pub sculpt: Vec<SculptSpec>,
+}
+
+/// A sculpt stroke as written in the scene: the brush as painted and the
+/// target heights it was baked into ([`crate::synth::control::sculpt`]).
+/// `targets` is None only for a stroke an editor has yet to bake: the
+/// synthesis refuses it, naming it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SculptSpec {
+    pub stroke: BrushStroke,
+    pub targets: Option<TargetGrid>,
 }
 
 /// A point constraint as written in the scene.

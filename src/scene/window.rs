@@ -66,6 +66,7 @@ impl WindowedScene {
             match e {
                 Edit::SetConstraint(_, c) => constraints.push(c),
                 Edit::Paste(p) => pastes.push(p),
+                Edit::Sculpt(Some(layer)) => constraints.push(layer as Arc<dyn Constraint>),
                 _ => {}
             }
         }

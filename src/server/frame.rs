@@ -57,6 +57,8 @@ pub struct Editor {
     /// A failed `Session::apply` after `SceneEdits` moved on: the next
     /// document starts a new session.
     stale: bool,
+    /// The sculpt strokes this frame baked (`{index, targets}`).
+    baked: Vec<Value>,
 }
 
 impl Editor {
@@ -87,6 +89,7 @@ impl Editor {
             timing,
             rebuilt: None,
             stale: false,
+            baked: Vec::new(),
         };
         ed.render(true)?;
         Ok(ed)
@@ -95,8 +98,14 @@ impl Editor {
     pub fn run(&mut self, task: Task, waited: Duration) -> Reply {
         let t = Instant::now();
         let with_doc = !matches!(task, Task::Scene { .. });
+        self.baked.clear();
         match task {
-            Task::Scene { doc, scene, commit } => {
+            Task::Scene {
+                mut doc,
+                mut scene,
+                commit,
+            } => {
+                self.baked = self.bake(&mut doc, &mut scene)?;
                 self.show(doc.clone(), *scene)?;
                 if commit {
                     self.history.commit(doc);
@@ -137,6 +146,32 @@ impl Editor {
         }
         self.revision += 1;
         Ok(self.frame_reply(Some(waited), t.elapsed(), with_doc))
+    }
+
+    /// Bakes the sculpt strokes the page has just painted (no targets yet)
+    /// against the terrain shown, into `doc` and `scene`; returns their
+    /// indices and targets for the reply (the page keeps them in its
+    /// document, so later edits and undo carry them).
+    fn bake(&self, doc: &mut Value, scene: &mut Scene) -> Result<Vec<Value>, ApiError> {
+        if scene.sculpt.iter().all(|s| s.targets.is_some()) {
+            return Ok(Vec::new());
+        }
+        let hf = &self.heightfield;
+        if (hf.width(), hf.height()) != (scene.width, scene.height) {
+            return Err(ApiError::invalid(
+                "sculpt",
+                "a new stroke is baked on the terrain shown: change the size or seed in its own edit",
+            ));
+        }
+        let mut out = Vec::new();
+        for i in scene.bake_sculpt(hf) {
+            let targets = crate::scene::targets_json(&scene.sculpt[i]);
+            if let Some(s) = doc.get_mut("sculpt").and_then(|s| s.get_mut(i)) {
+                s["targets"] = targets.clone();
+            }
+            out.push(json!({"index": i, "targets": targets}));
+        }
+        Ok(out)
     }
 
     /// Applies a checked document: as edits of the session, or in a new
@@ -276,6 +311,9 @@ impl Editor {
         });
         if with_doc {
             reply["scene"] = self.doc.clone();
+        }
+        if !self.baked.is_empty() {
+            reply["baked"] = Value::from(self.baked.clone());
         }
         reply
     }

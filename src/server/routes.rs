@@ -22,7 +22,10 @@
 //! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
 //! `timing_ms {queued, edits, synth, render, total}`, `changed {pixels,
 //! bounds}`, `rebuilt`, `heights_m {min, max}`, `overlay {curves,
-//! junctions}`, `view` (and `scene` after undo/redo/create); or
+//! junctions}`, `view` (and `scene` after undo/redo/create; `baked`,
+//! `[{index, targets}]`, when the document had sculpt strokes without
+//! targets: they are baked from the terrain shown, and the page keeps
+//! them); or
 //! `{"superseded": true}` when a newer document replaced it in the queue.
 
 use super::editor::{Handle, Reply, Task};

@@ -2,7 +2,8 @@
 //! re-synthesized coherently with the previous frame.
 //!
 //! Per frame, W⁰ (quarters) is 4 (unweighted) inside the influence of the
-//! constraints, type paint and pastes edited in this step, 1 (coherent,
+//! constraints, type paint and pastes edited in this step (and where a
+//! sculpt edit changed the target), 1 (coherent,
 //! 0.25) elsewhere and 0 where frozen (freezing brush, pasted regions);
 //! W^i follows by `reduce_weights`. The previous frame's per-pass results
 //! are the coherence candidates, and with [`Session::restrict`] only the
@@ -27,6 +28,7 @@ use std::time::Duration;
 use thiserror::Error;
 
 mod guides;
+mod sculpt;
 
 /// Pixels around a paste left unweighted in its step, so it blends in.
 pub const PASTE_MARGIN: f64 = 8.0;
@@ -42,6 +44,9 @@ pub enum Edit {
     /// Replaces the freeze mask; None clears it.
     Freeze(Option<Vec<bool>>),
     Paste(Paste),
+    /// Replaces the sculpt layer (None clears it); only where the old and
+    /// new layers' targets differ is re-synthesized.
+    Sculpt(Option<Arc<super::control::SculptLayer>>),
 }
 
 /// Invalid edits and sessions.
@@ -233,6 +238,7 @@ impl<'db> Session<'db> {
                     self.controls.types = map;
                 }
                 Edit::Freeze(mask) => self.controls.freeze = mask,
+                Edit::Sculpt(layer) => self.sculpt(layer, &mut weights),
                 Edit::Paste(p) => {
                     self.paste(&p, &mut weights);
                     self.controls.pastes.push(p);
@@ -314,7 +320,7 @@ impl<'db> Session<'db> {
             }
         };
         match e {
-            Edit::SetConstraint(..) => Ok(()),
+            Edit::SetConstraint(..) | Edit::Sculpt(_) => Ok(()),
             Edit::RemoveConstraint(id) => match self.controls.constraints.contains_key(id) {
                 true => Ok(()),
                 false => Err(SessionError::NoConstraint(id.0)),

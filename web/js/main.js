@@ -112,6 +112,11 @@ async function showFrame(frame, job) {
   ed.frame = frame;
   ed.revision = frame.revision;
   if (frame.scene) ed.doc = frame.scene;
+  // Sculpt strokes the server baked: their targets join the document.
+  for (const b of frame.baked || []) {
+    const st = (ed.doc.sculpt || [])[b.index];
+    if (st && !st.targets) st.targets = b.targets;
+  }
   ed.map.draw();
   ed.view3d.imageChanged();
   if (job) {
@@ -254,6 +259,14 @@ function scaleDoc(doc, [w, h]) {
       s.radius_px *= f;
     }
   }
+  for (const st of doc.sculpt || []) {
+    st.points = st.points.map(p);
+    st.radius_px *= f;
+    if (st.targets) {
+      st.targets.at = p(st.targets.at);
+      st.targets.step_px *= f;
+    }
+  }
   for (const ps of doc.pastes || []) {
     if (ps.source === 'terrain') ps.lasso = ps.lasso.map(p);
     ps.to = p(ps.to);
@@ -365,7 +378,7 @@ function wireBar() {
       e.preventDefault();
       save();
     } else if (!e.ctrlKey && !e.metaKey && !e.altKey) {
-      const tools = { v: 'select', p: 'point', c: 'curve', t: 'types', f: 'freeze', l: 'lasso', h: 'pan' };
+      const tools = { v: 'select', p: 'point', c: 'curve', t: 'types', f: 'freeze', s: 'sculpt', l: 'lasso', h: 'pan' };
       if (tools[k]) tool(tools[k]);
       else if (k === '0') fit();
       else if (k === '3') show3d(!ed.view3d.shown);

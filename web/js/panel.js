@@ -36,7 +36,7 @@ export class Panel {
     // The controls' counts are in the key: the Scene summary shows them
     // (issue 43: it said "0 freeze strokes" after three).
     const n = (list) => (list || []).length;
-    const counts = [ed.doc.points, ed.doc.curves, ed.doc.pastes, ed.doc.types && ed.doc.types.strokes, ed.doc.freeze && ed.doc.freeze.strokes].map(n);
+    const counts = [ed.doc.points, ed.doc.curves, ed.doc.pastes, ed.doc.types && ed.doc.types.strokes, ed.doc.freeze && ed.doc.freeze.strokes, ed.doc.sculpt].map(n);
     const key = JSON.stringify([t.tool, s, !!t.pending, t.opts, ed.doc.size, (ed.frame && ed.frame.overlay.junctions.length) || 0, counts]);
     if (key !== this.key) {
       this.key = key;
@@ -128,11 +128,41 @@ export class Panel {
         return [h('h3', {}, 'Freeze'), h('div', { class: 'row' }, h('label', {}, 'brush'),
           select({ freeze: 'freeze (lock)', thaw: 'thaw (unlock)' }, o.thaw ? 'thaw' : 'freeze', (v) => { o.thaw = v === 'thaw'; })),
         radius('freezeRadius'), h('p', { class: 'note' }, 'Frozen terrain (blue) keeps its exact heights through later edits.')];
+      case 'sculpt':
+        return this.sculptOptions(select, radius);
       case 'lasso':
         return this.pasteOptions();
       default:
         return [];
     }
+  }
+
+  /** The sculpt brushes: which one, its radius, strength and falloff. */
+  sculptOptions(select, radius) {
+    const ed = this.ed, o = ed.tools.opts;
+    const metres = ['raise', 'lower'].includes(o.brush);
+    const slider = (label, min, max, step, get, set, unit) => {
+      const r = h('input', { type: 'range', min: String(min), max: String(max), step: String(step), value: String(get()) });
+      r.dataset.option = label;
+      const out = h('span', {}, `${get()}${unit}`);
+      r.addEventListener('input', () => {
+        set(Number(r.value));
+        out.textContent = `${get()}${unit}`;
+      });
+      return h('div', { class: 'row' }, h('label', {}, label), r, out);
+    };
+    const relief = Math.max(10, Math.round(ed.range().relief / 2));
+    const brush = select({ raise: 'raise', lower: 'lower', smooth: 'smooth', flatten: 'flatten', erode: 'erode' }, o.brush, (v) => {
+      o.brush = v;
+      this.refresh();
+    });
+    brush.id = 'sculpt-brush';
+    return [h('h3', {}, 'Sculpt'), h('div', { class: 'row' }, h('label', {}, 'brush'), brush), radius('sculptRadius'),
+      metres
+        ? slider('strength', 1, relief, 1, () => o.strength[o.brush], (v) => (o.strength[o.brush] = v), ' m')
+        : slider('strength', 0.05, 1, 0.05, () => o.strength[o.brush], (v) => (o.strength[o.brush] = v), ''),
+      slider('falloff', 0, 1, 0.05, () => o.falloff, (v) => (o.falloff = v), ''),
+      h('p', { class: 'note' }, 'Paint a stroke: raise/lower by metres, smooth, flatten (to the height where the stroke starts) or erode. The stroke becomes a low-frequency target; the synthesis keeps the exemplar\'s texture on it.')];
   }
 
   pasteOptions() {
@@ -227,7 +257,7 @@ export class Panel {
       const count = (list, what) => `${(list || []).length} ${what}${(list || []).length === 1 ? '' : 's'}`;
       const strokes = (layer) => layer && layer.strokes;
       return [h('h3', {}, 'Scene'), h('p', { class: 'note' },
-        `${count(doc.points, 'point')}, ${count(doc.curves, 'curve')}, ${count(doc.pastes, 'paste')}; ${count(strokes(doc.types), 'type stroke')}, ${count(strokes(doc.freeze), 'freeze stroke')}. Click a control to edit it.`)];
+        `${count(doc.points, 'point')}, ${count(doc.curves, 'curve')}, ${count(doc.pastes, 'paste')}; ${count(strokes(doc.types), 'type stroke')}, ${count(strokes(doc.freeze), 'freeze stroke')}, ${count(doc.sculpt, 'sculpt stroke')}. Click a control to edit it.`)];
     }
     const del = (label) => h('div', { class: 'buttons' }, h('button', { onclick: () => t.remove() }, label));
     if (s.kind === 'point') {

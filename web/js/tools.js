@@ -28,6 +28,12 @@ export class Tools {
       freezeRadius: Math.round(side * 0.05),
       thaw: false,
       pasteSource: 'terrain',
+      brush: 'raise',
+      sculptRadius: Math.round(side * 0.05),
+      // Per brush: metres for raise/lower, a share 0–1 for the others.
+      strength: { raise: 150, lower: 150, smooth: 0.8, flatten: 0.8, erode: 1 },
+      // Hills, not mesas: the effect fades over most of the radius.
+      falloff: 0.8,
     };
     this.frozenLayer = document.createElement('canvas');
     this.map.handler = this;
@@ -61,6 +67,7 @@ export class Tools {
     D.drawPending(ctx, map, ed, this.pending);
     if (this.tool === 'types') D.drawBrush(ctx, map, this.cursor, this.opts.typeRadius);
     if (this.tool === 'freeze') D.drawBrush(ctx, map, this.cursor, this.opts.freezeRadius);
+    if (this.tool === 'sculpt') D.drawBrush(ctx, map, this.cursor, this.opts.sculptRadius);
   }
 
   /**
@@ -156,7 +163,7 @@ export class Tools {
 
   down(p, e) {
     const ed = this.ed;
-    const h = this.hit(p, !['types', 'freeze', 'lasso'].includes(this.tool));
+    const h = this.hit(p, !['types', 'freeze', 'lasso', 'sculpt'].includes(this.tool));
     const draggable = h && !['curve', 'paste', 'junction'].includes(h.kind);
     if (h && (draggable || this.tool === 'select' || this.tool === 'point')) {
       if (h.kind === 'curve' && e.shiftKey) return this.addWidget(h);
@@ -184,6 +191,9 @@ export class Tools {
       case 'types':
       case 'freeze':
         this.startBrush(p);
+        break;
+      case 'sculpt':
+        this.stroke = { points: [p], radius: this.opts.sculptRadius, colour: 'rgba(255,170,60,0.5)', sculpt: true };
         break;
       case 'lasso':
         if (this.opts.pasteSource === 'terrain') {
@@ -223,7 +233,7 @@ export class Tools {
     const hm = this.ed.heightAt(p);
     document.getElementById('status-cursor').textContent =
       `(${Math.round(p[0])}, ${Math.round(p[1])})${hm != null ? ` ${Math.round(hm)} m` : ''}`;
-    if (this.tool === 'types' || this.tool === 'freeze') this.map.redraw();
+    if (['types', 'freeze', 'sculpt'].includes(this.tool)) this.map.redraw();
   }
 
   up(p) {
@@ -239,6 +249,7 @@ export class Tools {
     if (!s) return;
     this.stroke = null;
     if (s.layer) return this.updateBrush(true);
+    if (s.sculpt) return this.finishSculpt(s);
     if (this.tool === 'curve') this.finishCurve(s.points, p);
     else if (this.tool === 'lasso') this.finishLasso(s.points);
     this.map.redraw();
@@ -354,6 +365,23 @@ export class Tools {
     if (commit) this.ed.refresh();
   }
 
+  /**
+   * A sculpt stroke, sent without targets: the server bakes them from the
+   * terrain shown and the frame brings them back (`baked`), so the
+   * document keeps them.
+   */
+  finishSculpt(s) {
+    const o = this.opts;
+    const item = {
+      brush: o.brush,
+      points: g.thin(s.points, Math.max(1, s.radius / 3)).map(g.r1p),
+      radius_px: s.radius,
+      strength: o.strength[o.brush],
+      falloff: o.falloff,
+    };
+    this.ed.change((d) => (d.sculpt = (d.sculpt || []).concat([item])), { kind: 'sculpt' });
+  }
+
   finishCurve(pts, end) {
     const ed = this.ed, doc = ed.doc;
     if (pts.length < 2 || g.dist(pts[0], end) + g.arcLengths(pts).pop() < this.map.px(6)) {
@@ -455,7 +483,7 @@ export class Tools {
     else if (e.key === 'Enter') this.applyPaste();
     else if (e.key === '[' || e.key === ']') {
       const k = e.key === ']' ? 1.25 : 0.8;
-      const key = this.tool === 'freeze' ? 'freezeRadius' : 'typeRadius';
+      const key = { freeze: 'freezeRadius', sculpt: 'sculptRadius' }[this.tool] || 'typeRadius';
       this.opts[key] = Math.max(1, Math.min(4096, Math.round(this.opts[key] * k)));
       this.ed.panel.refresh();
       this.map.redraw();

@@ -6,6 +6,7 @@
 mod constraints;
 mod paint;
 mod reader;
+mod sculpt;
 
 use super::*;
 use reader::{R, Range, Reader, join};
@@ -32,6 +33,7 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
             "types",
             "freeze",
             "pastes",
+            "sculpt",
         ],
     )?;
     let version = match m.get("version") {
@@ -100,6 +102,7 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
     let types = paint::types(&d)?;
     let freeze = paint::freeze(&d)?;
     let pastes = paint::pastes(&d, &mut ids)?;
+    let sculpt = sculpt::sculpt(&d)?;
 
     Ok(Scene {
         file: file.to_path_buf(),
@@ -116,6 +119,7 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         types,
         freeze,
         pastes,
+        sculpt,
     })
 }
 

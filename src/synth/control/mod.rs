@@ -15,10 +15,12 @@ pub mod blend;
 pub mod curve;
 pub mod lift;
 pub mod point;
+pub mod sculpt;
 
 pub use blend::{Blend, Targets};
 pub use lift::Lift;
 pub use point::PointConstraint;
+pub use sculpt::SculptLayer;
 
 use thiserror::Error;
 
@@ -144,6 +146,8 @@ pub struct Controls {
     pub freeze: Option<Vec<bool>>,
     /// Pastes applied so far, in order (each stays frozen).
     pub pastes: Vec<Paste>,
+    /// The sculpt brushes' strokes ([`sculpt`]); None = nothing sculpted.
+    pub sculpt: Option<std::sync::Arc<SculptLayer>>,
 }
 
 /// Width of a [`Lift::Source`] paste's height feather, output pixels: δ

@@ -140,12 +140,18 @@ pub fn run(a: Args) -> CliResult {
         .chain(a.edits.iter().cloned())
         .collect();
     let mut prev: Option<terrasynth::Heightfield> = None;
+    let mut prev_scene: Option<Scene> = None;
     for (k, file) in files.iter().enumerate() {
-        let scene = if k == 0 {
+        let mut scene = if k == 0 {
             base.clone()
         } else {
             Scene::read(file)?
         };
+        // Sculpt strokes written without targets are baked on the frame
+        // before, as the editor bakes them on the terrain shown.
+        if let (Some(p), Some(hf)) = (&prev_scene, session.heightfield()) {
+            scene.bake_sculpt_over(p, hf);
+        }
         let list = edits.edits(&scene, &db)?;
         let n_edits = list.len();
         let frame = session.apply(list)?;
@@ -201,6 +207,7 @@ pub fn run(a: Args) -> CliResult {
         }
         report.push(entry);
         prev = Some(frame.heightfield);
+        prev_scene = Some(scene);
     }
     let path = a.out_dir.join("report.json");
     let text = serde_json::to_string_pretty(&serde_json::json!({ "frames": report }))?;
