@@ -6,33 +6,13 @@
 
 use serde_json::json;
 use std::path::Path;
-use std::sync::OnceLock;
-use terrasynth::database::{BuildOptions, Database};
-use terrasynth::progress::Silent;
 use terrasynth::scene::{Scene, SceneEdits};
 use terrasynth::synth::control::Constraint;
 use terrasynth::synth::session::{Edit, Session};
 
 mod common;
-use common::dem;
+use common::db::pyrenees_crop;
 const SIZE: usize = 256;
-
-/// A 320² crop of the Pyrenees DEM (alpine relief, 92.6 m cells) with its
-/// type mask; `None` when the shared DEMs are absent.
-fn db() -> Option<&'static (Database, f64, f64)> {
-    static DB: OnceLock<Option<(Database, f64, f64)>> = OnceLock::new();
-    DB.get_or_init(|| {
-        let input = dem::exemplar("pyrenees_andorra", (300, 250, 320, 320), true)?;
-        let s = input.heights.stats().unwrap();
-        let opts = BuildOptions {
-            levels: 5,
-            ..Default::default()
-        };
-        let (db, _) = terrasynth::database::build(vec![input], &opts, &Silent).unwrap();
-        Some((db, s.min as f64, s.max as f64))
-    })
-    .as_ref()
-}
 
 fn scene(v: serde_json::Value) -> Scene {
     Scene::parse(v.to_string().as_bytes(), Path::new("test.json")).unwrap()
@@ -55,7 +35,9 @@ fn curve_scene(lo: f64, hi: f64, mid_height: f64) -> serde_json::Value {
 
 #[test]
 fn curve_height_profile_follows_the_widgets_on_a_real_dem() {
-    let Some((db, lo, hi)) = db() else { return };
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
     let relief = hi - lo;
     let sc = scene(curve_scene(*lo, *hi, lo + 0.6 * relief));
     let mut edits = SceneEdits::new();
@@ -163,7 +145,9 @@ fn curve_height_profile_follows_the_widgets_on_a_real_dem() {
 /// side, falling at 45° on its right, 92.6 m cells.
 #[test]
 fn a_one_sided_cliff_is_steep_and_its_top_edge_holds() {
-    let Some((db, lo, hi)) = db() else { return };
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
     let relief = hi - lo;
     let (top, reach) = (lo + 0.75 * relief, 10.0);
     let sc = scene(json!({
@@ -203,7 +187,9 @@ fn a_one_sided_cliff_is_steep_and_its_top_edge_holds() {
 
 #[test]
 fn a_second_scene_only_resets_what_changed_and_stays_local() {
-    let Some((db, lo, hi)) = db() else { return };
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
     let relief = hi - lo;
     let base = scene(curve_scene(*lo, *hi, lo + 0.6 * relief));
     let moved = scene(curve_scene(*lo, *hi, lo + 0.75 * relief));
@@ -294,7 +280,9 @@ fn a_second_scene_only_resets_what_changed_and_stays_local() {
 
 #[test]
 fn cli_synth_scene_and_edit_write_frames_previews_and_a_report() {
-    let Some((db, lo, hi)) = db() else { return };
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     db.save(&dir.path().join("db.tsdb")).unwrap();
     let relief = hi - lo;
@@ -394,7 +382,9 @@ fn cli_synth_scene_and_edit_write_frames_previews_and_a_report() {
 
 #[test]
 fn overlays_draw_curves_widgets_points_types_and_frozen_regions() {
-    let Some((db, lo, hi)) = db() else { return };
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
     let mut v = curve_scene(*lo, *hi, lo + 0.6 * (hi - lo));
     v["freeze"] = json!({"strokes": [{"points": [[200, 40]], "radius_px": 12}]});
     v["types"] = json!({"strokes": [{"type": db.type_names()[0].clone(), "points": [[40, 230]], "radius_px": 10}]});

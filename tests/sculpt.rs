@@ -11,16 +11,14 @@
 use glam::DVec2;
 use serde_json::{Value, json};
 use std::path::Path;
-use std::sync::OnceLock;
 use terrasynth::Heightfield;
-use terrasynth::database::{BuildOptions, Database};
-use terrasynth::progress::Silent;
+use terrasynth::database::Database;
 use terrasynth::scene::{Scene, SceneEdits, targets_json};
 use terrasynth::synth::control::sculpt::polyline_distance;
 use terrasynth::synth::session::Session;
 
 mod common;
-use common::dem;
+use common::db::pyrenees_crop;
 
 const SIZE: usize = 256;
 const RADIUS: f64 = 32.0;
@@ -29,22 +27,6 @@ const FALLOFF: f64 = 0.5;
 /// its reach" (the synthesis's neighbourhoods and coherence carry a change
 /// a little past the pixels whose target changed).
 const MARGIN: f64 = 24.0;
-
-/// A 320² crop of the Pyrenees DEM (92.6 m cells), as in scene_session.rs.
-fn db() -> Option<&'static (Database, f64)> {
-    static DB: OnceLock<Option<(Database, f64)>> = OnceLock::new();
-    DB.get_or_init(|| {
-        let input = dem::exemplar("pyrenees_andorra", (300, 250, 320, 320), true)?;
-        let s = input.heights.stats().unwrap();
-        let opts = BuildOptions {
-            levels: 5,
-            ..Default::default()
-        };
-        let (db, _) = terrasynth::database::build(vec![input], &opts, &Silent).unwrap();
-        Some((db, (s.max - s.min) as f64))
-    })
-    .as_ref()
-}
 
 fn base_doc() -> Value {
     json!({"version": 2, "size": [SIZE, SIZE], "seed": 5})
@@ -194,8 +176,10 @@ fn check_common(e: &Effect, relief: f64) {
 
 #[test]
 fn raise_and_lower_move_the_ground_by_their_strength_and_only_there() {
-    let Some((db, relief)) = db() else { return };
-    let relief = *relief;
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
+    let relief = hi - lo;
     let strength = (0.1 * relief).round();
     for (brush, sign) in [("raise", 1.0), ("lower", -1.0)] {
         let (h0, h1, _) = sculpted(db, &doc_with(brush, strength));
@@ -215,8 +199,10 @@ fn raise_and_lower_move_the_ground_by_their_strength_and_only_there() {
 
 #[test]
 fn flatten_and_smooth_reduce_the_relief_under_the_stroke_but_keep_its_texture() {
-    let Some((db, relief)) = db() else { return };
-    let relief = *relief;
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
+    let relief = hi - lo;
     for brush in ["flatten", "smooth"] {
         let (h0, h1, _) = sculpted(db, &doc_with(brush, 1.0));
         let e = effect(brush, &h0, &h1);
@@ -238,8 +224,10 @@ fn flatten_and_smooth_reduce_the_relief_under_the_stroke_but_keep_its_texture() 
 
 #[test]
 fn erode_moves_the_ground_towards_the_eroded_terrain() {
-    let Some((db, relief)) = db() else { return };
-    let relief = *relief;
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
+    let relief = hi - lo;
     let (h0, h1, _) = sculpted(db, &doc_with("erode", 1.0));
     let e = effect("erode", &h0, &h1);
     let eroded = terrasynth::erode::erode(
@@ -279,8 +267,10 @@ fn erode_moves_the_ground_towards_the_eroded_terrain() {
 
 #[test]
 fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
-    let Some((db, relief)) = db() else { return };
-    let relief = *relief;
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
+    let relief = hi - lo;
     let dir = tempfile::tempdir().unwrap();
     db.save(&dir.path().join("db.tsdb")).unwrap();
     let strength = (0.1 * relief).round();
@@ -340,8 +330,10 @@ fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
 /// before, as the editor does, and raises the ground there only.
 #[test]
 fn cli_edit_bakes_new_strokes_on_the_frame_before() {
-    let Some((db, relief)) = db() else { return };
-    let relief = *relief;
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
+    let relief = hi - lo;
     let dir = tempfile::tempdir().unwrap();
     db.save(&dir.path().join("db.tsdb")).unwrap();
     let strength = (0.1 * relief).round();
@@ -406,7 +398,10 @@ fn cli_edit_bakes_new_strokes_on_the_frame_before() {
 /// (`synth --scene --window`): the layer is one more constraint there.
 #[test]
 fn windows_of_a_sculpted_scene_are_crops_of_the_whole() {
-    let Some((db, relief)) = db() else { return };
+    let Some((db, lo, hi)) = pyrenees_crop() else {
+        return;
+    };
+    let relief = hi - lo;
     let (_, _, sc) = sculpted(db, &doc_with("raise", (0.1 * relief).round()));
     let mut edits = SceneEdits::new();
     let mut session = Session::new(db, SceneEdits::params(&sc), SIZE, SIZE, 5).unwrap();

@@ -12,6 +12,24 @@ use terrasynth::progress::Silent;
 
 use super::dem::{self, DEM};
 
+/// A 320² crop of the Pyrenees DEM (alpine relief, 92.6 m cells) with its
+/// type mask, 5 levels, and its lowest and highest heights (m); `None` when
+/// the shared DEMs are absent. The scene, session and sculpt tests' terrain.
+pub fn pyrenees_crop() -> Option<&'static (Database, f64, f64)> {
+    static DB: OnceLock<Option<(Database, f64, f64)>> = OnceLock::new();
+    DB.get_or_init(|| {
+        let input = dem::exemplar("pyrenees_andorra", (300, 250, 320, 320), true)?;
+        let s = input.heights.stats().unwrap();
+        let opts = BuildOptions {
+            levels: 5,
+            ..Default::default()
+        };
+        let (db, _) = database::build(vec![input], &opts, &Silent).unwrap();
+        Some((db, s.min as f64, s.max as f64))
+    })
+    .as_ref()
+}
+
 /// The embedded default database, built once per test binary.
 pub fn default_db() -> &'static Database {
     static DB: OnceLock<Database> = OnceLock::new();

@@ -147,14 +147,7 @@ impl SculptLayer {
         let bounds = strokes
             .iter()
             .map(|s| s.bounds())
-            .reduce(|a, b| {
-                [
-                    a[0].min(b[0]),
-                    a[1].min(b[1]),
-                    a[2].max(b[2]),
-                    a[3].max(b[3]),
-                ]
-            })
+            .reduce(union)
             .expect("non-empty");
         // At most ~256 buckets a side, whatever the extent.
         let side = BUCKET.max((bounds[2] - bounds[0]).max(bounds[3] - bounds[1]) / 256.0);
@@ -211,14 +204,7 @@ impl SculptLayer {
             .iter()
             .chain(&b[same..])
             .map(|s| s.bounds())
-            .reduce(|a, b| {
-                [
-                    a[0].min(b[0]),
-                    a[1].min(b[1]),
-                    a[2].max(b[2]),
-                    a[3].max(b[3]),
-                ]
-            })
+            .reduce(union)
     }
 }
 
@@ -298,6 +284,16 @@ impl Constraint for Within<'_> {
     fn hold(&self) -> Hold {
         self.layer.hold()
     }
+}
+
+/// The smallest box `[x0, y0, x1, y1]` holding boxes `a` and `b`.
+fn union(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0].min(b[0]),
+        a[1].min(b[1]),
+        a[2].max(b[2]),
+        a[3].max(b[3]),
+    ]
 }
 
 #[cfg(test)]
