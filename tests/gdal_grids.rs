@@ -32,6 +32,23 @@ def heights(w, h):
     return (z + 1000).astype(np.float32)
 "#;
 
+/// GDAL writes a 64×48 Float32 GeoTIFF of [`HEIGHTS`] in `crs` (any
+/// `SetFromUserInput` text), 30-unit cells, top-left corner `origin`.
+fn gdal_writes_64x48(path: &Path, crs: &str, origin: [f64; 2]) {
+    gdal_python(&format!(
+        r#"{HEIGHTS}
+from osgeo import gdal, osr
+srs = osr.SpatialReference(); srs.SetFromUserInput('{crs}')
+ds = gdal.GetDriverByName('GTiff').Create('{f}', 64, 48, 1, gdal.GDT_Float32)
+ds.SetGeoTransform([{x}, 30.0, 0, {y}, 0, -30.0]); ds.SetSpatialRef(srs)
+ds.GetRasterBand(1).WriteArray(heights(64, 48)); ds = None
+"#,
+        f = s(path),
+        x = origin[0],
+        y = origin[1]
+    ));
+}
+
 /// A GLO-90-style tile (4.5″ east–west × 3″ north–south, pixel-is-point as
 /// Copernicus writes it) is resampled to square cells that match GDAL's own
 /// bilinear warp of the same file to the same grid within float rounding —
@@ -100,16 +117,7 @@ fn us_survey_feet_keep_their_origin() {
     }
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("ftus.tif");
-    gdal_python(&format!(
-        r#"{HEIGHTS}
-from osgeo import gdal, osr
-srs = osr.SpatialReference(); srs.ImportFromEPSG(2263)
-ds = gdal.GetDriverByName('GTiff').Create('{f}', 64, 48, 1, gdal.GDT_Float32)
-ds.SetGeoTransform([1000000.0, 30.0, 0, 250000.0, 0, -30.0]); ds.SetProjection(srs.ExportToWkt())
-ds.GetRasterBand(1).WriteArray(heights(64, 48)); ds = None
-"#,
-        f = s(&input)
-    ));
+    gdal_writes_64x48(&input, "EPSG:2263", [1_000_000.0, 250_000.0]);
     let hf = io::load(&input, &ReadOptions::default())
         .unwrap()
         .heightfield;
@@ -162,16 +170,7 @@ fn compound_crs_is_written_back_as_gdal_writes_it() {
     }
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("compound.tif");
-    gdal_python(&format!(
-        r#"{HEIGHTS}
-from osgeo import gdal, osr
-srs = osr.SpatialReference(); srs.SetFromUserInput('EPSG:32633+3855')
-ds = gdal.GetDriverByName('GTiff').Create('{f}', 64, 48, 1, gdal.GDT_Float32)
-ds.SetGeoTransform([500000.0, 30.0, 0, 5000000.0, 0, -30.0]); ds.SetSpatialRef(srs)
-ds.GetRasterBand(1).WriteArray(heights(64, 48)); ds = None
-"#,
-        f = s(&input)
-    ));
+    gdal_writes_64x48(&input, "EPSG:32633+3855", [500_000.0, 5_000_000.0]);
     let hf = io::load(&input, &ReadOptions::default())
         .unwrap()
         .heightfield;

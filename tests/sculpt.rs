@@ -28,6 +28,11 @@ const FALLOFF: f64 = 0.5;
 /// a little past the pixels whose target changed).
 const MARGIN: f64 = 24.0;
 
+/// The Pyrenees crop's database and relief (m).
+fn db() -> Option<(&'static Database, f64)> {
+    pyrenees_crop().map(|(db, lo, hi)| (db, hi - lo))
+}
+
 fn base_doc() -> Value {
     json!({"version": 2, "size": [SIZE, SIZE], "seed": 5})
 }
@@ -176,10 +181,7 @@ fn check_common(e: &Effect, relief: f64) {
 
 #[test]
 fn raise_and_lower_move_the_ground_by_their_strength_and_only_there() {
-    let Some((db, lo, hi)) = pyrenees_crop() else {
-        return;
-    };
-    let relief = hi - lo;
+    let Some((db, relief)) = db() else { return };
     let strength = (0.1 * relief).round();
     for (brush, sign) in [("raise", 1.0), ("lower", -1.0)] {
         let (h0, h1, _) = sculpted(db, &doc_with(brush, strength));
@@ -199,10 +201,7 @@ fn raise_and_lower_move_the_ground_by_their_strength_and_only_there() {
 
 #[test]
 fn flatten_and_smooth_reduce_the_relief_under_the_stroke_but_keep_its_texture() {
-    let Some((db, lo, hi)) = pyrenees_crop() else {
-        return;
-    };
-    let relief = hi - lo;
+    let Some((db, relief)) = db() else { return };
     for brush in ["flatten", "smooth"] {
         let (h0, h1, _) = sculpted(db, &doc_with(brush, 1.0));
         let e = effect(brush, &h0, &h1);
@@ -224,10 +223,7 @@ fn flatten_and_smooth_reduce_the_relief_under_the_stroke_but_keep_its_texture() 
 
 #[test]
 fn erode_moves_the_ground_towards_the_eroded_terrain() {
-    let Some((db, lo, hi)) = pyrenees_crop() else {
-        return;
-    };
-    let relief = hi - lo;
+    let Some((db, relief)) = db() else { return };
     let (h0, h1, _) = sculpted(db, &doc_with("erode", 1.0));
     let e = effect("erode", &h0, &h1);
     let eroded = terrasynth::erode::erode(
@@ -267,10 +263,7 @@ fn erode_moves_the_ground_towards_the_eroded_terrain() {
 
 #[test]
 fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
-    let Some((db, lo, hi)) = pyrenees_crop() else {
-        return;
-    };
-    let relief = hi - lo;
+    let Some((db, relief)) = db() else { return };
     let dir = tempfile::tempdir().unwrap();
     db.save(&dir.path().join("db.tsdb")).unwrap();
     let strength = (0.1 * relief).round();
@@ -330,10 +323,7 @@ fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
 /// before, as the editor does, and raises the ground there only.
 #[test]
 fn cli_edit_bakes_new_strokes_on_the_frame_before() {
-    let Some((db, lo, hi)) = pyrenees_crop() else {
-        return;
-    };
-    let relief = hi - lo;
+    let Some((db, relief)) = db() else { return };
     let dir = tempfile::tempdir().unwrap();
     db.save(&dir.path().join("db.tsdb")).unwrap();
     let strength = (0.1 * relief).round();
@@ -398,10 +388,7 @@ fn cli_edit_bakes_new_strokes_on_the_frame_before() {
 /// (`synth --scene --window`): the layer is one more constraint there.
 #[test]
 fn windows_of_a_sculpted_scene_are_crops_of_the_whole() {
-    let Some((db, lo, hi)) = pyrenees_crop() else {
-        return;
-    };
-    let relief = hi - lo;
+    let Some((db, relief)) = db() else { return };
     let (_, _, sc) = sculpted(db, &doc_with("raise", (0.1 * relief).round()));
     let mut edits = SceneEdits::new();
     let mut session = Session::new(db, SceneEdits::params(&sc), SIZE, SIZE, 5).unwrap();
