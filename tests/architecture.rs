@@ -1,7 +1,9 @@
 //! `docs/ARCHITECTURE.md` stays true (issue 42): its folder tree names
-//! every folder of the repository and no folder that is gone, and the
-//! stage rule it states — no stage imports another stage — holds in
-//! `src/stages/`. A moved or added folder, or a stage reaching into
+//! every folder of the repository and no folder that is gone, its module
+//! floors hold (every top-level module on one line, importing only from
+//! its own line or those above), and the stage rule it states — no stage
+//! imports another stage — holds in `src/stages/`. A moved or added
+//! folder or module, an import up the floors, or a stage reaching into
 //! another, fails here until the map says so.
 
 use std::collections::BTreeSet;
@@ -158,4 +160,114 @@ fn no_stage_imports_another_stage() {
             }
         }
     }
+}
+
+/// The map's module floors: line number → its modules (the bold
+/// `**`name`**` of each numbered item of "Module floors").
+fn floors() -> Vec<(usize, String)> {
+    let doc = architecture();
+    let section = doc
+        .split("## Module floors")
+        .nth(1)
+        .and_then(|s| s.split("\n## ").next())
+        .expect("a \"Module floors\" section");
+    let mut out = Vec::new();
+    let mut line = 0;
+    for text in section.lines() {
+        if let Some((n, _)) = text.split_once(". ")
+            && let Ok(n) = n.parse::<usize>()
+        {
+            line = n;
+        }
+        for bold in text.split("**`").skip(1) {
+            if let Some((name, _)) = bold.split_once("`**") {
+                out.push((line, name.to_owned()));
+            }
+        }
+    }
+    out
+}
+
+/// The crate's top-level modules a source text names as `crate::<module>`
+/// (also inside `use crate::{a, b::c}` groups); comments skipped.
+fn crate_modules(text: &str) -> BTreeSet<String> {
+    let code: String = text
+        .lines()
+        .map(|l| l.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let ident = |s: &str| -> String {
+        s.trim_start()
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut out = BTreeSet::new();
+    for rest in code.split("crate::").skip(1) {
+        if let Some(group) = rest.strip_prefix('{') {
+            // Top-level entries of the group: split at commas of depth 0.
+            let (mut depth, mut start) = (0, 0);
+            for (i, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        out.insert(ident(&group[start..i]));
+                        break;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        out.insert(ident(&group[start..i]));
+                        start = i + 1;
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            out.insert(ident(rest));
+        }
+    }
+    out.remove("");
+    out
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn every_module_imports_only_from_its_floor_or_below() {
+    let floors = floors();
+    let floor = |m: &str| floors.iter().find(|(_, n)| n == m).map(|(l, _)| *l);
+    assert!(floors.len() >= 25, "{floors:?}");
+    let src = root().join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut broken = Vec::new();
+    for f in files {
+        let rel = f.strip_prefix(&src).unwrap();
+        let top = rel.iter().next().unwrap().to_string_lossy();
+        let top = top.trim_end_matches(".rs");
+        if top == "lib" || top == "bin" {
+            continue;
+        }
+        let own = floor(top).unwrap_or_else(|| panic!("src/{top} is on no line of the floors"));
+        for m in crate_modules(&fs::read_to_string(&f).unwrap()) {
+            match floor(&m) {
+                Some(l) if l > own => broken.push(format!(
+                    "src/{} (line {own}) imports `{m}` (line {l})",
+                    rel.display()
+                )),
+                // Items of lib.rs itself (`crate::Heightfield`) are no module.
+                _ => {}
+            }
+        }
+    }
+    assert!(broken.is_empty(), "{broken:#?}");
 }

@@ -226,11 +226,8 @@ fn erode_moves_the_ground_towards_the_eroded_terrain() {
     let Some((db, relief)) = db() else { return };
     let (h0, h1, _) = sculpted(db, &doc_with("erode", 1.0));
     let e = effect("erode", &h0, &h1);
-    let eroded = terrasynth::erode::erode(
-        &h0,
-        terrasynth::synth::control::sculpt::brush::ERODE_FILTER_STRENGTH,
-    )
-    .unwrap();
+    let eroded =
+        terrasynth::erode::erode(&h0, terrasynth::scene::bake::ERODE_FILTER_STRENGTH).unwrap();
     // At the scale of the brush's targets and above: the means over 9×9.
     let gap = |hf: &Heightfield| {
         let d: Vec<f64> = (e.inner.iter())

@@ -83,6 +83,7 @@
 //! [`Scene::freeze_raster`] read the referenced images and check them
 //! against the scene and the database.
 
+pub mod bake;
 mod controls;
 mod error;
 pub mod overlay;

@@ -2,10 +2,11 @@
 //! strokes an editor has just painted (their targets from the terrain
 //! shown) into the document it stores.
 
+use super::bake::bake;
 use super::*;
 use crate::heightfield::Heightfield;
 use crate::synth::control::SculptLayer;
-use crate::synth::control::sculpt::{SculptStroke, bake};
+use crate::synth::control::sculpt::SculptStroke;
 use serde_json::{Value, json};
 use std::sync::Arc;
 

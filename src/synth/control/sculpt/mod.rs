@@ -6,7 +6,7 @@
 //!
 //! A stroke is a polyline with a radius and a grid of target heights
 //! ([`TargetGrid`], baked once from the terrain it was painted on by
-//! [`brush::bake`] and stored in the scene), so a scene reproduces its
+//! `scene::bake` and stored in the scene), so a scene reproduces its
 //! sculpt without the live terrain. The strokes of a scene form one
 //! [`SculptLayer`]: at a position the last stroke that covers it sets the
 //! target (later strokes paint over earlier ones, as type paint does). The
@@ -39,7 +39,7 @@ use crate::synth::control::curve::segments::closest_param;
 use glam::DVec2;
 use std::sync::Arc;
 
-pub use brush::{Brush, BrushStroke, bake};
+pub use brush::{Brush, BrushStroke};
 
 /// The distance every sculpted pixel reports to the blend, output pixels.
 pub const DISTANCE_PX: f64 = 4.0;
