@@ -33,6 +33,13 @@ fn db() -> Option<(&'static Database, f64)> {
     pyrenees_crop().map(|(db, lo, hi)| (db, hi - lo))
 }
 
+/// A temporary folder holding `db` as `db.tsdb`, for scene files that name it.
+fn saved(db: &Database) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    db.save(&dir.path().join("db.tsdb")).unwrap();
+    dir
+}
+
 fn base_doc() -> Value {
     json!({"version": 2, "size": [SIZE, SIZE], "seed": 5})
 }
@@ -261,8 +268,7 @@ fn erode_moves_the_ground_towards_the_eroded_terrain() {
 #[test]
 fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
     let Some((db, relief)) = db() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    db.save(&dir.path().join("db.tsdb")).unwrap();
+    let dir = saved(db);
     let strength = (0.1 * relief).round();
     let (h0, h1, sc) = sculpted(db, &doc_with("raise", strength));
     let mut doc = doc_with("raise", strength);
@@ -321,8 +327,7 @@ fn synth_scene_gives_the_editors_terrain_from_the_file_alone() {
 #[test]
 fn cli_edit_bakes_new_strokes_on_the_frame_before() {
     let Some((db, relief)) = db() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    db.save(&dir.path().join("db.tsdb")).unwrap();
+    let dir = saved(db);
     let strength = (0.1 * relief).round();
     let mut base = base_doc();
     base["database"] = json!("db.tsdb");

@@ -155,6 +155,18 @@ pub fn gdal_python(script: &str) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// Every `.rs` file under `dir`.
+pub fn rust_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
 /// Pearson's correlation of pairs.
 pub fn correlation(p: &[(f64, f64)]) -> f64 {
     let n = p.len() as f64;
