@@ -11,13 +11,12 @@
 mod common;
 
 use common::browser::{click, executables, in_chromium, js, settled, wait_for};
-use common::editor::{N, create, doc, expect_error, put_scene, serve_with};
+use common::editor::{self, N, create, doc, expect_error, put_scene, serve_with};
 use common::http;
 use serde_json::{Value, json};
-use std::io::{BufRead, BufReader};
+use std::ffi::OsStr;
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 use terrasynth::server::Running;
 
@@ -170,30 +169,14 @@ fn a_corrupt_side_file_is_reported_and_left_alone() {
         .unwrap();
     f.set_modified(SystemTime::now() + Duration::from_secs(60))
         .unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
-        .args(["serve", "--bind", "127.0.0.1:0", "--scene"])
-        .arg(&scene)
-        // Its database load starts in the background; it is killed first.
-        .env("TERRASYNTH_CACHE_DIR", dir.path().join("cache"))
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut said = String::new();
-    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
-    let url = loop {
-        let Some(Ok(line)) = lines.next() else {
-            let _ = child.kill();
-            panic!("the server stopped: {said}");
-        };
-        said.push_str(&line);
-        said.push('\n');
-        if let Some(rest) = line.split("open http://").nth(1) {
-            break rest.split('/').next().unwrap().to_string();
-        }
-    };
-    let info = http::get(url.parse().unwrap(), "/api/info");
-    let _ = child.kill();
-    let _ = child.wait();
+    // Its database load starts in the background; it is killed first.
+    let server = editor::spawn(
+        &[OsStr::new("--scene"), scene.as_os_str()],
+        &dir.path().join("cache"),
+    );
+    let info = http::get(server.addr, "/api/info");
+    let said = server.said.clone();
+    drop(server);
     assert_eq!(info.status, 200);
     assert!(info.json()["recovery"].is_null());
     let name = side(&scene).display().to_string();

@@ -174,7 +174,7 @@ fn write(app: &App, a: &Autosave, h: &Handle) {
         // Stopping with a decision still open: the side file is that work.
         return;
     }
-    if doc == saved.doc {
+    if doc == *saved.doc {
         if s.written.take().is_some()
             && let Err(e) = a.remove()
         {

@@ -127,6 +127,14 @@ export class Api {
     return (await check(await fetch(this.url(`/recovery?keep=${keep}`), { method: 'POST' }))).json();
   }
 
+  /**
+   * After a refused save: the saved file's version (`merge` false), or
+   * this tab's changes on top of it (true), as a frame with its `scene`.
+   */
+  async reload(merge) {
+    return (await check(await fetch(this.url(`/reload?merge=${merge}`), { method: 'POST' }))).json();
+  }
+
   /** Saves; `force` replaces a file another tab saved since this one loaded. */
   async save(force = false) {
     return (await check(await fetch(this.url(force ? '/save?force=true' : '/save'), { method: 'POST' }))).json();
