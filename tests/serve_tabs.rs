@@ -77,7 +77,7 @@ fn a_stale_save_is_told_and_reload_and_merge_work() {
         to(c, &a).await;
         place(c, (30.0, 30.0)).await;
         assert!(saved_after(c, "#save").await, "A's first save");
-        assert_eq!(saved_points(&file), [("p1".into(), 30.0, 30.0)]);
+        assert_eq!(saved_points(&file), [("point-1".into(), 30.0, 30.0)]);
 
         // B loaded before A's save: its save is refused and it is told.
         to(c, &b).await;
@@ -94,15 +94,15 @@ fn a_stale_save_is_told_and_reload_and_merge_work() {
         assert!(told.as_str().unwrap().contains("another tab"), "{told}");
         assert_eq!(
             saved_points(&file),
-            [("p1".into(), 30.0, 30.0)],
+            [("point-1".into(), 30.0, 30.0)],
             "no lost save"
         );
-        // Merge: B's point on top of A's (both were named p1 in their tab).
+        // Merge: B's point on top of A's (both were named point-1 in their tab).
         assert!(
             saved_after(c, "#conflict-merge").await,
             "B's merge and save"
         );
-        let both = vec![("p1".into(), 30.0, 30.0), ("p1-2".into(), 90.0, 90.0)];
+        let both = vec![("point-1".into(), 30.0, 30.0), ("point-1-2".into(), 90.0, 90.0)];
         assert_eq!(saved_points(&file), both);
         assert_eq!(js(c, "return window.terrasynth.doc.points.length").await, 2);
         assert_eq!(js(c, "return window.__errors").await, serde_json::json!([]));
@@ -119,7 +119,7 @@ fn a_stale_save_is_told_and_reload_and_merge_work() {
         click(c, "#conflict-reload").await;
         settled(c, rev).await;
         let shown = js(c, "return window.terrasynth.doc.points.map(p => p.id)").await;
-        assert_eq!(shown, serde_json::json!(["p1", "p1-2"]));
+        assert_eq!(shown, serde_json::json!(["point-1", "point-1-2"]));
         assert!(saved_after(c, "#save").await, "A's save after reloading");
         assert_eq!(saved_points(&file), both);
         assert_eq!(js(c, "return window.__errors").await, serde_json::json!([]));
