@@ -143,6 +143,71 @@ fn discarded_work_is_deleted() {
     until("the side file to go", || !side(&scene).exists());
 }
 
+/// The ids of the points a document holds, in order.
+fn point_ids(d: &Value) -> Vec<String> {
+    d["points"]
+        .as_array()
+        .map(|ps| {
+            ps.iter()
+                .map(|p| p["id"].as_str().unwrap().to_string())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Every tab's unsaved work is in the side file (issue 43: only the tab
+/// edited last was): two tabs each place a point and both are there; one
+/// tab saves and the other's point stays there; a tab closed unsaved keeps
+/// its work there while another edits; and the next start offers it all.
+#[test]
+fn every_tab_is_autosaved() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("design.json");
+    let s = serve_with(N, Some(scene.clone()), |c| {
+        c.autosave_delay = Duration::from_millis(300);
+        c.max_sessions = 3;
+    });
+    let a = s.addr;
+    let (one, _) = create(a);
+    let (two, _) = create(a);
+    let point =
+        |id: &str, x: u32| json!({"id": id, "at": [x, 20], "height_m": 900, "radius_px": 5});
+    let with = |ps: Value| {
+        let mut d = doc();
+        d["points"] = ps;
+        d
+    };
+    let side_ids = || {
+        std::fs::read(side(&scene))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<Value>(&b).ok())
+            .map(|d| point_ids(&d))
+    };
+    let holds = |ids: &[&str]| side_ids().is_some_and(|got| got == ids);
+    put_scene(a, &one, &with(json!([point("a", 10)])), true);
+    put_scene(a, &two, &with(json!([point("b", 40)])), true);
+    until("both tabs' points in the side file", || holds(&["a", "b"]));
+    // Tab one saves: its point is saved, tab two's is still unsaved.
+    let r = http::post(a, &format!("/api/sessions/{one}/save"), None);
+    assert_eq!(r.status, 200, "{}", r.json());
+    until("tab two's work after tab one's save", || holds(&["a", "b"]));
+    // Tab two closes unsaved; tab one moves its point: both still there.
+    assert_eq!(
+        http::post(a, &format!("/api/sessions/{two}/close"), None).status,
+        204
+    );
+    put_scene(a, &one, &with(json!([point("a", 12)])), true);
+    until("the moved point", || {
+        read_json(&side(&scene))["points"][0]["at"] == json!([12, 20])
+    });
+    assert!(holds(&["a", "b"]), "{:?}", side_ids());
+    drop(s);
+    let s = serve(&scene);
+    let (id, _) = create(s.addr);
+    let r = recovery(s.addr, &id, "?keep=true");
+    assert_eq!(point_ids(&r.json()["scene"]), ["a", "b"]);
+}
+
 #[test]
 fn a_side_file_older_than_the_scene_is_not_offered() {
     let dir = tempfile::tempdir().unwrap();

@@ -102,7 +102,10 @@ fn a_stale_save_is_told_and_reload_and_merge_work() {
             saved_after(c, "#conflict-merge").await,
             "B's merge and save"
         );
-        let both = vec![("point-1".into(), 30.0, 30.0), ("point-1-2".into(), 90.0, 90.0)];
+        let both = vec![
+            ("point-1".into(), 30.0, 30.0),
+            ("point-1-2".into(), 90.0, 90.0),
+        ];
         assert_eq!(saved_points(&file), both);
         assert_eq!(js(c, "return window.terrasynth.doc.points.length").await, 2);
         assert_eq!(js(c, "return window.__errors").await, serde_json::json!([]));

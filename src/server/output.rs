@@ -250,7 +250,7 @@ pub async fn save(
         .map_err(|e| ApiError::Internal(e.to_string()))?
         .map_err(|e| ApiError::Internal(format!("saving failed: {e}")))?;
     if let Some(a) = &app.autosave {
-        a.saved();
+        a.saved(&h);
     }
     saved.doc = Arc::new(l.committed.clone());
     saved.revision += 1;
