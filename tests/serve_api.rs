@@ -467,7 +467,11 @@ fn a_save_from_another_tab_is_never_overwritten_silently() {
     // A tab opened now starts from tab one's save, not the server's start.
     let (three, f) = create(a);
     assert_eq!(f["scene"], ridge);
-    // Tab two loaded before that save: its save is refused, the file kept.
+    // Tab two loaded before that save: its heartbeat says so, its save is
+    // refused, the file kept.
+    let stale =
+        |id: &str| http::post(a, &format!("/api/sessions/{id}/ping"), None).json()["stale"].clone();
+    assert_eq!((stale(&one), stale(&two)), (json!(false), json!(true)));
     let mut knoll = doc();
     knoll["points"] = json!([point("knoll", 40)]);
     put_scene(a, &two, &knoll, true);
@@ -486,11 +490,8 @@ fn a_save_from_another_tab_is_never_overwritten_silently() {
     let r = reload(&three, "?merge=false");
     assert_eq!(r.status, 200, "{}", r.json());
     assert_eq!(r.json()["scene"], ridge);
-    assert_eq!(
-        save(&three, false).status,
-        200,
-        "up to date after reloading"
-    );
+    assert_eq!(stale(&three), json!(false), "up to date after reloading");
+    assert_eq!(save(&three, false).status, 200);
     let u = http::post(a, &format!("/api/sessions/{three}/undo"), None).json();
     assert_eq!(u["scene"], doc());
     // Merge: tab two's knoll on top of the saved ridge; its save then

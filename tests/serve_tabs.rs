@@ -1,8 +1,8 @@
 //! Two tabs on one scene file in headless Chromium (issue 43, "never lose
-//! work"): tab A saves a point; tab B, opened before that save, places
-//! another and saves. B's save is refused and B is told (a banner naming
-//! the other tab's save), the file keeps A's work; B's "Merge and save"
-//! writes both. Then A, now the stale one, is refused in turn, and its
+//! work"): tab A saves a point; tab B, opened before that save, is told
+//! by its heartbeat, places another point and saves. B's save is refused
+//! and B is told (a banner naming the other tab's save), the file keeps
+//! A's work; B's "Merge and save" writes both. Then A, now the stale one, is refused in turn, and its
 //! "Reload saved" shows the file's version, after which A saves cleanly.
 //!
 //! Skipped without chromium and chromedriver unless
@@ -79,8 +79,16 @@ fn a_stale_save_is_told_and_reload_and_merge_work() {
         assert!(saved_after(c, "#save").await, "A's first save");
         assert_eq!(saved_points(&file), [("point-1".into(), 30.0, 30.0)]);
 
-        // B loaded before A's save: its save is refused and it is told.
+        // B loaded before A's save: the heartbeat tells it before it
+        // saves, and its save is refused and it is told again.
         to(c, &b).await;
+        wait_for(
+            c,
+            "B told of A's save",
+            "return document.body.dataset.conflict === 'open'",
+            20,
+        )
+        .await;
         place(c, (90.0, 90.0)).await;
         assert!(
             !saved_after(c, "#save").await,
@@ -112,7 +120,14 @@ fn a_stale_save_is_told_and_reload_and_merge_work() {
 
         // A is now the stale one: refused; Reload shows the file's version.
         to(c, &a).await;
-        place(c, (100.0, 20.0)).await;
+        wait_for(
+            c,
+            "A told of B's save",
+            "return document.body.dataset.conflict === 'open'",
+            20,
+        )
+        .await;
+        place(c, (20.0, 110.0)).await;
         assert!(
             !saved_after(c, "#save").await,
             "A's stale save went through"

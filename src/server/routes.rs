@@ -19,7 +19,8 @@
 //! | `POST /api/sessions/{id}/reload?merge=true` | → frame + `scene`: this tab's changes since it loaded, replayed on the file as last saved (`merge.rs`); Save then writes it |
 //! | `POST /api/sessions/{id}/recovery?keep=true` | → frame + `scene`: the recovered document becomes the session's (an undo step, unsaved); 404 when no recovery is pending |
 //! | `POST /api/sessions/{id}/recovery?keep=false` | → `{"discarded": path}`: the autosave file is deleted |
-//! | `POST /api/sessions/{id}/ping`, `…/close` | the page's heartbeat (`info.sessions.heartbeat_ms`); free the slot (on page hide, by beacon) |
+//! | `POST /api/sessions/{id}/ping` | the page's heartbeat (`info.sessions.heartbeat_ms`) → `{"stale"}`: true when another tab saved the scene file after this session's document was loaded (the page offers reload/merge before a save is refused) |
+//! | `POST /api/sessions/{id}/close` | free the slot (on page hide, by beacon) |
 //!
 //! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
 //! `timing_ms {queued, edits, synth, render, total}`, `changed {pixels,
@@ -436,9 +437,11 @@ async fn put_view(
     reply(h.submit(Task::View(view))).await
 }
 
-async fn ping(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<StatusCode> {
-    app.registry.get(&id)?.touch();
-    Ok(StatusCode::NO_CONTENT)
+async fn ping(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
+    let h = app.registry.get(&id)?;
+    h.touch();
+    let saved = app.saved.lock().await.revision;
+    Ok(axum::Json(json!({"stale": h.base().0 != saved})))
 }
 
 async fn close(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<StatusCode> {

@@ -161,9 +161,12 @@ export class Api {
     return { w: head[0], h: head[1], stride: head[2], data: new Float32Array(buf, 12), revision };
   }
 
-  /** The heartbeat; rejects when the session or the server is gone. */
+  /**
+   * The heartbeat → {stale}: whether another tab saved since this one
+   * loaded. Rejects when the session or the server is gone.
+   */
   async ping() {
-    await check(await fetch(this.url('/ping'), { method: 'POST' }));
+    return (await check(await fetch(this.url('/ping'), { method: 'POST' }))).json();
   }
 
   close() {

@@ -1,8 +1,9 @@
-// Saving to the server's scene file, and what the page offers when a save
-// is refused because another tab saved since this one loaded (409, field
-// `revision`): reload the file's version, merge this tab's changes on top
-// of it and save, or save anyway. Never a silent overwrite; and a reload
-// is an undo step, so Undo brings this tab's version back.
+// Saving to the server's scene file, and what the page offers when another
+// tab saved since this one loaded — learnt from the heartbeat, or from a
+// refused save (409, field `revision`): reload the file's version, merge
+// this tab's changes on top of it and save, or save anyway. Never a silent
+// overwrite; and a reload is an undo step, so Undo brings this tab's
+// version back.
 
 import { ApiError } from './api.js';
 
@@ -17,6 +18,8 @@ export class Saver {
     this.ed = ed;
     this.showFrame = showFrame;
     this.news = news;
+    // Told already that another tab saved: the heartbeat says it once.
+    this.told = false;
     $('conflict-merge').onclick = () => this.reload(true);
     $('conflict-reload').onclick = () => this.reload(false);
     $('conflict-overwrite').onclick = () => this.save(true);
@@ -35,6 +38,16 @@ export class Saver {
       if (e instanceof ApiError && e.status === 409 && e.field === 'revision') this.shown(e.message);
       else this.ed.error(e);
       return false;
+    }
+  }
+
+  /** The heartbeat's news: whether another tab saved since this one loaded. */
+  stale(stale) {
+    if (!stale) this.told = false;
+    else if (!this.told) {
+      this.told = true;
+      const file = this.ed.info.scene_file || 'the scene file';
+      this.shown(`${file} was saved from another tab after this one opened it. Merge to keep both tabs' work, or reload to take the saved version.`);
     }
   }
 
