@@ -193,44 +193,6 @@ fn history_commits_and_drags() {
     );
 }
 
-/// Undo keeps patches, not whole documents (issue 43: +6.8 MiB per step
-/// for a 0.74 MB scene): on a ~0.7 MB scene a step of a typical edit (a
-/// point moved) holds a few hundred bytes, far under 1 MiB, and undo still
-/// gives back each document.
-#[test]
-fn undo_memory_per_step_is_the_edit_not_the_scene() {
-    let s = serve(N, None, 2);
-    let a = s.addr;
-    let mut d = doc();
-    // ~0.7 MB of freeze strokes over the lower half.
-    let strokes: Vec<Value> = (0..3600)
-        .map(|k| {
-            let y = 40.0 + (k % 20) as f64 + (k / 20) as f64 * 1e-3;
-            let line: Vec<Value> = (0..12).map(|i| json!([2.5 + 5.0 * i as f64, y])).collect();
-            json!({"points": line, "radius_px": 0.5})
-        })
-        .collect();
-    d["freeze"] = json!({ "strokes": strokes });
-    let size = d.to_string().len();
-    assert!((600_000..800_000).contains(&size), "{size} B");
-    let r = http::post(a, "/api/sessions", Some(&json!({ "scene": d })));
-    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
-    let id = r.json()["session"].as_str().unwrap().to_string();
-    let steps = 20;
-    for k in 0..steps {
-        d["points"] = json!([{"at": [10 + k, 20], "height_m": 900, "radius_px": 5}]);
-        assert_eq!(put_scene(a, &id, &d, true).status, 200);
-    }
-    let shown = http::get(a, &format!("/api/sessions/{id}")).json();
-    let bytes = shown["history_bytes"].as_u64().unwrap();
-    let per_step = bytes / steps;
-    eprintln!("undo history: {per_step} B per step ({bytes} B, {steps} steps) on a {size} B scene");
-    assert!(per_step < 1 << 20, "{per_step} B per step");
-    let u = http::post(a, &format!("/api/sessions/{id}/undo"), None).json();
-    assert_eq!(u["scene"]["points"][0]["at"], json!([10 + steps - 2, 20]));
-    assert_eq!(u["scene"]["freeze"], d["freeze"]);
-}
-
 /// While one document is synthesized, a newer one replaces any queued one:
 /// the replaced request is answered `superseded`, the newest is shown.
 #[test]
@@ -481,7 +443,8 @@ fn save_writes_only_the_scene_file_and_a_restart_reloads_it() {
 
 /// Two tabs on one scene file (issue 43): a tab opened after another saved
 /// starts from that save, and a tab whose document predates a save cannot
-/// overwrite it unless it says so.
+/// overwrite it unless it says so; it can reload the saved file (an undo
+/// step) or merge its changes on top of it.
 #[test]
 fn a_save_from_another_tab_is_never_overwritten_silently() {
     let dir = tempfile::tempdir().unwrap();
@@ -494,27 +457,64 @@ fn a_save_from_another_tab_is_never_overwritten_silently() {
         let q = if force { "?force=true" } else { "" };
         http::post(a, &format!("/api/sessions/{id}/save{q}"), None)
     };
+    let reload = |id: &str, q: &str| http::post(a, &format!("/api/sessions/{id}/reload{q}"), None);
+    let point =
+        |id: &str, x: u32| json!({"id": id, "at": [x, 20], "height_m": 900, "radius_px": 6});
     let mut ridge = doc();
-    ridge["points"] = json!([{"id": "ridge", "at": [20, 20], "height_m": 2500, "radius_px": 6}]);
+    ridge["points"] = json!([point("ridge", 20)]);
     put_scene(a, &one, &ridge, true);
     assert_eq!(save(&one, false).status, 200);
     // A tab opened now starts from tab one's save, not the server's start.
     let (three, f) = create(a);
     assert_eq!(f["scene"], ridge);
-    // Tab two loaded before that save: its save is refused, the file kept.
+    // Tab two loaded before that save: its heartbeat says so, its save is
+    // refused, the file kept.
+    let stale =
+        |id: &str| http::post(a, &format!("/api/sessions/{id}/ping"), None).json()["stale"].clone();
+    assert_eq!((stale(&one), stale(&two)), (json!(false), json!(true)));
     let mut knoll = doc();
-    knoll["points"] = json!([{"id": "knoll", "at": [40, 40], "height_m": 900, "radius_px": 6}]);
+    knoll["points"] = json!([point("knoll", 40)]);
     put_scene(a, &two, &knoll, true);
-    let e = expect_error(&save(&two, false), 409, "$");
-    assert!(e.contains("another tab"), "{e}");
+    let e = expect_error(&save(&two, false), 409, "revision");
+    assert!(e.contains("another tab") && e.contains("merge"), "{e}");
     assert_eq!(Scene::read(&path).unwrap().points[0].id, "ridge");
     // Tab one saves again (its own save is its base); tab three, opened
     // from the first save, is now behind and refused too.
     assert_eq!(save(&one, false).status, 200);
-    expect_error(&save(&three, false), 409, "$");
-    // Forced, tab two replaces the file, and is then up to date.
-    assert_eq!(save(&two, true).status, 200);
-    assert_eq!(Scene::read(&path).unwrap().points[0].id, "knoll");
+    expect_error(&save(&three, false), 409, "revision");
+    // Reload: tab three shows the file; undo brings its own back.
+    expect_error(&reload(&three, ""), 400, "merge");
+    expect_error(&reload(&three, "?merge=perhaps"), 400, "merge");
+    expect_error(&reload("nope", "?merge=false"), 404, "id");
+    put_scene(a, &three, &doc(), true);
+    let r = reload(&three, "?merge=false");
+    assert_eq!(r.status, 200, "{}", r.json());
+    assert_eq!(r.json()["scene"], ridge);
+    assert_eq!(stale(&three), json!(false), "up to date after reloading");
+    assert_eq!(save(&three, false).status, 200);
+    let u = http::post(a, &format!("/api/sessions/{three}/undo"), None).json();
+    assert_eq!(u["scene"], doc());
+    // Merge: tab two's knoll on top of the saved ridge; its save then
+    // goes through and holds both.
+    expect_error(&save(&two, false), 409, "revision");
+    let r = reload(&two, "?merge=true");
+    assert_eq!(r.status, 200, "{}", r.json());
+    assert_eq!(
+        r.json()["scene"]["points"],
+        json!([point("ridge", 20), point("knoll", 40)])
+    );
     assert_eq!(save(&two, false).status, 200);
-    expect_error(&save(&one, false), 409, "$");
+    let ids: Vec<String> = Scene::read(&path)
+        .unwrap()
+        .points
+        .iter()
+        .map(|p| p.id.clone())
+        .collect();
+    assert_eq!(ids, ["ridge", "knoll"]);
+    // Forced, tab one replaces the file, and is then up to date.
+    expect_error(&save(&one, false), 409, "revision");
+    assert_eq!(save(&one, true).status, 200);
+    assert_eq!(Scene::read(&path).unwrap().points.len(), 1);
+    assert_eq!(save(&one, false).status, 200);
+    expect_error(&save(&two, false), 409, "revision");
 }

@@ -11,13 +11,12 @@
 mod common;
 
 use common::browser::{click, executables, in_chromium, js, settled, wait_for};
-use common::editor::{N, create, doc, expect_error, put_scene, serve_with};
+use common::editor::{self, N, create, doc, expect_error, put_scene, serve_with};
 use common::http;
 use serde_json::{Value, json};
-use std::io::{BufRead, BufReader};
+use std::ffi::OsStr;
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant, SystemTime};
 use terrasynth::server::Running;
 
@@ -144,6 +143,71 @@ fn discarded_work_is_deleted() {
     until("the side file to go", || !side(&scene).exists());
 }
 
+/// The ids of the points a document holds, in order.
+fn point_ids(d: &Value) -> Vec<String> {
+    d["points"]
+        .as_array()
+        .map(|ps| {
+            ps.iter()
+                .map(|p| p["id"].as_str().unwrap().to_string())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Every tab's unsaved work is in the side file (issue 43: only the tab
+/// edited last was): two tabs each place a point and both are there; one
+/// tab saves and the other's point stays there; a tab closed unsaved keeps
+/// its work there while another edits; and the next start offers it all.
+#[test]
+fn every_tab_is_autosaved() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("design.json");
+    let s = serve_with(N, Some(scene.clone()), |c| {
+        c.autosave_delay = Duration::from_millis(300);
+        c.max_sessions = 3;
+    });
+    let a = s.addr;
+    let (one, _) = create(a);
+    let (two, _) = create(a);
+    let point =
+        |id: &str, x: u32| json!({"id": id, "at": [x, 20], "height_m": 900, "radius_px": 5});
+    let with = |ps: Value| {
+        let mut d = doc();
+        d["points"] = ps;
+        d
+    };
+    let side_ids = || {
+        std::fs::read(side(&scene))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<Value>(&b).ok())
+            .map(|d| point_ids(&d))
+    };
+    let holds = |ids: &[&str]| side_ids().is_some_and(|got| got == ids);
+    put_scene(a, &one, &with(json!([point("a", 10)])), true);
+    put_scene(a, &two, &with(json!([point("b", 40)])), true);
+    until("both tabs' points in the side file", || holds(&["a", "b"]));
+    // Tab one saves: its point is saved, tab two's is still unsaved.
+    let r = http::post(a, &format!("/api/sessions/{one}/save"), None);
+    assert_eq!(r.status, 200, "{}", r.json());
+    until("tab two's work after tab one's save", || holds(&["a", "b"]));
+    // Tab two closes unsaved; tab one moves its point: both still there.
+    assert_eq!(
+        http::post(a, &format!("/api/sessions/{two}/close"), None).status,
+        204
+    );
+    put_scene(a, &one, &with(json!([point("a", 12)])), true);
+    until("the moved point", || {
+        read_json(&side(&scene))["points"][0]["at"] == json!([12, 20])
+    });
+    assert!(holds(&["a", "b"]), "{:?}", side_ids());
+    drop(s);
+    let s = serve(&scene);
+    let (id, _) = create(s.addr);
+    let r = recovery(s.addr, &id, "?keep=true");
+    assert_eq!(point_ids(&r.json()["scene"]), ["a", "b"]);
+}
+
 #[test]
 fn a_side_file_older_than_the_scene_is_not_offered() {
     let dir = tempfile::tempdir().unwrap();
@@ -170,30 +234,14 @@ fn a_corrupt_side_file_is_reported_and_left_alone() {
         .unwrap();
     f.set_modified(SystemTime::now() + Duration::from_secs(60))
         .unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
-        .args(["serve", "--bind", "127.0.0.1:0", "--scene"])
-        .arg(&scene)
-        // Its database load starts in the background; it is killed first.
-        .env("TERRASYNTH_CACHE_DIR", dir.path().join("cache"))
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut said = String::new();
-    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
-    let url = loop {
-        let Some(Ok(line)) = lines.next() else {
-            let _ = child.kill();
-            panic!("the server stopped: {said}");
-        };
-        said.push_str(&line);
-        said.push('\n');
-        if let Some(rest) = line.split("open http://").nth(1) {
-            break rest.split('/').next().unwrap().to_string();
-        }
-    };
-    let info = http::get(url.parse().unwrap(), "/api/info");
-    let _ = child.kill();
-    let _ = child.wait();
+    // Its database load starts in the background; it is killed first.
+    let server = editor::spawn(
+        &[OsStr::new("--scene"), scene.as_os_str()],
+        &dir.path().join("cache"),
+    );
+    let info = http::get(server.addr, "/api/info");
+    let said = server.said.clone();
+    drop(server);
     assert_eq!(info.status, 200);
     assert!(info.json()["recovery"].is_null());
     let name = side(&scene).display().to_string();

@@ -5,8 +5,10 @@
 //! radius + 24 px, fewer than 1 % of the pixels move, by less than 1 % of
 //! the relief); raise and lower move the ground under the stroke up and
 //! down; each stroke's targets are baked into the page's document; undo
-//! takes the last stroke away. The server's baking and undo are also
-//! tested over the API alone (no browser needed).
+//! takes the last stroke away. After painting, the strokes are drawn on
+//! the map and one picked there is deleted alone, its ground synthesized
+//! again. The server's baking and undo are also tested over the API alone
+//! (no browser needed).
 //!
 //! Without chromium and chromedriver the test says so and passes, unless
 //! `TERRASYNTH_REQUIRE_BROWSER` is set.
@@ -204,6 +206,114 @@ fn each_brush_changes_the_terrain_where_painted_and_nowhere_else() {
         settled(c, rev).await;
         let n = js(c, "return window.terrasynth.doc.sculpt.length").await;
         assert_eq!(n, json!(4), "undo removed the erode stroke");
+        assert_eq!(js(c, "return window.__errors").await, json!([]));
+    });
+    server.stop();
+}
+
+/// The mean height change from `a` to `b` within `RADIUS / 2` of `line`.
+fn mean_under(a: &[f32], b: &[f32], line: &[(f64, f64)]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            if distance(line, x, y) <= RADIUS / 2.0 {
+                sum += (b[y * SIZE + x] - a[y * SIZE + x]) as f64;
+                n += 1;
+            }
+        }
+    }
+    sum / n as f64
+}
+
+/// Two raise strokes stay drawn on the map after painting (the map's
+/// pixel on a stroke differs with the controls shown and hidden); the
+/// first, clicked with the Select tool, is selected and deleted from the
+/// inspector: the second stays, the ground under the first goes back
+/// down, the ground under the second stays raised.
+#[test]
+fn strokes_are_drawn_and_deleted_one_by_one() {
+    let Some(browser) = executables() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let server = editor::serve(SIZE, None, 2);
+    let first = [(40.0, 60.0), (70.0, 62.0), (100.0, 60.0)];
+    let second = [(150.0, 190.0), (180.0, 192.0), (210.0, 190.0)];
+    in_chromium(&browser, dir.path(), async |c| {
+        c.goto(&server.url()).await.unwrap();
+        settled(c, -1).await;
+        let session = js(c, "return window.terrasynth.api.session").await;
+        let session = session.as_str().unwrap().to_string();
+        click(c, "[data-tool=sculpt]").await;
+        js(
+            c,
+            &format!("window.terrasynth.tools.opts.sculptRadius = {RADIUS}; return true"),
+        )
+        .await;
+        let h0 = heights(server.addr, &session);
+        for line in [&first, &second] {
+            let rev = revision(c).await;
+            drag(c, line).await;
+            settled(c, rev).await;
+        }
+        let painted = heights(server.addr, &session);
+        let strength = js(c, "return window.terrasynth.doc.sculpt[0].strength").await;
+        let strength = strength.as_f64().unwrap();
+        // Drawn: the map's pixel at the first stroke's middle, with the
+        // controls shown and hidden.
+        let pixels = js(
+            c,
+            &format!(
+                "const ed = window.terrasynth, m = ed.map, q = m.toScreen([{}, {}]);
+                 const k = m.canvas.width / m.canvas.getBoundingClientRect().width;
+                 const px = () => {{ m.draw(); return Array.from(m.ctx.getImageData(Math.round(q[0] * k), Math.round(q[1] * k), 1, 1).data); }};
+                 const on = px(); ed.handles = false; const off = px(); ed.handles = true; m.draw();
+                 return [on, off];",
+                first[1].0, first[1].1 + 4.0
+            ),
+        )
+        .await;
+        assert_ne!(pixels[0], pixels[1], "the stroke is not drawn on the map");
+        // Picked on the map and deleted alone.
+        click(c, "[data-tool=select]").await;
+        drag(c, &[first[1]]).await;
+        let sel = js(c, "return window.terrasynth.tools.sel").await;
+        assert_eq!(sel, json!({"kind": "sculpt", "index": 0}));
+        let inspector = js(c, "return document.getElementById('inspector').textContent").await;
+        assert!(
+            inspector.as_str().unwrap().contains("Sculpt stroke 1"),
+            "{inspector}"
+        );
+        let rev = revision(c).await;
+        click(c, "#inspector .buttons button").await;
+        settled(c, rev).await;
+        let left = js(
+            c,
+            "return window.terrasynth.doc.sculpt.map(s => s.points[0])",
+        )
+        .await;
+        let left = left.as_array().unwrap();
+        let near = |p: &serde_json::Value, q: (f64, f64)| {
+            (p[0].as_f64().unwrap() - q.0).hypot(p[1].as_f64().unwrap() - q.1) < 1.0
+        };
+        assert!(
+            left.len() == 1 && near(&left[0], second[0]),
+            "only the first stroke went: {left:?}"
+        );
+        let after = heights(server.addr, &session);
+        let (raised, back, kept) = (
+            mean_under(&h0, &painted, &first),
+            mean_under(&h0, &after, &first),
+            mean_under(&h0, &after, &second),
+        );
+        eprintln!(
+            "first stroke: {raised:+.1} m painted, {back:+.1} m after deleting it; second: {kept:+.1} m (strength {strength} m)"
+        );
+        assert!(raised > 0.5 * strength && kept > 0.5 * strength);
+        assert!(
+            back.abs() < 0.2 * strength,
+            "{back:+.1} m left under the deleted stroke"
+        );
         assert_eq!(js(c, "return window.__errors").await, json!([]));
     });
     server.stop();

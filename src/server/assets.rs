@@ -30,6 +30,11 @@ const FILES: &[(&str, &str, &[u8])] = &[
         include_bytes!("../../web/js/link.js"),
     ),
     (
+        "js/save.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../web/js/save.js"),
+    ),
+    (
         "js/map.js",
         "text/javascript; charset=utf-8",
         include_bytes!("../../web/js/map.js"),

@@ -1,12 +1,18 @@
 //! Autosave and recovery (issue 43: "never lose work"). A tab's document
 //! lives in the page and in its session; a crashed browser, a killed server
-//! or a closed laptop lose whatever was not saved. So, while the last
-//! edited session's committed document differs from the scene file as last
-//! saved, a background thread writes it to a side file beside the scene,
-//! `<scene>.autosave.json` ([`side_file`]), [`Config::autosave_delay`]
-//! after the last edit (debounced: a drag or a burst of strokes is one
-//! write, and never on the request path), atomically. Save removes it; the
-//! scene file itself is only ever written by Save.
+//! or a closed laptop lose whatever was not saved. So, while any tab's
+//! committed document differs from the scene file as last saved, a
+//! background thread writes the unsaved work to a side file beside the
+//! scene, `<scene>.autosave.json` ([`side_file`]),
+//! [`Config::autosave_delay`] after the last edit (debounced: a drag or a
+//! burst of strokes is one write, and never on the request path),
+//! atomically. The scene file itself is only ever written by Save.
+//!
+//! Every tab's work is in it: the side file is one scene document, the
+//! saved scene with each tab's changes since its base replayed on top
+//! (oldest edit first, as a stale save's Merge does, `merge.rs`). So two
+//! tabs' unsaved points are both there, a tab closed unsaved keeps its
+//! work in it, and a tab's Save leaves the others' work in it.
 //!
 //! At the next start, a side file newer than the scene file and different
 //! from it is offered for recovery ([`find`]): the page shows a banner and
@@ -22,7 +28,7 @@ use super::editor::Handle;
 use crate::io;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, Weak};
 use std::time::{Duration, Instant, SystemTime};
 
 /// The autosave file of a scene file: its name plus `.autosave.json`.
@@ -46,10 +52,25 @@ pub struct Autosave {
     wake: Condvar,
 }
 
+/// A tab with work that may be unsaved: its session while it is open, and
+/// its work as last read (a closed tab's stays).
+struct Tab {
+    handle: Weak<Handle>,
+    work: Option<Work>,
+}
+
+/// A session's design and the saved document it stands on.
+struct Work {
+    base: Arc<Value>,
+    doc: Value,
+}
+
 #[derive(Default)]
 struct State {
-    /// The session edited last and when: what the next write takes.
-    pending: Option<(Arc<Handle>, Instant)>,
+    /// When the last edit came: the next write is due the delay after.
+    pending: Option<Instant>,
+    /// Tabs edited since they last saved, oldest edit first.
+    tabs: Vec<Tab>,
     recovery: Option<Recovery>,
     /// The document the side file holds, when this server wrote it (the
     /// same document is not written twice).
@@ -74,9 +95,16 @@ impl Autosave {
         self.state.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// `h`'s document may have changed: write it after the delay.
+    /// `h`'s document may have changed: the side file is rewritten after
+    /// the delay, `h`'s work on top.
     pub fn changed(&self, h: &Arc<Handle>) {
-        self.state().pending = Some((h.clone(), Instant::now()));
+        let mut s = self.state();
+        let work = take_tab(&mut s.tabs, h).and_then(|t| t.work);
+        s.tabs.push(Tab {
+            handle: Arc::downgrade(h),
+            work,
+        });
+        s.pending = Some(Instant::now());
         self.wake.notify_all();
     }
 
@@ -102,15 +130,26 @@ impl Autosave {
         }
     }
 
-    /// The scene file was just saved (its lock held): the side file goes,
-    /// unless it holds recovered work nobody has decided on yet.
-    pub fn saved(&self) {
+    /// Session `h` just saved the scene file (its lock held): its work is
+    /// saved, so the side file goes, unless it holds recovered work nobody
+    /// has decided on yet. Other tabs' unsaved work is written again at
+    /// once (on the thread: their merge needs that lock).
+    pub fn saved(&self, h: &Arc<Handle>) {
         let mut s = self.state();
+        take_tab(&mut s.tabs, h);
         if s.recovery.is_none() {
             s.written = None;
             if let Err(e) = self.remove() {
                 eprintln!("warning: {e}");
             }
+        }
+        if !s.tabs.is_empty() {
+            s.pending = Some(
+                Instant::now()
+                    .checked_sub(self.delay)
+                    .unwrap_or_else(Instant::now),
+            );
+            self.wake.notify_all();
         }
     }
 
@@ -129,12 +168,12 @@ pub fn spawn(app: Arc<App>) -> std::io::Result<std::thread::JoinHandle<()>> {
         .spawn(move || {
             let Some(a) = &app.autosave else { return };
             loop {
-                let (handle, stopped) = {
+                let (due, stopped) = {
                     let mut s = a.state();
                     loop {
                         let due = match &s.pending {
                             _ if s.recovery.is_some() && !s.stopped => None,
-                            Some((_, at)) => Some(a.delay.saturating_sub(at.elapsed())),
+                            Some(at) => Some(a.delay.saturating_sub(at.elapsed())),
                             None => None,
                         };
                         match due {
@@ -150,10 +189,10 @@ pub fn spawn(app: Arc<App>) -> std::io::Result<std::thread::JoinHandle<()>> {
                             None => s = a.wake.wait(s).unwrap_or_else(|e| e.into_inner()),
                         }
                     }
-                    (s.pending.take().map(|(h, _)| h), s.stopped)
+                    (s.pending.take().is_some(), s.stopped)
                 };
-                if let Some(h) = handle {
-                    write(&app, a, &h);
+                if due {
+                    write(&app, a);
                 }
                 if stopped {
                     return;
@@ -162,11 +201,39 @@ pub fn spawn(app: Arc<App>) -> std::io::Result<std::thread::JoinHandle<()>> {
         })
 }
 
-/// Writes `h`'s committed document to the side file when it differs from
-/// the saved scene; removes the side file when it no longer does (undone
-/// back to the saved state).
-fn write(app: &App, a: &Autosave, h: &Handle) {
-    let Some(doc) = h.committed() else { return };
+/// Removes `h`'s tab from `tabs`, if there.
+fn take_tab(tabs: &mut Vec<Tab>, h: &Arc<Handle>) -> Option<Tab> {
+    let i = tabs
+        .iter()
+        .position(|t| std::ptr::eq(t.handle.as_ptr(), Arc::as_ptr(h)))?;
+    Some(tabs.remove(i))
+}
+
+/// Every tab's unsaved work on top of the saved scene: each open tab's
+/// work is read again, a closed one's stays as last read, and tabs with
+/// nothing unsaved drop out.
+fn unsaved(tabs: &mut Vec<Tab>, saved: &Arc<Value>) -> Value {
+    for t in tabs.iter_mut() {
+        if let Some(h) = t.handle.upgrade().filter(|h| !h.is_closed())
+            && let Some(doc) = h.committed()
+        {
+            t.work = Some(Work {
+                base: h.base().1,
+                doc,
+            });
+        }
+    }
+    tabs.retain(|t| t.work.as_ref().is_some_and(|w| w.doc != *w.base));
+    tabs.iter()
+        .filter_map(|t| t.work.as_ref())
+        .fold((**saved).clone(), |doc, w| {
+            super::merge::merge(&w.base, &w.doc, &doc)
+        })
+}
+
+/// Writes every tab's unsaved work to the side file; removes the side
+/// file when there is none (undone back to the saved state).
+fn write(app: &App, a: &Autosave) {
     // Held while writing: a save in between would leave a stale side file.
     let saved = app.saved.blocking_lock();
     let mut s = a.state();
@@ -174,7 +241,8 @@ fn write(app: &App, a: &Autosave, h: &Handle) {
         // Stopping with a decision still open: the side file is that work.
         return;
     }
-    if doc == saved.doc {
+    let doc = unsaved(&mut s.tabs, &saved.doc);
+    if doc == *saved.doc {
         if s.written.take().is_some()
             && let Err(e) = a.remove()
         {

@@ -23,7 +23,7 @@ use crate::scene::Scene;
 use image::RgbaImage;
 use serde_json::{Value, json};
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, RwLock};
 use std::time::{Duration, Instant};
 use tokio::sync::oneshot;
@@ -99,20 +99,23 @@ pub struct Handle {
     /// the synthesis takes.
     working: AtomicBool,
     /// The revision of the scene file this session's document stands on
-    /// (`App::saved`): a save from a session whose base is older would
-    /// overwrite another tab's save.
-    base: AtomicU64,
+    /// (`App::saved`), and that document: a save from a session whose base
+    /// is older would overwrite another tab's save, and a merge needs to
+    /// know what this tab changed since (`merge.rs`).
+    base: Mutex<(u64, Arc<Value>)>,
 }
 
 impl Handle {
-    /// The saved revision this session's document stands on.
-    pub fn base(&self) -> u64 {
-        self.base.load(Ordering::Relaxed)
+    /// The saved revision this session's document stands on, and its
+    /// document.
+    pub fn base(&self) -> (u64, Arc<Value>) {
+        self.base.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 
-    /// After this session saved: its document is the saved one.
-    pub fn set_base(&self, revision: u64) {
-        self.base.store(revision, Ordering::Relaxed);
+    /// After this session saved, reloaded or merged: its document stands
+    /// on the saved `revision`, whose document is `doc`.
+    pub fn set_base(&self, revision: u64, doc: Arc<Value>) {
+        *self.base.lock().unwrap_or_else(|e| e.into_inner()) = (revision, doc);
     }
 
     /// Starts a session's thread on `doc` (already checked by `policy`);
@@ -124,7 +127,7 @@ impl Handle {
         style: Arc<Style>,
         doc: Value,
         scene: Scene,
-        base: u64,
+        base: (u64, Arc<Value>),
     ) -> (Arc<Handle>, oneshot::Receiver<Reply>) {
         let handle = Arc::new(Handle {
             queue: Mutex::new(Queue::default()),
@@ -134,7 +137,7 @@ impl Handle {
             full_png: Mutex::new(None),
             last_used: Mutex::new(Instant::now()),
             working: AtomicBool::new(true),
-            base: AtomicU64::new(base),
+            base: Mutex::new(base),
         });
         let (tx, rx) = oneshot::channel();
         let h = handle.clone();

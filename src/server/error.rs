@@ -57,9 +57,10 @@ pub enum ApiError {
         "this server was started without --scene, so it has no file to save to: restart it with --scene PATH, or use Download"
     )]
     NoSavePath,
-    /// Another tab saved after this session's document was loaded (409).
+    /// Another tab saved after this session's document was loaded (409,
+    /// field `revision`: the page tells it from [`ApiError::NoSavePath`]).
     #[error(
-        "{path} was saved from another tab after this one opened it: saving now would overwrite that work. Download this design first, or save anyway to replace it"
+        "{path} was saved from another tab after this one opened it: saving now would overwrite that work. Reload it (take the file's version), merge (this tab's changes on top of it), or save anyway to replace it"
     )]
     SaveConflict { path: String },
     /// A request from another site or host name (403).
@@ -107,6 +108,7 @@ impl ApiError {
             ApiError::Malformed { field, .. } | ApiError::Invalid { field, .. } => field,
             ApiError::Scene(e) => &e.path,
             ApiError::NoSession(_) => "id",
+            ApiError::SaveConflict { .. } => "revision",
             _ => "$",
         }
     }

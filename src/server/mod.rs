@@ -25,6 +25,7 @@ mod editor;
 mod error;
 mod frame;
 mod history;
+mod merge;
 mod output;
 mod patch;
 mod registry;
@@ -182,7 +183,8 @@ pub(crate) struct App {
 
 /// The scene file's document as last saved, and how many saves it took.
 pub(crate) struct Saved {
-    pub doc: Value,
+    /// Shared with the sessions that stand on it (their merge base).
+    pub doc: Arc<Value>,
     pub revision: u64,
 }
 
@@ -425,7 +427,7 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
         style: RwLock::new(None),
         policy: Arc::new(policy),
         saved: tokio::sync::Mutex::new(Saved {
-            doc: initial,
+            doc: Arc::new(initial),
             revision: 0,
         }),
         registry: registry::Registry::new(config.max_sessions.max(1), config.idle),

@@ -239,7 +239,7 @@ pub async fn save(
         .map_err(|e| ApiError::Internal(e.to_string()))?;
     // Held across the write: two saves never interleave.
     let mut saved = app.saved.lock().await;
-    if !force && h.base() != saved.revision {
+    if !force && h.base().0 != saved.revision {
         return Err(ApiError::SaveConflict {
             path: path.display().to_string(),
         });
@@ -250,11 +250,11 @@ pub async fn save(
         .map_err(|e| ApiError::Internal(e.to_string()))?
         .map_err(|e| ApiError::Internal(format!("saving failed: {e}")))?;
     if let Some(a) = &app.autosave {
-        a.saved();
+        a.saved(&h);
     }
-    saved.doc = l.committed.clone();
+    saved.doc = Arc::new(l.committed.clone());
     saved.revision += 1;
-    h.set_base(saved.revision);
+    h.set_base(saved.revision, saved.doc.clone());
     Ok(axum::Json(
         json!({"path": path.display().to_string(), "revision": l.revision}),
     ))

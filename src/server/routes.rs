@@ -15,9 +15,12 @@
 //! | `GET /api/sessions/{id}/heights` | binary: u32 width, u32 height, u32 stride, then f32 metres (≤ 512² samples); header `x-revision` |
 //! | `GET /api/sessions/{id}/export?format=exr[&sidecar=true]` | a download (any writable format, or `preview`) |
 //! | `POST /api/sessions/{id}/save[?force=true]` | writes the `--scene` file → `{"path"}`; 409 when another tab saved after this session's document was loaded (unless forced) |
+//! | `POST /api/sessions/{id}/reload?merge=false` | → frame + `scene`: the scene file as last saved becomes the session's document (an undo step: undo brings this tab's back); the answer to a 409 on save |
+//! | `POST /api/sessions/{id}/reload?merge=true` | → frame + `scene`: this tab's changes since it loaded, replayed on the file as last saved (`merge.rs`); Save then writes it |
 //! | `POST /api/sessions/{id}/recovery?keep=true` | → frame + `scene`: the recovered document becomes the session's (an undo step, unsaved); 404 when no recovery is pending |
 //! | `POST /api/sessions/{id}/recovery?keep=false` | → `{"discarded": path}`: the autosave file is deleted |
-//! | `POST /api/sessions/{id}/ping`, `…/close` | the page's heartbeat (`info.sessions.heartbeat_ms`); free the slot (on page hide, by beacon) |
+//! | `POST /api/sessions/{id}/ping` | the page's heartbeat (`info.sessions.heartbeat_ms`) → `{"stale"}`: true when another tab saved the scene file after this session's document was loaded (the page offers reload/merge before a save is refused) |
+//! | `POST /api/sessions/{id}/close` | free the slot (on page hide, by beacon) |
 //!
 //! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
 //! `timing_ms {queued, edits, synth, render, total}`, `changed {pixels,
@@ -65,6 +68,7 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/api/sessions/{id}/heights", get(output::heights))
         .route("/api/sessions/{id}/export", get(output::export))
         .route("/api/sessions/{id}/save", post(output::save))
+        .route("/api/sessions/{id}/reload", post(reload))
         .route("/api/sessions/{id}/recovery", post(recovery))
         .route("/api/sessions/{id}/ping", post(ping))
         .route("/api/sessions/{id}/close", post(close))
@@ -246,11 +250,11 @@ async fn create(
 ) -> Api {
     let db = app.ready()?;
     let body = json_body(&headers, body, app.max_request_bytes)?;
-    let (start, base) = {
+    let base = {
         let saved = app.saved.lock().await;
-        (saved.doc.clone(), saved.revision)
+        (saved.revision, saved.doc.clone())
     };
-    let doc = request::new_session(&body)?.unwrap_or(start);
+    let doc = request::new_session(&body)?.unwrap_or_else(|| (*base.1).clone());
     // Field paths inside {"scene": …} are the document's own.
     let scene = app.policy.check_value(&doc)?;
     let style = app
@@ -333,6 +337,50 @@ fn changed(app: &App, id: &str) {
     }
 }
 
+/// `POST …/reload?merge=true|false`: the page's answer to a refused
+/// (stale) save. The session then stands on the file as last saved, so
+/// its next save is no longer refused; the new document is an undo step,
+/// so reloading loses nothing of this tab's work.
+async fn reload(
+    State(app): State<Arc<App>>,
+    PathParam(id): PathParam,
+    RawQuery(raw): RawQuery,
+) -> Api {
+    let h = app.registry.get(&id)?;
+    let q = request::query(raw.as_deref(), &["merge"])?;
+    if request::param(&q, "merge").is_none() {
+        return Err(ApiError::malformed(
+            "merge",
+            "missing: expected false (take the saved file's version) or true (this tab's changes on top of it)",
+        ));
+    }
+    let merge = request::flag(&q, "merge", false)?;
+    let (revision, theirs) = {
+        let saved = app.saved.lock().await;
+        (saved.revision, saved.doc.clone())
+    };
+    let doc = match merge {
+        false => (*theirs).clone(),
+        true => {
+            let mine = h
+                .committed()
+                .ok_or_else(|| ApiError::NotReady("the first frame is not ready".into()))?;
+            super::merge::merge(&h.base().1, &mine, &theirs)
+        }
+    };
+    let scene = app.policy.check_value(&doc)?;
+    let mut frame = reply(h.submit(Task::Scene {
+        doc: doc.clone(),
+        scene: Box::new(scene),
+        commit: true,
+    }))
+    .await?;
+    h.set_base(revision, theirs);
+    changed(&app, &id);
+    frame["scene"] = doc;
+    Ok(frame)
+}
+
 /// `POST …/recovery?keep=true|false`: the artist's answer to the unsaved
 /// work found at start. Keep shows it in this session as an edit (so undo
 /// goes back to the saved scene and Save writes it); discard deletes it.
@@ -389,9 +437,11 @@ async fn put_view(
     reply(h.submit(Task::View(view))).await
 }
 
-async fn ping(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<StatusCode> {
-    app.registry.get(&id)?.touch();
-    Ok(StatusCode::NO_CONTENT)
+async fn ping(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
+    let h = app.registry.get(&id)?;
+    h.touch();
+    let saved = app.saved.lock().await.revision;
+    Ok(axum::Json(json!({"stale": h.base().0 != saved})))
 }
 
 async fn close(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api<StatusCode> {

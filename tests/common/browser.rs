@@ -45,10 +45,22 @@ pub fn executables() -> Option<(PathBuf, PathBuf)> {
     }
 }
 
-/// A WebDriver session in a fresh headless Chromium profile under `dir`.
+/// Where the browser of [`connect`]`(…, dir)` saves downloads.
+pub fn downloads(dir: &Path) -> PathBuf {
+    dir.join("downloads")
+}
+
+/// A WebDriver session in a fresh headless Chromium profile under `dir`;
+/// downloads go to [`downloads`]`(dir)` without asking, several per page
+/// included (an export with a sidecar is two).
 pub async fn connect(driver: &Driver, chromium: &Path, dir: &Path) -> Client {
     let caps = json!({
         "goog:chromeOptions": {
+            "prefs": {
+                "download.default_directory": downloads(dir),
+                "download.prompt_for_download": false,
+                "profile.default_content_setting_values.automatic_downloads": 1,
+            },
             "binary": chromium,
             "args": [
                 "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",

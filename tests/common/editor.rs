@@ -64,6 +64,14 @@ pub fn create(addr: SocketAddr) -> (String, Value) {
     (f["session"].as_str().unwrap().to_string(), f)
 }
 
+/// A new session on document `d`: its id and first frame.
+pub fn create_with(addr: SocketAddr, d: &Value) -> (String, Value) {
+    let r = http::post(addr, "/api/sessions", Some(&json!({ "scene": d })));
+    assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
+    let f = r.json();
+    (f["session"].as_str().unwrap().to_string(), f)
+}
+
 pub fn put_scene(addr: SocketAddr, s: &str, d: &Value, commit: bool) -> Response {
     http::put(addr, &format!("/api/sessions/{s}/scene?commit={commit}"), d)
 }
@@ -80,4 +88,55 @@ pub fn expect_error(r: &Response, status: u16, field: &str) -> String {
     let message = r.json()["error"]["message"].as_str().unwrap().to_string();
     assert!(!message.is_empty());
     message
+}
+
+/// `terrasynth serve` as its own process (for what only a process shows:
+/// its resident memory, its stderr, a kill), stopped by its own id when
+/// dropped.
+pub struct Process {
+    pub child: std::process::Child,
+    pub addr: SocketAddr,
+    /// What it said on stderr until it listened.
+    pub said: String,
+}
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Starts `terrasynth serve --bind 127.0.0.1:0 ARGS` with its database
+/// cache under `cache`, and waits until it listens (its database may
+/// still be loading).
+pub fn spawn(args: &[&std::ffi::OsStr], cache: &std::path::Path) -> Process {
+    use std::io::{BufRead, BufReader};
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_terrasynth"))
+        .args(["serve", "--bind", "127.0.0.1:0"])
+        .args(args)
+        .env("TERRASYNTH_CACHE_DIR", cache)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("terrasynth serve starts");
+    let stderr = child.stderr.take().unwrap();
+    let mut p = Process {
+        child,
+        addr: SocketAddr::from(([127, 0, 0, 1], 0)),
+        said: String::new(),
+    };
+    let mut lines = BufReader::new(stderr).lines();
+    p.addr = loop {
+        let Some(Ok(line)) = lines.next() else {
+            panic!("the server stopped: {}", p.said);
+        };
+        p.said.push_str(&line);
+        p.said.push('\n');
+        if let Some(rest) = line.split("open http://").nth(1) {
+            break rest.split('/').next().unwrap().parse().unwrap();
+        }
+    };
+    // Keep reading, so a chatty server never blocks on a full pipe.
+    std::thread::spawn(move || for _ in lines {});
+    p
 }

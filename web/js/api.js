@@ -127,6 +127,14 @@ export class Api {
     return (await check(await fetch(this.url(`/recovery?keep=${keep}`), { method: 'POST' }))).json();
   }
 
+  /**
+   * After a refused save: the saved file's version (`merge` false), or
+   * this tab's changes on top of it (true), as a frame with its `scene`.
+   */
+  async reload(merge) {
+    return (await check(await fetch(this.url(`/reload?merge=${merge}`), { method: 'POST' }))).json();
+  }
+
   /** Saves; `force` replaces a file another tab saved since this one loaded. */
   async save(force = false) {
     return (await check(await fetch(this.url(force ? '/save?force=true' : '/save'), { method: 'POST' }))).json();
@@ -153,9 +161,12 @@ export class Api {
     return { w: head[0], h: head[1], stride: head[2], data: new Float32Array(buf, 12), revision };
   }
 
-  /** The heartbeat; rejects when the session or the server is gone. */
+  /**
+   * The heartbeat → {stale}: whether another tab saved since this one
+   * loaded. Rejects when the session or the server is gone.
+   */
   async ping() {
-    await check(await fetch(this.url('/ping'), { method: 'POST' }));
+    return (await check(await fetch(this.url('/ping'), { method: 'POST' }))).json();
   }
 
   close() {

@@ -1,7 +1,7 @@
 // Drawing the controls over the preview, in screen pixels (crisp at any
-// zoom): grid, frozen wash, pastes, curves with their envelope of effect
-// and widgets, junctions, points with their handles, and the tools'
-// strokes in progress.
+// zoom): grid, frozen wash, sculpt strokes, pastes, curves with their
+// envelope of effect and widgets, junctions, points with their handles,
+// and the tools' strokes in progress.
 
 import * as g from './geometry.js';
 import * as C from './controls.js';
@@ -15,6 +15,7 @@ const COL = {
   point: '#00c8ff',
   paste: '#ff7800',
   freeze: 'rgba(120,190,255,1)',
+  sculpt: 'rgb(255,170,60)',
   select: '#ffffff',
 };
 
@@ -142,6 +143,29 @@ export function drawFrozen(ctx, map, ed, layer) {
   ctx.globalAlpha = 0.33;
   ctx.drawImage(c, 0, 0);
   ctx.restore();
+}
+
+/**
+ * Sculpt strokes after painting: each one's footprint (as wide as its
+ * brush, faint) and its path, so a stroke can be found, picked and
+ * deleted like any other control.
+ */
+export function drawSculpt(ctx, map, ed, sel) {
+  ctx.lineCap = 'round';
+  ctx.lineJoin = 'round';
+  (ed.doc.sculpt || []).forEach((st, i) => {
+    const selected = sel && sel.kind === 'sculpt' && sel.index === i;
+    const pts = st.points.length > 1 ? st.points : [st.points[0], st.points[0]];
+    path(ctx, map, pts, false);
+    ctx.globalAlpha = selected ? 0.35 : 0.18;
+    ctx.strokeStyle = COL.sculpt;
+    ctx.lineWidth = 2 * st.radius_px * map.s;
+    ctx.stroke();
+    ctx.globalAlpha = 1;
+    ctx.lineWidth = selected ? 3 : 1.5;
+    ctx.strokeStyle = selected ? COL.select : COL.sculpt;
+    ctx.stroke();
+  });
 }
 
 export function drawPastes(ctx, map, ed, sel) {

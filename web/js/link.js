@@ -43,12 +43,18 @@ export class Link {
     this.reconnecting = null;
   }
 
-  /** Pings at the server's heartbeat; a missed ping means reconnecting. */
+  /**
+   * Pings at the server's heartbeat; a missed ping means reconnecting, a
+   * stale answer that another tab saved (the saver tells the artist).
+   */
   heartbeat() {
     const every = (this.ed.info.sessions && this.ed.info.sessions.heartbeat_ms) || 2000;
     setInterval(() => {
       if (this.reconnecting) return;
-      this.ed.api.ping().catch((e) => this.lost(e));
+      this.ed.api
+        .ping()
+        .then((r) => this.ed.saver.stale(r.stale))
+        .catch((e) => this.lost(e));
     }, every);
   }
 

@@ -8,6 +8,7 @@ import { Tools } from './tools.js';
 import { Panel } from './panel.js';
 import { View3d } from './view3d.js';
 import { Link, open, closeOnHide } from './link.js';
+import { Saver } from './save.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -209,25 +210,11 @@ async function undoRedo(which) {
   }
 }
 
-async function save() {
-  await ed.api.idle();
-  try {
-    let r;
-    try {
-      r = await ed.api.save();
-    } catch (e) {
-      // Another tab saved since this one loaded: say so, and replace the
-      // file only if the artist says to.
-      if (!(e.status === 409 && e.message.includes('another tab') && confirm(`${e.message}.\n\nReplace the saved file with this tab's design?`))) throw e;
-      r = await ed.api.save(true);
-    }
-    $('status-error').textContent = '';
-    // Keep the last edit's numbers on the status line beside the news.
-    status();
-    $('status-main').textContent = `saved ${r.path} · ${$('status-main').textContent}`;
-  } catch (e) {
-    ed.error(e);
-  }
+/** Puts `text` on the status line, before the last edit's numbers. */
+function news(text) {
+  $('status-error').textContent = '';
+  status();
+  $('status-main').textContent = `${text} · ${$('status-main').textContent}`;
 }
 
 function download(url, name) {
@@ -295,7 +282,7 @@ function fit() {
 function wireBar() {
   $('undo').onclick = () => undoRedo('undo');
   $('redo').onclick = () => undoRedo('redo');
-  $('save').onclick = save;
+  $('save').onclick = () => ed.saver.save();
   $('download-scene').onclick = () => {
     const blob = new Blob([JSON.stringify(ed.doc, null, 2)], { type: 'application/json' });
     const url = URL.createObjectURL(blob);
@@ -376,7 +363,7 @@ function wireBar() {
       undoRedo('redo');
     } else if ((e.ctrlKey || e.metaKey) && k === 's') {
       e.preventDefault();
-      save();
+      ed.saver.save();
     } else if (!e.ctrlKey && !e.metaKey && !e.altKey) {
       const tools = { v: 'select', p: 'point', c: 'curve', t: 'types', f: 'freeze', s: 'sculpt', l: 'lasso', h: 'pan' };
       if (tools[k]) tool(tools[k]);
@@ -469,6 +456,7 @@ async function boot() {
     size: ed.frame.size,
   }));
   ed.tools = new Tools(ed);
+  ed.saver = new Saver(ed, showFrame, news);
   wireBar();
   ed.api.onFrame = showFrame;
   // The session closed (its slot taken while the tab slept) or the server

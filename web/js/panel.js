@@ -315,6 +315,13 @@ export class Panel {
         this.num((p.lift || (doc.version === 2 ? 'ground' : 'source')) === 'ground' ? 'δ above the ground (m)' : 'δ above its source (m)', () => p.delta_m || 0, (v) => (p.delta_m = v), { kind: 'paste' }),
         del('Delete paste')];
     }
+    if (s.kind === 'sculpt') {
+      const st = (doc.sculpt || [])[s.index];
+      if (!st) return [];
+      return [h('h3', {}, `Sculpt stroke ${s.index + 1}`),
+        h('p', { class: 'note' }, `${st.brush}, radius ${st.radius_px} px, strength ${st.strength}, falloff ${st.falloff ?? 0.5}. Its target heights were baked from the terrain it was painted on; deleting it lets the ground under it be synthesized again.`),
+        del('Delete stroke')];
+    }
     return [];
   }
 

@@ -59,6 +59,7 @@ export class Tools {
   drawControls(ctx, map) {
     const ed = this.ed;
     if (ed.handles) {
+      D.drawSculpt(ctx, map, ed, this.sel);
       D.drawPastes(ctx, map, ed, this.sel);
       D.drawCurves(ctx, map, ed, this.sel);
       D.drawPoints(ctx, map, ed, this.sel);
@@ -136,6 +137,9 @@ export class Tools {
       const h = g.onPolyline(p, b ? b.line : c.points);
       if (h.d <= tol) return { kind: 'curve', index: i, frac: h.frac };
     }
+    for (let i = (doc.sculpt || []).length - 1; i >= 0; i--) {
+      if (g.onPolyline(p, doc.sculpt[i].points).d <= tol) return { kind: 'sculpt', index: i };
+    }
     for (let i = (doc.pastes || []).length - 1; i >= 0; i--) {
       const ps = doc.pastes[i];
       const c = g.centroid(ps.lasso);
@@ -151,7 +155,7 @@ export class Tools {
     if (h.kind.startsWith('widget')) return { kind: 'curve', index: h.index, widget: h.widget };
     if (h.kind === 'curve') return { kind: 'curve', index: h.index, widget: null };
     if (h.kind.startsWith('junction')) return { kind: 'junction', index: h.index };
-    if (h.kind === 'paste') return { kind: 'paste', index: h.index };
+    if (h.kind === 'paste' || h.kind === 'sculpt') return { kind: h.kind, index: h.index };
     return this.sel;
   }
 
@@ -164,7 +168,7 @@ export class Tools {
   down(p, e) {
     const ed = this.ed;
     const h = this.hit(p, !['types', 'freeze', 'lasso', 'sculpt'].includes(this.tool));
-    const draggable = h && !['curve', 'paste', 'junction'].includes(h.kind);
+    const draggable = h && !['curve', 'paste', 'junction', 'sculpt'].includes(h.kind);
     if (h && (draggable || this.tool === 'select' || this.tool === 'point')) {
       if (h.kind === 'curve' && e.shiftKey) return this.addWidget(h);
       this.setSel(this.selection(h));
@@ -459,6 +463,7 @@ export class Tools {
         const e = j ? C.junctionEntry(d, j.at) : -1;
         if (e >= 0) d.junctions.splice(e, 1);
       } else if (s.kind === 'paste') d.pastes.splice(s.index, 1);
+      else if (s.kind === 'sculpt') d.sculpt.splice(s.index, 1);
     }, { kind: 'remove' });
   }
 
