@@ -50,13 +50,18 @@ impl Heightfield {
         check_cell_size(cell_size)?;
         let data = vec![0.0; width * height];
         crate::pages::advise_huge(&data);
-        Ok(Self {
+        Ok(Self::wrap(width, height, cell_size, data))
+    }
+
+    /// The grid of checked dimensions and samples, without a georeference.
+    fn wrap(width: usize, height: usize, cell_size: f64, data: Vec<f32>) -> Self {
+        Self {
             width,
             height,
             cell_size,
             data,
             georef: None,
-        })
+        }
     }
 
     /// Wraps row-major samples. NaN marks nodata; ±∞ is refused because no
@@ -81,13 +86,7 @@ impl Heightfield {
                 y: i / width,
             });
         }
-        Ok(Self {
-            width,
-            height,
-            cell_size,
-            data,
-            georef: None,
-        })
+        Ok(Self::wrap(width, height, cell_size, data))
     }
 
     /// Builds a grid from a function of (x, y), evaluated in parallel by row.
