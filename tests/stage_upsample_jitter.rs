@@ -12,6 +12,7 @@
 use proptest::prelude::*;
 use terrasynth::database::layout::MARGIN;
 use terrasynth::hash::hash4;
+use terrasynth::isa::Isa;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::fixed::{Coord, FRAC_BITS};
 use terrasynth::level::state::State;
@@ -159,19 +160,21 @@ proptest! {
         let origin = [bits[1] % 65536 * 2, bits[2] % 65536 * 2];
         let p = UpsampleParams { seed, level: level as u32, jitter, step: Step::Pyramid, origin };
         let (cw, ch) = (2 * w, 2 * h);
-        let part = State::new(cw, ch);
         let rect = [r[0].min(r[1]), r[2].min(r[3]), r[0].max(r[1]), r[2].max(r[3])];
-        upsample_jitter_rect(&parent, &part, Some(&rig.atlas[level]), &p, rect);
         let untouched = State::new(1, 1);
-        for k in 0..cw * ch {
-            let (x, y) = (k % cw, k / cw);
-            let inside = (rect[0]..rect[2]).contains(&x) && (rect[1]..rect[3]).contains(&y);
-            let want = if inside {
-                oracle(&parent, rig.atlas.get(level), &p, x, y)
-            } else {
-                (untouched.s(0), untouched.v(0))
-            };
-            prop_assert_eq!((part.s(k), part.v(k)), want, "pixel ({}, {})", x, y);
+        for &isa in Isa::all() {
+            let part = State::new(cw, ch);
+            upsample_jitter_rect(&parent, &part, Some(&rig.atlas[level]), &p, rect, isa);
+            for k in 0..cw * ch {
+                let (x, y) = (k % cw, k / cw);
+                let inside = (rect[0]..rect[2]).contains(&x) && (rect[1]..rect[3]).contains(&y);
+                let want = if inside {
+                    oracle(&parent, rig.atlas.get(level), &p, x, y)
+                } else {
+                    (untouched.s(0), untouched.v(0))
+                };
+                prop_assert_eq!((part.s(k), part.v(k)), want, "{:?}: pixel ({}, {})", isa, x, y);
+            }
         }
     }
 }
@@ -210,12 +213,14 @@ fn upsample_jitter_whole_level_follows_the_rule_at_exemplar_corners() {
         step: Step::Pyramid,
         origin: [0, 0],
     };
-    let child = State::new(2 * w, 2 * h);
-    upsample_jitter(&parent, &child, Some(&rig.atlas[0]), &p);
-    for k in 0..4 * w * h {
-        let (x, y) = (k % (2 * w), k / (2 * w));
-        let want = oracle(&parent, rig.atlas.first(), &p, x, y);
-        assert_eq!((child.s(k), child.v(k)), want, "pixel ({x}, {y})");
+    for &isa in Isa::all() {
+        let child = State::new(2 * w, 2 * h);
+        upsample_jitter(&parent, &child, Some(&rig.atlas[0]), &p, isa);
+        for k in 0..4 * w * h {
+            let (x, y) = (k % (2 * w), k / (2 * w));
+            let want = oracle(&parent, rig.atlas.first(), &p, x, y);
+            assert_eq!((child.s(k), child.v(k)), want, "{isa:?}: pixel ({x}, {y})");
+        }
     }
 }
 

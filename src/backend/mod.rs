@@ -16,22 +16,16 @@ pub mod kernels;
 
 use crate::level::fixed::Coord;
 use crate::level::state::State;
+use crate::stages::Stage;
 use crate::stages::correct::{self, CorrectParams};
 use crate::stages::upsample_jitter::UpsampleParams;
 use std::time::Duration;
 use thiserror::Error;
 
-/// The stages a backend runs, for per-stage timings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stage {
-    UpsampleJitter,
-    Correct,
-    Reconstruct,
-}
-
 /// The device's own measure of one stage call (GPU timestamp queries).
 #[derive(Debug, Clone, Copy)]
 pub struct StageTime {
+    /// The stage, keyed by its line in the table of stages.
     pub stage: Stage,
     /// The level the call worked on.
     pub level: usize,

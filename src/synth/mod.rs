@@ -168,10 +168,7 @@ impl<'db> Synthesizer<'db> {
 
     /// The CPU backend over this synthesizer's database.
     fn cpu(&self) -> Cpu<'_, 'db> {
-        Cpu {
-            atlas: &self.atlas,
-            heights: self.db.heights(),
-        }
+        Cpu::new(&self.atlas, self.db.heights())
     }
 
     pub fn params(&self) -> &Params {
