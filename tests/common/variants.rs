@@ -7,6 +7,7 @@
 //! all with [`assert_agree`] — one loop, whatever was built, in one run.
 
 use std::fmt::Debug;
+use terrasynth::backend::engine::Engine;
 use terrasynth::backend::{Backend, BackendError, cpu::Cpu};
 use terrasynth::database::Database;
 use terrasynth::isa::Isa;
@@ -15,7 +16,7 @@ use terrasynth::level::fixed::Coord;
 use terrasynth::level::state::{State, level_size, top_level};
 use terrasynth::stages::correct::{CorrectParams, Guide, PRIORS, SUBPASSES, scalar};
 use terrasynth::stages::fill_ssd::{fill_ssd_scalar, fill_ssd_table};
-use terrasynth::stages::shade::{self, ShadeBuffers, ShadeParams};
+use terrasynth::stages::shade::{ShadeBuffers, ShadeParams};
 use terrasynth::stages::upsample_jitter::UpsampleParams;
 
 #[cfg(feature = "gpu")]
@@ -294,15 +295,14 @@ impl<'db> Rig<'db> {
     }
 }
 
-/// Stage `shade`: `cpu` and `gpu` packed RGBA pixels.
+/// Stage `shade`: `cpu` and `gpu` packed RGBA pixels, each through the
+/// engine a preview is rendered on (`Engine::shade`).
 pub fn shade(p: &ShadeParams, b: &ShadeBuffers<'_>) -> Vec<Run<u32>> {
-    let mut cpu = vec![0u32; b.heights.len()];
-    shade::shade(p, b, &mut cpu).unwrap();
     #[allow(unused_mut)]
-    let mut runs = vec![("cpu", cpu)];
+    let mut runs = vec![("cpu", Engine::default().shade(p, b).unwrap())];
     #[cfg(feature = "gpu")]
     if let Some(ctx) = super::gpu::context() {
-        runs.push(("gpu", ctx.shade(p, b).unwrap()));
+        runs.push(("gpu", Engine::Gpu(ctx).shade(p, b).unwrap()));
     }
     runs
 }
