@@ -11,7 +11,7 @@
 //! backend. `docs/ARCHITECTURE.md` lists each stage's files, tests and
 //! benches.
 //!
-//! Each stage is declared once, by its line in the [`stages!`] table
+//! Each stage is declared once, by its line in the `stages!` table
 //! below: the line makes its module, its [`Stage`] and its kernel source,
 //! and every other list of the stages — the GPU pipelines, the timing
 //! keys, the layout checks, the bench groups — is [`Stage::ALL`]. Adding a
