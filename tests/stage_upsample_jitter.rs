@@ -249,3 +249,30 @@ fn upsample_jitter_agrees_on_real_states() {
         }
     }
 }
+
+/// The rig runs the CPU path once per instruction-set level this CPU has,
+/// named by it, then the GPU where there is one: a level that silently
+/// stopped running (an AVX2 CPU whose `avx2` copy went unchecked) fails
+/// here rather than passing every comparison unseen.
+#[test]
+fn the_rig_runs_every_isa_level_and_the_gpu() {
+    let rig = rig(default_db());
+    let p = UpsampleParams {
+        seed: 1,
+        level: 0,
+        jitter: 102,
+        step: Step::Virtual { shift: 0 },
+        origin: [0, 0],
+    };
+    let runs = rig.upsample_jitter(&State::new(2, 2), (4, 4), 0, &p);
+    let names: Vec<&str> = runs.iter().map(|r| r.0).collect();
+    let mut want: Vec<&str> = Isa::all().iter().map(|i| i.name()).collect();
+    if rig.has_gpu() {
+        want.push("gpu");
+    }
+    assert_eq!(names, want);
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        assert_eq!(names[..2], ["portable", "avx2"]);
+    }
+}
