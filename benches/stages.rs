@@ -13,9 +13,12 @@
 //!   transform, against a half-filled window of it.
 //!
 //! Variants as in `tests/stage_<x>.rs`: `scalar` (the oracle, where the
-//! CPU has a SIMD path), `simd` or `cpu`, and with `--features gpu` and an
-//! adapter `gpu` (each call waits for the device); without one the GPU
-//! variants are skipped with a message. Whole syntheses: `benches/synth.rs`.
+//! CPU has a SIMD path), `simd` or `cpu` (at the default instruction-set
+//! level, `isa::Isa::default`: `TERRASYNTH_PORTABLE_SIMD=1` benches the
+//! portable copy), and with `--features gpu` and an adapter `gpu` (each
+//! call waits for the device); without one the GPU variants are skipped
+//! with a message. One group per stage of `stages::Stage::ALL`. Whole
+//! syntheses: `benches/synth.rs`.
 
 use criterion::{
     BenchmarkGroup, Criterion, criterion_group, criterion_main, measurement::WallTime,
@@ -36,7 +39,9 @@ use terrasynth::stages::common::ALL_TYPES;
 use terrasynth::stages::correct::{self, CorrectParams, W_FREE};
 use terrasynth::stages::fill_ssd::{fill_ssd_scalar, fill_ssd_table};
 use terrasynth::stages::upsample_jitter::{Step, UpsampleParams};
-use terrasynth::stages::{reconstruct, reduce_types, reduce_weights, shade, upsample_jitter};
+use terrasynth::stages::{
+    Stage, reconstruct, reduce_types, reduce_weights, shade, upsample_jitter,
+};
 use terrasynth::synth::control::UNCONSTRAINED;
 use terrasynth::synth::{Params, Synthesizer};
 
@@ -137,10 +142,7 @@ fn bench(c: &mut Criterion) {
     let atlas: Vec<_> = (0..i.db.level_count())
         .map(|l| AtlasLevel::new(&i.db, l))
         .collect();
-    let cpu = Cpu {
-        atlas: &atlas,
-        heights: i.db.heights(),
-    };
+    let cpu = Cpu::new(&atlas, i.db.heights());
     #[cfg(feature = "gpu")]
     let gpu = match terrasynth::backend::gpu::Context::new() {
         Ok(ctx) => Some(terrasynth::backend::gpu::Gpu::new(ctx, &atlas, i.db.heights()).unwrap()),
@@ -152,152 +154,182 @@ fn bench(c: &mut Criterion) {
     let (mw, mh) = i.mask_size;
     let (rw, rh) = (mw.div_ceil(2), mh.div_ceil(2));
 
-    let up = UpsampleParams {
-        seed: 1,
-        level: 0,
-        jitter: 102,
-        step: Step::Pyramid,
-        origin: [0, 0],
-    };
-    let mut g = group(c, "upsample_jitter");
-    let child = State::new(N, N);
-    g.bench_function(format!("cpu/{N}"), |b| {
-        b.iter(|| upsample_jitter::upsample_jitter(black_box(&i.l1), &child, Some(&atlas[0]), &up))
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        let (parent, child) = (gpu.upload(copy(&i.l1)).unwrap(), gpu.alloc(N, N).unwrap());
-        g.bench_function(format!("gpu/{N}"), |b| {
-            b.iter(|| {
-                gpu.upsample_jitter(&parent, &child, 0, &up);
-                gpu.finish().unwrap()
-            })
-        });
+    // One group per line of the table of stages: a stage added there
+    // does not compile here until it has a group (or a reason not to).
+    for stage in Stage::ALL {
+        match stage {
+            Stage::UpsampleJitter => {
+                let up = UpsampleParams {
+                    seed: 1,
+                    level: 0,
+                    jitter: 102,
+                    step: Step::Pyramid,
+                    origin: [0, 0],
+                };
+                let mut g = group(c, stage);
+                let child = State::new(N, N);
+                g.bench_function(format!("cpu/{N}"), |b| {
+                    b.iter(|| {
+                        upsample_jitter::upsample_jitter(
+                            black_box(&i.l1),
+                            &child,
+                            Some(&atlas[0]),
+                            &up,
+                            cpu.isa,
+                        )
+                    })
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    let (parent, child) =
+                        (gpu.upload(copy(&i.l1)).unwrap(), gpu.alloc(N, N).unwrap());
+                    g.bench_function(format!("gpu/{N}"), |b| {
+                        b.iter(|| {
+                            gpu.upsample_jitter(&parent, &child, 0, &up);
+                            gpu.finish().unwrap()
+                        })
+                    });
+                }
+                g.finish();
+            }
+            Stage::Correct => {
+                let p = CorrectParams {
+                    px: 0,
+                    py: 0,
+                    prior: correct::DEFAULT_PRIOR,
+                    similar: true,
+                };
+                let mut g = group(c, stage);
+                g.bench_function(format!("scalar/{N}"), |b| {
+                    b.iter(|| {
+                        correct::scalar::correct(&atlas[0], black_box(&i.l0), Some(&i.l1), &p)
+                    })
+                });
+                g.bench_function(format!("simd/{N}"), |b| {
+                    b.iter(|| cpu.correct(black_box(&i.l0), Some(&i.l1), 0, &p))
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    let (st, parent) = (
+                        gpu.upload(copy(&i.l0)).unwrap(),
+                        gpu.upload(copy(&i.l1)).unwrap(),
+                    );
+                    g.bench_function(format!("gpu/{N}"), |b| {
+                        b.iter(|| {
+                            gpu.correct(&st, Some(&parent), 0, &p);
+                            gpu.finish().unwrap()
+                        })
+                    });
+                }
+                g.finish();
+            }
+            Stage::Reconstruct => {
+                let mut g = group(c, stage);
+                g.bench_function(format!("cpu/{N}"), |b| {
+                    b.iter(|| reconstruct::reconstruct(&atlas[0], i.db.heights(), black_box(&i.l0)))
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    let st = gpu.upload(copy(&i.l0)).unwrap();
+                    g.bench_function(format!("gpu/{N}"), |b| {
+                        b.iter(|| gpu.reconstruct(&st).unwrap())
+                    });
+                }
+                g.finish();
+            }
+            // Fused with `reconstruct` on the CPU and dispatched right after
+            // it on the GPU: timed in its group.
+            Stage::RepairExtrema => {}
+            Stage::ReduceTypes => {
+                let mut g = group(c, stage);
+                g.bench_function(format!("cpu/{mw}"), |b| {
+                    b.iter(|| {
+                        reduce_types::reduce_types(black_box(&i.types), mw, mh, rw, rh, i.full)
+                    })
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    let r0 = gpu.upload_types(&i.types, mw, mh).unwrap();
+                    g.bench_function(format!("gpu/{mw}"), |b| {
+                        b.iter(|| {
+                            gpu.reduce_types(&r0, rw, rh, i.full).unwrap();
+                            gpu.finish().unwrap()
+                        })
+                    });
+                }
+                g.finish();
+            }
+            Stage::ReduceWeights => {
+                let mut g = group(c, stage);
+                g.bench_function(format!("cpu/{mw}"), |b| {
+                    b.iter(|| reduce_weights::reduce_weights(black_box(&i.weights), mw, mh, rw, rh))
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    let w0 = gpu.upload_weights(&i.weights, mw, mh).unwrap();
+                    g.bench_function(format!("gpu/{mw}"), |b| {
+                        b.iter(|| {
+                            gpu.reduce_weights(&w0, rw, rh).unwrap();
+                            gpu.finish().unwrap()
+                        })
+                    });
+                }
+                g.finish();
+            }
+            Stage::Shade => {
+                let (params, buffers) = (&i.preview.params, i.preview.buffers());
+                let mut out = vec![0u32; i.preview.heights.len()];
+                let mut g = group(c, stage);
+                g.bench_function(format!("cpu/{}", params.width), |b| {
+                    b.iter(|| shade::shade(params, &buffers, black_box(&mut out)).unwrap())
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    g.bench_function(format!("gpu/{}", params.width), |b| {
+                        b.iter(|| gpu.context().shade(params, &buffers).unwrap())
+                    });
+                }
+                g.finish();
+            }
+            Stage::FillSsd => {
+                let (user, masks, k, cells) = (&i.user, &i.masks, &i.count, &i.cells);
+                let n = cells.len() / user[0].len();
+                let mut g = group(c, stage);
+                // The oracle over the same rayon loop as the table, so that the two
+                // differ by SIMD alone.
+                g.bench_function(format!("scalar/{n}"), |b| {
+                    b.iter(|| {
+                        cells
+                            .par_chunks(user[0].len())
+                            .flat_map_iter(|c| {
+                                user.iter()
+                                    .zip(masks)
+                                    .map(move |(u, m)| fill_ssd_scalar(u, m, c, *k))
+                            })
+                            .collect::<Vec<u64>>()
+                    })
+                });
+                g.bench_function(format!("simd/{n}"), |b| {
+                    b.iter(|| fill_ssd_table(user, masks, black_box(cells), *k))
+                });
+                #[cfg(feature = "gpu")]
+                if let Some(gpu) = &gpu {
+                    let ctx = gpu.context();
+                    let src = ctx.upload_fill_source(cells, user[0].len()).unwrap();
+                    g.bench_function(format!("gpu/{n}"), |b| {
+                        b.iter(|| ctx.fill_ssd(&src, user, masks, *k).unwrap())
+                    });
+                }
+                g.finish();
+            }
+        }
     }
-    g.finish();
-
-    let p = CorrectParams {
-        px: 0,
-        py: 0,
-        prior: correct::DEFAULT_PRIOR,
-        similar: true,
-    };
-    let mut g = group(c, "correct");
-    g.bench_function(format!("scalar/{N}"), |b| {
-        b.iter(|| correct::scalar::correct(&atlas[0], black_box(&i.l0), Some(&i.l1), &p))
-    });
-    g.bench_function(format!("simd/{N}"), |b| {
-        b.iter(|| cpu.correct(black_box(&i.l0), Some(&i.l1), 0, &p))
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        let (st, parent) = (
-            gpu.upload(copy(&i.l0)).unwrap(),
-            gpu.upload(copy(&i.l1)).unwrap(),
-        );
-        g.bench_function(format!("gpu/{N}"), |b| {
-            b.iter(|| {
-                gpu.correct(&st, Some(&parent), 0, &p);
-                gpu.finish().unwrap()
-            })
-        });
-    }
-    g.finish();
-
-    let mut g = group(c, "reconstruct");
-    g.bench_function(format!("cpu/{N}"), |b| {
-        b.iter(|| reconstruct::reconstruct(&atlas[0], i.db.heights(), black_box(&i.l0)))
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        let st = gpu.upload(copy(&i.l0)).unwrap();
-        g.bench_function(format!("gpu/{N}"), |b| {
-            b.iter(|| gpu.reconstruct(&st).unwrap())
-        });
-    }
-    g.finish();
-
-    let mut g = group(c, "reduce_types");
-    g.bench_function(format!("cpu/{mw}"), |b| {
-        b.iter(|| reduce_types::reduce_types(black_box(&i.types), mw, mh, rw, rh, i.full))
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        let r0 = gpu.upload_types(&i.types, mw, mh).unwrap();
-        g.bench_function(format!("gpu/{mw}"), |b| {
-            b.iter(|| {
-                gpu.reduce_types(&r0, rw, rh, i.full).unwrap();
-                gpu.finish().unwrap()
-            })
-        });
-    }
-    g.finish();
-
-    let mut g = group(c, "reduce_weights");
-    g.bench_function(format!("cpu/{mw}"), |b| {
-        b.iter(|| reduce_weights::reduce_weights(black_box(&i.weights), mw, mh, rw, rh))
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        let w0 = gpu.upload_weights(&i.weights, mw, mh).unwrap();
-        g.bench_function(format!("gpu/{mw}"), |b| {
-            b.iter(|| {
-                gpu.reduce_weights(&w0, rw, rh).unwrap();
-                gpu.finish().unwrap()
-            })
-        });
-    }
-    g.finish();
-
-    let (params, buffers) = (&i.preview.params, i.preview.buffers());
-    let mut out = vec![0u32; i.preview.heights.len()];
-    let mut g = group(c, "shade");
-    g.bench_function(format!("cpu/{}", params.width), |b| {
-        b.iter(|| shade::shade(params, &buffers, black_box(&mut out)).unwrap())
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        g.bench_function(format!("gpu/{}", params.width), |b| {
-            b.iter(|| gpu.context().shade(params, &buffers).unwrap())
-        });
-    }
-    g.finish();
-
-    let (user, masks, k, cells) = (&i.user, &i.masks, &i.count, &i.cells);
-    let n = cells.len() / user[0].len();
-    let mut g = group(c, "fill_ssd");
-    // The oracle over the same rayon loop as the table, so that the two
-    // differ by SIMD alone.
-    g.bench_function(format!("scalar/{n}"), |b| {
-        b.iter(|| {
-            cells
-                .par_chunks(user[0].len())
-                .flat_map_iter(|c| {
-                    user.iter()
-                        .zip(masks)
-                        .map(move |(u, m)| fill_ssd_scalar(u, m, c, *k))
-                })
-                .collect::<Vec<u64>>()
-        })
-    });
-    g.bench_function(format!("simd/{n}"), |b| {
-        b.iter(|| fill_ssd_table(user, masks, black_box(cells), *k))
-    });
-    #[cfg(feature = "gpu")]
-    if let Some(gpu) = &gpu {
-        let ctx = gpu.context();
-        let src = ctx.upload_fill_source(cells, user[0].len()).unwrap();
-        g.bench_function(format!("gpu/{n}"), |b| {
-            b.iter(|| ctx.fill_ssd(&src, user, masks, *k).unwrap())
-        });
-    }
-    g.finish();
 }
 
 /// A group of few samples: the slow variants (the scalar oracle, a
 /// software GPU) take seconds each.
-fn group<'c>(c: &'c mut Criterion, name: &str) -> BenchmarkGroup<'c, WallTime> {
-    let mut g = c.benchmark_group(name);
+fn group(c: &mut Criterion, stage: Stage) -> BenchmarkGroup<'_, WallTime> {
+    let mut g = c.benchmark_group(stage.name());
     g.sample_size(10);
     g
 }

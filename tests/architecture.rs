@@ -2,7 +2,8 @@
 //! every folder of the repository and no folder that is gone, its module
 //! floors hold (every top-level module on one line, importing only from
 //! its own line or those above), and the stage rule it states — no stage
-//! imports another stage — holds in `src/stages/`. A moved or added
+//! imports another stage — holds in `src/stages/`; its table of stages
+//! is the `stages!` table's (`stages::Stage::ALL`). A moved or added
 //! folder or module, an import up the floors, or a stage reaching into
 //! another, fails here until the map says so.
 
@@ -12,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 mod common;
 use common::rust_files;
+use terrasynth::stages::Stage;
 
 /// The repository root (the crate's manifest folder).
 fn root() -> PathBuf {
@@ -89,19 +91,55 @@ fn the_folder_tree_names_every_folder_and_no_gone_one() {
     );
 }
 
-/// The stems of the stages (`src/stages/<x>.rs`, mod.rs and common.rs
-/// aside).
+/// The stems of the stages: the names of the `stages!` table's lines.
 fn stages() -> Vec<String> {
-    let mut out: Vec<String> = fs::read_dir(root().join("src/stages"))
-        .unwrap()
-        .filter_map(|e| {
-            let name = e.unwrap().file_name().to_string_lossy().into_owned();
-            name.strip_suffix(".rs").map(str::to_owned)
-        })
-        .filter(|s| s != "mod" && s != "common")
-        .collect();
-    out.sort();
-    out
+    Stage::ALL.iter().map(|s| s.name().to_owned()).collect()
+}
+
+/// The map's table of stages has one row per line of the `stages!` table,
+/// in its order; every file a row names exists; every `src/stages/<x>.rs`
+/// (mod.rs and common.rs aside), `kernels/<x>.wgsl` (common.wgsl aside)
+/// and `tests/stage_<x>.rs` is a stage's.
+#[test]
+fn the_stage_table_matches_the_stages() {
+    let doc = architecture();
+    let rows: Vec<&str> = doc.lines().filter(|l| l.starts_with("| `")).collect();
+    let named: Vec<&str> = rows.iter().filter_map(|r| r.split('`').nth(1)).collect();
+    assert_eq!(named, stages(), "ARCHITECTURE.md's table of stages");
+    for row in &rows {
+        // Backticked paths, less patterns (`{a,b}`, `<x>`) and bench ids.
+        for path in row.split('`').skip(1).step_by(2) {
+            let file = path.ends_with(".rs") || path.ends_with(".wgsl");
+            if file && path.contains('/') && !path.contains(['{', '<']) && !path.starts_with('.') {
+                let p = root().join(path);
+                assert!(p.is_file(), "ARCHITECTURE.md names {path}, which is gone");
+            }
+        }
+    }
+    let stems = |dir: &str, prefix: &str, ext: &str| -> Vec<String> {
+        fs::read_dir(root().join(dir))
+            .unwrap()
+            .filter_map(|e| {
+                let name = e.unwrap().file_name().to_string_lossy().into_owned();
+                name.strip_prefix(prefix)?
+                    .strip_suffix(ext)
+                    .map(str::to_owned)
+            })
+            .collect()
+    };
+    let known = stages();
+    for (dir, prefix, ext) in [
+        ("src/stages", "", ".rs"),
+        ("kernels", "", ".wgsl"),
+        ("tests", "stage_", ".rs"),
+    ] {
+        for stem in stems(dir, prefix, ext) {
+            assert!(
+                known.contains(&stem) || ["mod", "common"].contains(&stem.as_str()),
+                "{dir}/{prefix}{stem}{ext} is no line of the stages! table (src/stages/mod.rs)"
+            );
+        }
+    }
 }
 
 /// Every `.rs` file of stage `stem`: its file and its folder's.

@@ -142,6 +142,7 @@ fn scene_session_matches_end_to_end() {
 #[test]
 fn sketch_synthesis_matches_end_to_end() {
     use terrasynth::backend::Choice;
+    use terrasynth::backend::engine::Engine;
     use terrasynth::patch::fill::fill_ssd::FillCost;
     use terrasynth::patch::input::sketch::Sketch;
     use terrasynth::patch::{self, Library, Params};
@@ -170,8 +171,9 @@ fn sketch_synthesis_matches_end_to_end() {
     )
     .unwrap();
     let run = |choice| {
-        let (cost, notice) = FillCost::choose(choice, &lib).unwrap();
+        let (engine, notice) = Engine::choose(choice).unwrap();
         assert!(notice.is_none(), "{notice:?}");
+        let cost = FillCost::new(&engine, &lib).unwrap();
         let s = patch::synthesize_with(&lib, &sketch, 160, 160, &cost, &Silent).unwrap();
         (cost.name(), s)
     };

@@ -5,6 +5,7 @@
 use std::mem::{offset_of, size_of};
 use terrasynth::backend::kernels;
 use terrasynth::level::atlas::Column;
+use terrasynth::stages::Stage;
 use terrasynth::stages::correct::{CorrectUniform, GuideCell};
 use terrasynth::stages::fill_ssd::FillSsdUniform;
 use terrasynth::stages::reconstruct::ReconstructUniform;
@@ -13,20 +14,20 @@ use terrasynth::stages::reduce_weights::ReduceWeightsUniform;
 use terrasynth::stages::shade::ShadeParams;
 use terrasynth::stages::upsample_jitter::UpsampleUniform;
 
-fn module(k: kernels::Kernel) -> naga::Module {
+fn module(k: Stage) -> naga::Module {
     module_info(k).0
 }
 
-fn module_info(k: kernels::Kernel) -> (naga::Module, naga::valid::ModuleInfo) {
-    let src = k.module_source();
+fn module_info(k: Stage) -> (naga::Module, naga::valid::ModuleInfo) {
+    let src = kernels::module_source(k);
     let m = naga::front::wgsl::parse_str(&src)
-        .unwrap_or_else(|e| panic!("{}.wgsl: {}", k.name, e.emit_to_string(&src)));
+        .unwrap_or_else(|e| panic!("{}.wgsl: {}", k.name(), e.emit_to_string(&src)));
     let info = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::empty(),
     )
     .validate(&m)
-    .unwrap_or_else(|e| panic!("{}.wgsl does not validate: {e:?}", k.name));
+    .unwrap_or_else(|e| panic!("{}.wgsl does not validate: {e:?}", k.name()));
     (m, info)
 }
 
@@ -41,10 +42,10 @@ fn kernels_use_no_floating_point() {
             Some(naga::ScalarKind::Float | naga::ScalarKind::AbstractFloat)
         )
     };
-    for k in kernels::ALL {
+    for k in Stage::ALL {
         let (m, info) = module_info(k);
         for (_, t) in m.types.iter() {
-            assert!(!is_float(&t.inner), "{}: float type {:?}", k.name, t.name);
+            assert!(!is_float(&t.inner), "{}: float type {:?}", k.name(), t.name);
         }
         let functions = m.functions.iter().map(|(h, f)| (f, &info[h])).chain(
             m.entry_points
@@ -59,14 +60,18 @@ fn kernels_use_no_floating_point() {
                 assert!(
                     !is_float(ty),
                     "{}: {:?} in {:?} has a float type",
-                    k.name,
+                    k.name(),
                     e,
                     f.name
                 );
                 checked += 1;
             }
         }
-        assert!(checked > 50, "{}: only {checked} expressions seen", k.name);
+        assert!(
+            checked > 50,
+            "{}: only {checked} expressions seen",
+            k.name()
+        );
     }
 }
 
@@ -101,7 +106,7 @@ macro_rules! rust_layout {
 #[test]
 fn kernels_fit_the_default_storage_buffer_limit() {
     let limit = WEBGPU_DEFAULT_STORAGE_BUFFERS;
-    for k in kernels::ALL {
+    for k in Stage::ALL {
         let m = module(k);
         let n = m
             .global_variables
@@ -111,7 +116,7 @@ fn kernels_fit_the_default_storage_buffer_limit() {
         assert!(
             n <= limit,
             "{} binds {n} storage buffers: the default limit is {limit}",
-            k.name
+            k.name()
         );
     }
 }
@@ -122,14 +127,14 @@ const WEBGPU_DEFAULT_STORAGE_BUFFERS: usize = 8;
 
 #[test]
 fn every_kernel_parses_and_validates() {
-    for k in kernels::ALL {
+    for k in Stage::ALL {
         let m = module(k);
         assert!(
             m.entry_points
                 .iter()
                 .any(|e| e.name == kernels::ENTRY_POINT),
             "{} has no `{}` entry point",
-            k.name,
+            k.name(),
             kernels::ENTRY_POINT
         );
     }
@@ -137,7 +142,7 @@ fn every_kernel_parses_and_validates() {
 
 #[test]
 fn parameter_structs_match_their_wgsl_declarations() {
-    let upsample = module(kernels::UPSAMPLE_JITTER);
+    let upsample = module(Stage::UpsampleJitter);
     assert_eq!(
         wgsl_struct(&upsample, "UpsampleParams"),
         rust_layout!(UpsampleUniform {
@@ -160,7 +165,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
         })
     );
     assert_eq!(
-        wgsl_struct(&module(kernels::CORRECT), "CorrectParams"),
+        wgsl_struct(&module(Stage::Correct), "CorrectParams"),
         rust_layout!(CorrectUniform {
             width,
             height,
@@ -185,7 +190,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
         })
     );
     assert_eq!(
-        wgsl_struct(&module(kernels::FILL_SSD), "FillSsdParams"),
+        wgsl_struct(&module(Stage::FillSsd), "FillSsdParams"),
         rust_layout!(FillSsdUniform {
             cells,
             candidates,
@@ -194,7 +199,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
         })
     );
     assert_eq!(
-        wgsl_struct(&module(kernels::CORRECT), "GuideCell"),
+        wgsl_struct(&module(Stage::Correct), "GuideCell"),
         rust_layout!(GuideCell {
             blend_target,
             allowed,
@@ -205,7 +210,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
         })
     );
     assert_eq!(
-        wgsl_struct(&module(kernels::REDUCE_TYPES), "ReduceTypesParams"),
+        wgsl_struct(&module(Stage::ReduceTypes), "ReduceTypesParams"),
         rust_layout!(ReduceTypesUniform {
             width,
             height,
@@ -218,7 +223,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
         })
     );
     assert_eq!(
-        wgsl_struct(&module(kernels::REDUCE_WEIGHTS), "ReduceWeightsParams"),
+        wgsl_struct(&module(Stage::ReduceWeights), "ReduceWeightsParams"),
         rust_layout!(ReduceWeightsUniform {
             width,
             height,
@@ -226,7 +231,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
             child_height
         })
     );
-    for k in [kernels::RECONSTRUCT, kernels::REPAIR_EXTREMA] {
+    for k in [Stage::Reconstruct, Stage::RepairExtrema] {
         assert_eq!(
             wgsl_struct(&module(k), "ReconstructParams"),
             rust_layout!(ReconstructUniform {
@@ -236,11 +241,11 @@ fn parameter_structs_match_their_wgsl_declarations() {
                 pad1
             }),
             "ReconstructParams in {}",
-            k.name
+            k.name()
         );
     }
     assert_eq!(
-        wgsl_struct(&module(kernels::SHADE), "ShadeParams"),
+        wgsl_struct(&module(Stage::Shade), "ShadeParams"),
         rust_layout!(ShadeParams {
             lights,
             width,
@@ -287,10 +292,10 @@ fn parameter_structs_match_their_wgsl_declarations() {
     );
     // The atlas column table is uploaded as the Rust slice's bytes.
     for k in [
-        kernels::UPSAMPLE_JITTER,
-        kernels::CORRECT,
-        kernels::RECONSTRUCT,
-        kernels::REPAIR_EXTREMA,
+        Stage::UpsampleJitter,
+        Stage::Correct,
+        Stage::Reconstruct,
+        Stage::RepairExtrema,
     ] {
         assert_eq!(
             wgsl_struct(&module(k), "Column"),
@@ -302,7 +307,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
                 max_y
             }),
             "Column in {}",
-            k.name
+            k.name()
         );
     }
 }
@@ -310,7 +315,7 @@ fn parameter_structs_match_their_wgsl_declarations() {
 #[test]
 fn shade_constants_match() {
     use terrasynth::stages::shade::{self, flags};
-    let src = kernels::SHADE.source;
+    let src = Stage::Shade.wgsl();
     for (name, v) in [
         ("F_CONTOURS", flags::CONTOURS),
         ("F_GRID", flags::GRID),
@@ -347,7 +352,7 @@ fn correct_constants_match() {
         CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, SEED_SALT,
         SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };
-    let src = kernels::CORRECT.source;
+    let src = Stage::Correct.wgsl();
     for (name, v) in [
         ("F_TARGETS", CORRECT_TARGETS),
         ("F_ALLOWED", CORRECT_ALLOWED),
@@ -377,8 +382,8 @@ fn correct_constants_match() {
 fn reconstruct_constants_match() {
     use terrasynth::stages::repair_extrema::SUPPORT;
     assert!(
-        kernels::REPAIR_EXTREMA
-            .source
+        Stage::RepairExtrema
+            .wgsl()
             .contains(&format!("const SUPPORT: u32 = {SUPPORT}u;")),
         "SUPPORT must be {SUPPORT} in repair_extrema.wgsl"
     );
@@ -402,11 +407,11 @@ fn common_constants_match() {
             "{decl} in common.wgsl"
         );
         let name = decl.split(':').next().expect("a declaration");
-        for k in kernels::ALL {
+        for k in Stage::ALL {
             assert!(
-                !k.source.contains(name),
+                !k.wgsl().contains(name),
                 "{name} declared again in {}.wgsl",
-                k.name
+                k.name()
             );
         }
     }
@@ -415,7 +420,7 @@ fn common_constants_match() {
 #[test]
 fn step_constants_match() {
     use terrasynth::stages::upsample_jitter::{STEP_PYRAMID, STEP_VIRTUAL, STEP_WRAP};
-    let src = kernels::UPSAMPLE_JITTER.source;
+    let src = Stage::UpsampleJitter.wgsl();
     for (name, v) in [
         ("STEP_PYRAMID", STEP_PYRAMID),
         ("STEP_VIRTUAL", STEP_VIRTUAL),
@@ -426,15 +431,15 @@ fn step_constants_match() {
             "{name} must be {v} in upsample_jitter.wgsl"
         );
     }
-    for k in kernels::ALL {
+    for k in Stage::ALL {
         assert!(
-            k.source.contains(&format!(
+            k.wgsl().contains(&format!(
                 "@workgroup_size({}, {})",
                 kernels::WORKGROUP,
                 kernels::WORKGROUP
             )),
             "{} workgroup size",
-            k.name
+            k.name()
         );
     }
 }

@@ -15,6 +15,7 @@ use std::path::Path;
 use terrasynth::database::c2;
 use terrasynth::database::layout;
 use terrasynth::io::maps::type_mask::TypeMask;
+use terrasynth::isa::Isa;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::state::{State, level_size};
 use terrasynth::stages::common::ALL_TYPES;
@@ -445,7 +446,7 @@ fn controls_change_the_result_as_intended() {
         similar: true,
     };
     let plain = copy(&st);
-    correct::correct(&atlas, &plain, None, &p);
+    correct::correct(&atlas, &plain, None, &p, Isa::default());
     // A far-away target with zero tolerance moves every corrected offset.
     let targets = vec![
         Target {
@@ -459,7 +460,7 @@ fn controls_change_the_result_as_intended() {
         targets: Some(&targets),
         ..Guide::NONE
     };
-    correct::correct_guided(&atlas, &pulled, None, &p, &g);
+    correct::correct_guided(&atlas, &pulled, None, &p, &g, Isa::default());
     for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
         assert!(
             pulled.offsets()[i] > plain.offsets()[i] + 10_000,
@@ -472,7 +473,7 @@ fn controls_change_the_result_as_intended() {
         window: Some([10, 4, 20, 12]),
         ..Guide::NONE
     };
-    correct::correct_guided(&atlas, &windowed, None, &p, &g);
+    correct::correct_guided(&atlas, &windowed, None, &p, &g, Isa::default());
     for y in 0..h {
         for x in 0..w {
             let i = y * w + x;
@@ -498,7 +499,7 @@ fn controls_change_the_result_as_intended() {
         }),
         ..Guide::NONE
     };
-    correct::correct_guided(&atlas, &frozen, None, &p, &g);
+    correct::correct_guided(&atlas, &frozen, None, &p, &g, Isa::default());
     for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
         assert_eq!(
             (frozen.coords()[i], frozen.offsets()[i]),

@@ -117,10 +117,7 @@ fn reduce_types_follows_the_rule_on_every_block_of_the_sets_that_matter() {
 #[test]
 fn mis_sized_type_rasters_are_rejected() {
     // The CPU backend reads no database for this: bind none.
-    let cpu = Cpu {
-        atlas: &[],
-        heights: &[],
-    };
+    let cpu = Cpu::new(&[], &[]);
     assert_mis_sized(cpu.upload_types(&[0; 5], 2, 3).map(|_| ()));
     #[cfg(feature = "gpu")]
     if let Some(gpu) = &rig(default_db()).gpu {

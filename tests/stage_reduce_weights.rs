@@ -55,10 +55,7 @@ proptest! {
 #[test]
 fn mis_sized_weight_rasters_are_rejected() {
     // The CPU backend reads no database for this: bind none.
-    let cpu = Cpu {
-        atlas: &[],
-        heights: &[],
-    };
+    let cpu = Cpu::new(&[], &[]);
     assert_mis_sized(cpu.upload_weights(&[0; 5], 2, 3).map(|_| ()));
     #[cfg(feature = "gpu")]
     if let Some(gpu) = &rig(default_db()).gpu {

@@ -12,6 +12,7 @@
 use proptest::prelude::*;
 use terrasynth::database::layout::MARGIN;
 use terrasynth::hash::hash4;
+use terrasynth::isa::Isa;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::fixed::{Coord, FRAC_BITS};
 use terrasynth::level::state::State;
@@ -159,19 +160,21 @@ proptest! {
         let origin = [bits[1] % 65536 * 2, bits[2] % 65536 * 2];
         let p = UpsampleParams { seed, level: level as u32, jitter, step: Step::Pyramid, origin };
         let (cw, ch) = (2 * w, 2 * h);
-        let part = State::new(cw, ch);
         let rect = [r[0].min(r[1]), r[2].min(r[3]), r[0].max(r[1]), r[2].max(r[3])];
-        upsample_jitter_rect(&parent, &part, Some(&rig.atlas[level]), &p, rect);
         let untouched = State::new(1, 1);
-        for k in 0..cw * ch {
-            let (x, y) = (k % cw, k / cw);
-            let inside = (rect[0]..rect[2]).contains(&x) && (rect[1]..rect[3]).contains(&y);
-            let want = if inside {
-                oracle(&parent, rig.atlas.get(level), &p, x, y)
-            } else {
-                (untouched.s(0), untouched.v(0))
-            };
-            prop_assert_eq!((part.s(k), part.v(k)), want, "pixel ({}, {})", x, y);
+        for &isa in Isa::all() {
+            let part = State::new(cw, ch);
+            upsample_jitter_rect(&parent, &part, Some(&rig.atlas[level]), &p, rect, isa);
+            for k in 0..cw * ch {
+                let (x, y) = (k % cw, k / cw);
+                let inside = (rect[0]..rect[2]).contains(&x) && (rect[1]..rect[3]).contains(&y);
+                let want = if inside {
+                    oracle(&parent, rig.atlas.get(level), &p, x, y)
+                } else {
+                    (untouched.s(0), untouched.v(0))
+                };
+                prop_assert_eq!((part.s(k), part.v(k)), want, "{:?}: pixel ({}, {})", isa, x, y);
+            }
         }
     }
 }
@@ -210,12 +213,14 @@ fn upsample_jitter_whole_level_follows_the_rule_at_exemplar_corners() {
         step: Step::Pyramid,
         origin: [0, 0],
     };
-    let child = State::new(2 * w, 2 * h);
-    upsample_jitter(&parent, &child, Some(&rig.atlas[0]), &p);
-    for k in 0..4 * w * h {
-        let (x, y) = (k % (2 * w), k / (2 * w));
-        let want = oracle(&parent, rig.atlas.first(), &p, x, y);
-        assert_eq!((child.s(k), child.v(k)), want, "pixel ({x}, {y})");
+    for &isa in Isa::all() {
+        let child = State::new(2 * w, 2 * h);
+        upsample_jitter(&parent, &child, Some(&rig.atlas[0]), &p, isa);
+        for k in 0..4 * w * h {
+            let (x, y) = (k % (2 * w), k / (2 * w));
+            let want = oracle(&parent, rig.atlas.first(), &p, x, y);
+            assert_eq!((child.s(k), child.v(k)), want, "{isa:?}: pixel ({x}, {y})");
+        }
     }
 }
 
@@ -242,5 +247,32 @@ fn upsample_jitter_agrees_on_real_states() {
                 assert_agree(&runs, &format!("upsample_jitter to level {level} (real)"));
             }
         }
+    }
+}
+
+/// The rig runs the CPU path once per instruction-set level this CPU has,
+/// named by it, then the GPU where there is one: a level that silently
+/// stopped running (an AVX2 CPU whose `avx2` copy went unchecked) fails
+/// here rather than passing every comparison unseen.
+#[test]
+fn the_rig_runs_every_isa_level_and_the_gpu() {
+    let rig = rig(default_db());
+    let p = UpsampleParams {
+        seed: 1,
+        level: 0,
+        jitter: 102,
+        step: Step::Virtual { shift: 0 },
+        origin: [0, 0],
+    };
+    let runs = rig.upsample_jitter(&State::new(2, 2), (4, 4), 0, &p);
+    let names: Vec<&str> = runs.iter().map(|r| r.0).collect();
+    let mut want: Vec<&str> = Isa::all().iter().map(|i| i.name()).collect();
+    if rig.has_gpu() {
+        want.push("gpu");
+    }
+    assert_eq!(names, want);
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        assert_eq!(names[..2], ["portable", "avx2"]);
     }
 }

@@ -2,6 +2,7 @@
 //! host memory. The reference every other backend is checked against.
 
 use super::{Backend, BackendError, Raster};
+use crate::isa::Isa;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::State;
@@ -16,6 +17,20 @@ pub struct Cpu<'a, 'db> {
     pub atlas: &'a [AtlasLevel<'db>],
     /// Level-0 heights (`Database::heights`).
     pub heights: &'a [u16],
+    /// The instruction-set level the run-time-dispatched stages run at: a
+    /// value, so that tests run every level in one process.
+    pub isa: Isa,
+}
+
+impl<'a, 'db> Cpu<'a, 'db> {
+    /// The CPU backend at the default level ([`Isa::default`]).
+    pub fn new(atlas: &'a [AtlasLevel<'db>], heights: &'a [u16]) -> Cpu<'a, 'db> {
+        Cpu {
+            atlas,
+            heights,
+            isa: Isa::default(),
+        }
+    }
 }
 
 impl Backend for Cpu<'_, '_> {
@@ -58,11 +73,11 @@ impl Backend for Cpu<'_, '_> {
         rect: [usize; 4],
     ) {
         let atlas = matches!(p.step, Step::Pyramid).then(|| &self.atlas[level]);
-        upsample_jitter::upsample_jitter_rect(parent, child, atlas, p, rect);
+        upsample_jitter::upsample_jitter_rect(parent, child, atlas, p, rect, self.isa);
     }
 
     fn correct(&self, st: &State, parent: Option<&State>, level: usize, p: &CorrectParams) {
-        correct::correct(&self.atlas[level], st, parent, p);
+        correct::correct(&self.atlas[level], st, parent, p, self.isa);
     }
 
     fn upload_guide<'g>(
@@ -83,7 +98,7 @@ impl Backend for Cpu<'_, '_> {
         p: &CorrectParams,
         g: &correct::Guide<'_>,
     ) {
-        correct::correct_guided(&self.atlas[level], st, parent, p, g);
+        correct::correct_guided(&self.atlas[level], st, parent, p, g, self.isa);
     }
 
     fn reconstruct(&self, st: &State) -> Result<Vec<i32>, BackendError> {

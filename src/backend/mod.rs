@@ -7,31 +7,28 @@
 //! computes — host memory or GPU buffers — so state stays on the GPU across
 //! stages and levels and only results (and requested debug maps) come back.
 //! Both produce the same bytes after every stage (DESIGN §6); the
-//! `backend_*` tests check it.
+//! `backend_*` tests check it. Which one runs — for synthesis, the
+//! preview's `shade` and the patch engine's `fill_ssd` alike — is one
+//! [`engine::Engine`], chosen once from the user's [`Choice`].
 
 pub mod cpu;
+pub mod engine;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod kernels;
 
 use crate::level::fixed::Coord;
 use crate::level::state::State;
+use crate::stages::Stage;
 use crate::stages::correct::{self, CorrectParams};
 use crate::stages::upsample_jitter::UpsampleParams;
 use std::time::Duration;
 use thiserror::Error;
 
-/// The stages a backend runs, for per-stage timings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Stage {
-    UpsampleJitter,
-    Correct,
-    Reconstruct,
-}
-
 /// The device's own measure of one stage call (GPU timestamp queries).
 #[derive(Debug, Clone, Copy)]
 pub struct StageTime {
+    /// The stage, keyed by its line in the table of stages.
     pub stage: Stage,
     /// The level the call worked on.
     pub level: usize,

@@ -1,5 +1,6 @@
 //! Errors of the preview renderer.
 
+use crate::backend::BackendError;
 use crate::io::IoError;
 use crate::size::SizeError;
 use crate::stages::shade::ParamsError;
@@ -35,4 +36,7 @@ pub enum RenderError {
     Size(#[from] SizeError),
     #[error(transparent)]
     Io(#[from] IoError),
+    /// The GPU failed while shading (never the arithmetic: that is tested).
+    #[error(transparent)]
+    Backend(BackendError),
 }

@@ -35,8 +35,9 @@ pub use prepare::{Prepared, RenderInfo, prepare};
 pub use tint::Palette;
 pub use types::TypeOverlay;
 
+use crate::backend::BackendError;
+use crate::backend::engine::Engine;
 use crate::heightfield::Heightfield;
-use crate::stages::shade;
 use image::RgbaImage;
 use std::path::Path;
 
@@ -194,11 +195,25 @@ impl Preview {
     }
 }
 
-/// Renders a preview: [`prepare`], then the `shade` stage.
+/// Renders a preview: [`prepare`], then the `shade` stage on the CPU.
 pub fn render(hf: &Heightfield, opts: &RenderOptions) -> Result<Preview, RenderError> {
+    render_on(&Engine::default(), hf, opts)
+}
+
+/// [`render`] with the `shade` stage on `engine` (a synthesis's own, so
+/// that its preview is shaded where it ran): the same bytes on every one.
+pub fn render_on(
+    engine: &Engine,
+    hf: &Heightfield,
+    opts: &RenderOptions,
+) -> Result<Preview, RenderError> {
     let prep = prepare(hf, opts)?;
-    let mut pixels = vec![0u32; prep.heights.len()];
-    shade::shade(&prep.params, &prep.buffers(), &mut pixels)?;
+    let pixels = engine
+        .shade(&prep.params, &prep.buffers())
+        .map_err(|e| match e {
+            BackendError::Shade(e) => RenderError::Params(e),
+            e => RenderError::Backend(e),
+        })?;
     Ok(Preview::from_pixels(prep.info, &pixels))
 }
 

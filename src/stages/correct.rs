@@ -72,6 +72,7 @@ pub mod scalar;
 pub mod simd;
 mod uniform;
 
+use crate::isa::Isa;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, div_floor};
 use crate::level::state::State;
@@ -338,11 +339,17 @@ pub const SEEDS_PER_ALLOWED_TYPE: u32 = 9;
 /// Hash salt of type seeding.
 pub const SEED_SALT: u32 = 0x7E5E_0000;
 
-/// Runs one subpass in place over the level by the [`simd`] path. `parent`
-/// is the level above (the height prior's anchor; none at the coarsest
-/// corrected level).
-pub fn correct(atlas: &AtlasLevel<'_>, st: &State, parent: Option<&State>, p: &CorrectParams) {
-    correct_guided(atlas, st, parent, p, &Guide::NONE)
+/// Runs one subpass in place over the level by the [`simd`] path, its copy
+/// for `isa` (the same bytes at every level). `parent` is the level above
+/// (the height prior's anchor; none at the coarsest corrected level).
+pub fn correct(
+    atlas: &AtlasLevel<'_>,
+    st: &State,
+    parent: Option<&State>,
+    p: &CorrectParams,
+    isa: Isa,
+) {
+    correct_guided(atlas, st, parent, p, &Guide::NONE, isa)
 }
 
 /// [`correct`] with control inputs. Pixels with a type constraint go
@@ -354,13 +361,14 @@ pub fn correct_guided(
     parent: Option<&State>,
     p: &CorrectParams,
     g: &Guide<'_>,
+    isa: Isa,
 ) {
     match p.prior {
-        0 => guided::<0>(atlas, st, parent, p, g),
-        1 => guided::<1>(atlas, st, parent, p, g),
-        2 => guided::<2>(atlas, st, parent, p, g),
-        4 => guided::<4>(atlas, st, parent, p, g),
-        8 => guided::<8>(atlas, st, parent, p, g),
+        0 => guided::<0>(atlas, st, parent, p, g, isa),
+        1 => guided::<1>(atlas, st, parent, p, g, isa),
+        2 => guided::<2>(atlas, st, parent, p, g, isa),
+        4 => guided::<4>(atlas, st, parent, p, g, isa),
+        8 => guided::<8>(atlas, st, parent, p, g, isa),
         w => panic!("height prior {w} is not one of {PRIORS:?} (checked by Synthesizer::new)"),
     }
 }
@@ -372,6 +380,7 @@ fn guided<const P: u32>(
     parent: Option<&State>,
     p: &CorrectParams,
     g: &Guide<'_>,
+    isa: Isa,
 ) {
     keep_outside(st, p, g);
     let (w, h) = (st.width, st.height);
@@ -395,7 +404,8 @@ fn guided<const P: u32>(
             let first = b * ROWS_PER_TASK;
             let ys: [usize; ROWS_PER_TASK] = std::array::from_fn(|j| y_first + 2 * (first + j));
             let ys = &ys[..ROWS_PER_TASK.min(rows - first)];
-            simd::correct_span::<P>(atlas, st, parent, (ys, x_first, x_end), p.similar, g);
+            let span = (ys, x_first, x_end);
+            simd::correct_span::<P>(atlas, st, parent, span, p.similar, g, isa);
         });
 }
 

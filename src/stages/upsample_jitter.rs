@@ -19,6 +19,7 @@
 
 use crate::database::layout::MARGIN;
 use crate::hash::hash4;
+use crate::isa::Isa;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS};
 use crate::level::state::State;
@@ -74,15 +75,17 @@ pub fn jitter(seed: u32, level: u32, x: u32, y: u32, r: i32) -> (i32, i32) {
 }
 
 /// Fills `child` from `parent`. `atlas` is the child level's atlas (used by
-/// [`Step::Pyramid`] to clamp).
+/// [`Step::Pyramid`] to clamp); `isa` picks the jitter's copy (the same
+/// bytes at every level).
 pub fn upsample_jitter(
     parent: &State,
     child: &State,
     atlas: Option<&AtlasLevel<'_>>,
     p: &UpsampleParams,
+    isa: Isa,
 ) {
     let rect = [0, 0, child.width, child.height];
-    upsample_jitter_rect(parent, child, atlas, p, rect);
+    upsample_jitter_rect(parent, child, atlas, p, rect, isa);
 }
 
 /// [`upsample_jitter`] of the child pixels in `[x0, y0, x1, y1)` only (the
@@ -94,6 +97,7 @@ pub fn upsample_jitter_rect(
     atlas: Option<&AtlasLevel<'_>>,
     p: &UpsampleParams,
     [x0, y0, x1, y1]: [usize; 4],
+    isa: Isa,
 ) {
     let [ox, oy] = p.origin;
     debug_assert!(ox % 2 == 0 && oy % 2 == 0, "odd origin {:?}", p.origin);
@@ -103,7 +107,7 @@ pub fn upsample_jitter_rect(
         for a in (x0..x1).step_by(ROW_CHUNK) {
             let b = x1.min(a + ROW_CHUNK);
             let jit = &mut jit[..b - a];
-            jitter_row(p, ox + a as u32, oy + y as u32, jit);
+            jitter_row(p, ox + a as u32, oy + y as u32, jit, isa);
             let run = Run {
                 parent,
                 child,
@@ -146,12 +150,13 @@ pub fn upsample_jitter_rect(
 /// work was the stage's main cost.
 const ROW_CHUNK: usize = 256;
 
-/// [`jitter`] of the pixels (ax, ay), (ax + 1, ay), … into `out`.
+/// [`jitter`] of the pixels (ax, ay), (ax + 1, ay), … into `out`, by
+/// `isa`'s copy.
 #[inline]
-fn jitter_row(p: &UpsampleParams, ax: u32, ay: u32, out: &mut [(i32, i32)]) {
+fn jitter_row(p: &UpsampleParams, ax: u32, ay: u32, out: &mut [(i32, i32)], isa: Isa) {
     #[cfg(target_arch = "x86_64")]
-    if crate::isa::avx2() {
-        // SAFETY: the CPU supports AVX2 (`isa::avx2` checks it), the one
+    if isa.avx2() {
+        // SAFETY: the CPU supports AVX2 (`Isa::avx2` checks it), the one
         // feature the function enables.
         unsafe { jitter_row_avx2(p, ax, ay, out) };
         return;

@@ -7,12 +7,12 @@ use super::cone::Cone;
 use super::restricted::LevelBuffers;
 use super::window::{REACH_PER_SUBPASS, widen};
 use super::{Control, Frames, LevelMaps, LevelTiming, SynthError, Synthesis, Synthesizer, Timings};
-use crate::backend::{Backend, Stage};
+use crate::backend::Backend;
 use crate::heightfield::Heightfield;
 use crate::level::state::top_level;
 use crate::stages::common::HEIGHT_FRAC_BITS;
 use crate::stages::correct::SUBPASSES;
-use crate::stages::reconstruct;
+use crate::stages::{Stage, reconstruct};
 use std::time::{Duration, Instant};
 
 impl Synthesizer<'_> {
@@ -211,7 +211,11 @@ impl Synthesizer<'_> {
                 match st.stage {
                     Stage::UpsampleJitter => timings.levels[st.level].upsample += st.time,
                     Stage::Correct => timings.levels[st.level].correct += st.time,
-                    Stage::Reconstruct => timings.reconstruct += st.time,
+                    Stage::Reconstruct | Stage::RepairExtrema => timings.reconstruct += st.time,
+                    // Untimed (the control pyramids' reductions run once
+                    // per pass, outside any level's time) or not synthesis
+                    // stages.
+                    Stage::ReduceTypes | Stage::ReduceWeights | Stage::Shade | Stage::FillSsd => {}
                 }
             }
         }

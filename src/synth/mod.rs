@@ -25,9 +25,11 @@ pub mod source_map;
 mod window;
 mod windowed;
 
+use crate::backend::engine::Engine;
 use crate::backend::{Backend, Choice, cpu::Cpu};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
+use crate::isa::Isa;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::FRAC_BITS;
 use crate::level::state::{State, level_size, top_level};
@@ -66,6 +68,8 @@ pub struct Synthesizer<'db> {
     /// The coarse start's pool, built by the first synthesis that starts
     /// from pieces (it ranks every interior texel of level L).
     pool: OnceLock<coarse::Pool>,
+    /// The CPU stages' instruction-set level (when no GPU runs them).
+    isa: Isa,
     #[cfg(feature = "gpu")]
     gpu: Option<crate::backend::gpu::Gpu>,
 }
@@ -98,6 +102,7 @@ impl<'db> Synthesizer<'db> {
             atlas,
             jitter,
             pool: OnceLock::new(),
+            isa: Isa::default(),
             #[cfg(feature = "gpu")]
             gpu: None,
         })
@@ -106,34 +111,25 @@ impl<'db> Synthesizer<'db> {
     /// Moves the stages to the backend `choice` names. Returns a one-line
     /// notice when [`Choice::Auto`] found no GPU and stays on the CPU.
     pub fn use_backend(&mut self, choice: Choice) -> Result<Option<String>, SynthError> {
-        #[cfg(feature = "gpu")]
-        {
-            let ctx = match choice {
-                Choice::Cpu => {
+        let (engine, notice) = Engine::choose(choice)?;
+        self.use_engine(engine)?;
+        Ok(notice)
+    }
+
+    /// Runs the stages on `engine` (a GPU: uploads the database once).
+    pub fn use_engine(&mut self, engine: Engine) -> Result<(), SynthError> {
+        match engine {
+            Engine::Cpu(isa) => {
+                self.isa = isa;
+                #[cfg(feature = "gpu")]
+                {
                     self.gpu = None;
-                    return Ok(None);
                 }
-                Choice::Gpu => crate::backend::gpu::Context::new()?,
-                Choice::Auto => match crate::backend::gpu::Context::new() {
-                    Ok(ctx) => ctx,
-                    Err(e) => {
-                        self.gpu = None;
-                        return Ok(Some(format!("{e}; using the CPU")));
-                    }
-                },
-            };
-            self.use_gpu(ctx)?;
-            Ok(None)
+            }
+            #[cfg(feature = "gpu")]
+            Engine::Gpu(ctx) => self.use_gpu(ctx)?,
         }
-        #[cfg(not(feature = "gpu"))]
-        match choice {
-            Choice::Cpu => Ok(None),
-            Choice::Gpu => Err(crate::backend::BackendError::NotCompiled.into()),
-            Choice::Auto => Ok(Some(format!(
-                "{}; using the CPU",
-                crate::backend::BackendError::NotCompiled
-            ))),
-        }
+        Ok(())
     }
 
     /// Runs the stages on the GPU of `ctx` (uploads the database once).
@@ -150,11 +146,13 @@ impl<'db> Synthesizer<'db> {
         Ok(())
     }
 
-    /// The GPU the stages run on, if they do (e.g. to shade a preview
-    /// there too).
-    #[cfg(feature = "gpu")]
-    pub fn gpu_context(&self) -> Option<&std::sync::Arc<crate::backend::gpu::Context>> {
-        self.gpu.as_ref().map(|g| g.context())
+    /// The engine the stages run on (e.g. to shade a preview there too).
+    pub fn engine(&self) -> Engine {
+        #[cfg(feature = "gpu")]
+        if let Some(g) = &self.gpu {
+            return Engine::Gpu(g.context().clone());
+        }
+        Engine::Cpu(self.isa)
     }
 
     /// Where the stages run: `"cpu"` or `"gpu"`.
@@ -171,6 +169,7 @@ impl<'db> Synthesizer<'db> {
         Cpu {
             atlas: &self.atlas,
             heights: self.db.heights(),
+            isa: self.isa,
         }
     }
 

@@ -1,19 +1,22 @@
 //! Every way a stage runs, against one result (DESIGN §6): the scalar
 //! oracle, the CPU's fast path (rayon, explicit SIMD where the stage has
-//! it) and, with `--features gpu` and an adapter, the WGSL kernel. Each
-//! stage test draws its inputs once, asks for every variant's output here
-//! and checks them all with [`assert_agree`] — one loop, whatever was
-//! built.
+//! it) at every instruction-set level this CPU has (`Isa::all`: the
+//! portable copy and AVX2, for the stages that dispatch on it) and, with
+//! `--features gpu` and an adapter, the WGSL kernel. Each stage test draws
+//! its inputs once, asks for every variant's output here and checks them
+//! all with [`assert_agree`] — one loop, whatever was built, in one run.
 
 use std::fmt::Debug;
+use terrasynth::backend::engine::Engine;
 use terrasynth::backend::{Backend, BackendError, cpu::Cpu};
 use terrasynth::database::Database;
+use terrasynth::isa::Isa;
 use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::fixed::Coord;
 use terrasynth::level::state::{State, level_size, top_level};
 use terrasynth::stages::correct::{CorrectParams, Guide, PRIORS, SUBPASSES, scalar};
 use terrasynth::stages::fill_ssd::{fill_ssd_scalar, fill_ssd_table};
-use terrasynth::stages::shade::{self, ShadeBuffers, ShadeParams};
+use terrasynth::stages::shade::{ShadeBuffers, ShadeParams};
 use terrasynth::stages::upsample_jitter::UpsampleParams;
 
 #[cfg(feature = "gpu")]
@@ -103,12 +106,17 @@ pub fn rig(db: &'static Database) -> &'static Rig<'static> {
 }
 
 impl<'db> Rig<'db> {
-    /// The CPU backend (the stages' fast paths).
+    /// The CPU backend (the stages' fast paths) at the default level.
     pub fn cpu(&self) -> Cpu<'_, 'db> {
-        Cpu {
-            atlas: &self.atlas,
-            heights: self.heights,
-        }
+        Cpu::new(&self.atlas, self.heights)
+    }
+
+    /// The CPU backend at every level this CPU has, each named by it.
+    fn cpus(&self) -> impl Iterator<Item = (&'static str, Cpu<'_, 'db>)> {
+        Isa::all().iter().map(|&isa| {
+            let cpu = Cpu { isa, ..self.cpu() };
+            (isa.name(), cpu)
+        })
     }
 
     /// Whether a GPU variant runs.
@@ -121,9 +129,9 @@ impl<'db> Rig<'db> {
     }
 
     /// Stage `correct`, one subpass at `level` from `st` (the level above:
-    /// `parent`): `scalar`, `simd` (the CPU backend) and `gpu`. Without a
-    /// guide through each variant's plain entry point, with one through its
-    /// guided one.
+    /// `parent`): `scalar`, the CPU backend at each [`Isa`] (`portable`,
+    /// `avx2`) and `gpu`. Without a guide through each variant's plain
+    /// entry point, with one through its guided one.
     pub fn correct(
         &self,
         level: usize,
@@ -138,16 +146,18 @@ impl<'db> Rig<'db> {
             None => scalar::correct(atlas, &oracle, parent, p),
             Some(g) => scalar::correct_guided(atlas, &oracle, parent, p, g),
         }
-        let fast = copy(st);
-        match g {
-            None => self.cpu().correct(&fast, parent, level, p),
-            Some(g) => {
-                let cg = self.cpu().upload_guide(g, st.width, st.height).unwrap();
-                self.cpu().correct_guided(&fast, parent, level, p, &cg);
+        let mut runs = vec![("scalar", out(&oracle))];
+        for (name, cpu) in self.cpus() {
+            let fast = copy(st);
+            match g {
+                None => cpu.correct(&fast, parent, level, p),
+                Some(g) => {
+                    let cg = cpu.upload_guide(g, st.width, st.height).unwrap();
+                    cpu.correct_guided(&fast, parent, level, p, &cg);
+                }
             }
+            runs.push((name, out(&fast)));
         }
-        #[allow(unused_mut)]
-        let mut runs = vec![("scalar", out(&oracle)), ("simd", out(&fast))];
         #[cfg(feature = "gpu")]
         if let Some(gpu) = &self.gpu {
             let gs = gpu.upload(copy(st)).unwrap();
@@ -193,7 +203,7 @@ impl<'db> Rig<'db> {
     }
 
     /// Stage `upsample_jitter` from `parent` into a `w × h` level `level`:
-    /// `cpu` and `gpu`.
+    /// the CPU backend at each [`Isa`] and `gpu`.
     pub fn upsample_jitter(
         &self,
         parent: &State,
@@ -201,10 +211,12 @@ impl<'db> Rig<'db> {
         level: usize,
         p: &UpsampleParams,
     ) -> Vec<Run<(Coord, i32)>> {
-        let child = State::new(w, h);
-        self.cpu().upsample_jitter(parent, &child, level, p);
-        #[allow(unused_mut)]
-        let mut runs = vec![("cpu", pixels(&child.coords(), &child.offsets()))];
+        let mut runs = Vec::new();
+        for (name, cpu) in self.cpus() {
+            let child = State::new(w, h);
+            cpu.upsample_jitter(parent, &child, level, p);
+            runs.push((name, pixels(&child.coords(), &child.offsets())));
+        }
         #[cfg(feature = "gpu")]
         if let Some(gpu) = &self.gpu {
             let gp = gpu.upload(copy(parent)).unwrap();
@@ -283,15 +295,14 @@ impl<'db> Rig<'db> {
     }
 }
 
-/// Stage `shade`: `cpu` and `gpu` packed RGBA pixels.
+/// Stage `shade`: `cpu` and `gpu` packed RGBA pixels, each through the
+/// engine a preview is rendered on (`Engine::shade`).
 pub fn shade(p: &ShadeParams, b: &ShadeBuffers<'_>) -> Vec<Run<u32>> {
-    let mut cpu = vec![0u32; b.heights.len()];
-    shade::shade(p, b, &mut cpu).unwrap();
     #[allow(unused_mut)]
-    let mut runs = vec![("cpu", cpu)];
+    let mut runs = vec![("cpu", Engine::default().shade(p, b).unwrap())];
     #[cfg(feature = "gpu")]
     if let Some(ctx) = super::gpu::context() {
-        runs.push(("gpu", ctx.shade(p, b).unwrap()));
+        runs.push(("gpu", Engine::Gpu(ctx).shade(p, b).unwrap()));
     }
     runs
 }

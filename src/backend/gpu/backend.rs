@@ -6,6 +6,7 @@ use super::{Gpu, GpuGuide, GpuRaster, GpuState};
 use crate::backend::{Backend, BackendError, StageTime};
 use crate::level::fixed::Coord;
 use crate::level::state::State;
+use crate::stages::Stage;
 use crate::stages::correct::{CorrectParams, Guide};
 use crate::stages::reduce_types::ReduceTypesUniform;
 use crate::stages::reduce_weights::ReduceWeightsUniform;
@@ -109,14 +110,7 @@ impl Backend for Gpu {
         full: u32,
     ) -> Result<GpuRaster, BackendError> {
         let u = ReduceTypesUniform::new(width, height, (child.width, child.height), full);
-        self.reduce(
-            "type sets",
-            &self.ctx.reduce_types,
-            &u,
-            child,
-            width,
-            height,
-        )
+        self.reduce("type sets", Stage::ReduceTypes, &u, child, width, height)
     }
 
     fn reduce_weights(
@@ -128,7 +122,7 @@ impl Backend for Gpu {
         let u = ReduceWeightsUniform::new(width, height, (child.width, child.height));
         self.reduce(
             "coherence weights",
-            &self.ctx.reduce_weights,
+            Stage::ReduceWeights,
             &u,
             child,
             width,

@@ -1,10 +1,11 @@
 //! The device and its compiled kernels: adapter choice, device creation and
-//! one compute pipeline per WGSL kernel.
+//! one compute pipeline per stage of the table (`stages::Stage::ALL`).
 
 use super::dispatch::Recorder;
 use super::timing::MAX_TIMED;
 use crate::backend::BackendError;
-use crate::backend::kernels::{self, Kernel};
+use crate::backend::kernels;
+use crate::stages::Stage;
 use std::sync::{Arc, Mutex};
 
 /// A device with the kernels compiled: create once, share (`Arc`) between
@@ -14,14 +15,8 @@ pub struct Context {
     pub(super) queue: wgpu::Queue,
     pub(super) info: wgpu::AdapterInfo,
     pub(super) limits: wgpu::Limits,
-    pub(super) upsample_jitter: wgpu::ComputePipeline,
-    pub(super) correct: wgpu::ComputePipeline,
-    pub(super) reduce_types: wgpu::ComputePipeline,
-    pub(super) reduce_weights: wgpu::ComputePipeline,
-    pub(super) reconstruct: wgpu::ComputePipeline,
-    pub(super) repair_extrema: wgpu::ComputePipeline,
-    pub(super) shade: wgpu::ComputePipeline,
-    pub(super) fill_ssd: wgpu::ComputePipeline,
+    /// Each stage's kernel, at its index in [`Stage::ALL`].
+    pipelines: [wgpu::ComputePipeline; Stage::ALL.len()],
     /// Timestamp queries (two per timed dispatch), where the adapter has them.
     pub(super) queries: Option<wgpu::QuerySet>,
     /// Passes recorded and not yet submitted, and what the queries time.
@@ -62,13 +57,13 @@ impl Context {
             })
             .await
             .map_err(|e| BackendError::Device(e.to_string()))?;
-        let pipeline = |k: Kernel| {
+        let pipeline = |s: Stage| {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(k.name),
-                source: wgpu::ShaderSource::Wgsl(k.module_source().into()),
+                label: Some(s.name()),
+                source: wgpu::ShaderSource::Wgsl(kernels::module_source(s).into()),
             });
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(k.name),
+                label: Some(s.name()),
                 layout: None,
                 module: &module,
                 entry_point: Some(kernels::ENTRY_POINT),
@@ -77,14 +72,7 @@ impl Context {
             })
         };
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let upsample_jitter = pipeline(kernels::UPSAMPLE_JITTER);
-        let correct = pipeline(kernels::CORRECT);
-        let reduce_types = pipeline(kernels::REDUCE_TYPES);
-        let reduce_weights = pipeline(kernels::REDUCE_WEIGHTS);
-        let reconstruct = pipeline(kernels::RECONSTRUCT);
-        let repair_extrema = pipeline(kernels::REPAIR_EXTREMA);
-        let shade = pipeline(kernels::SHADE);
-        let fill_ssd = pipeline(kernels::FILL_SSD);
+        let pipelines = Stage::ALL.map(pipeline);
         if let Some(e) = scope.pop().await {
             return Err(BackendError::Gpu(e.to_string()));
         }
@@ -102,15 +90,13 @@ impl Context {
             device,
             queue,
             limits,
-            upsample_jitter,
-            correct,
-            reduce_types,
-            reduce_weights,
-            reconstruct,
-            repair_extrema,
-            shade,
-            fill_ssd,
+            pipelines,
         }))
+    }
+
+    /// `stage`'s compiled kernel.
+    pub(super) fn pipeline(&self, stage: Stage) -> &wgpu::ComputePipeline {
+        &self.pipelines[stage as usize]
     }
 
     /// Whether stage times come from GPU timestamp queries (else wall clock).

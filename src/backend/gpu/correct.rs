@@ -2,7 +2,8 @@
 //! inputs it reads uploaded once per pass.
 
 use super::{Gpu, GpuState, groups};
-use crate::backend::{BackendError, Stage, check_guide};
+use crate::backend::{BackendError, check_guide};
+use crate::stages::Stage;
 use crate::stages::correct::{
     CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, CorrectParams, CorrectUniform, Guide,
     GuideCell,
@@ -113,8 +114,8 @@ impl Gpu {
         // Pixels of the parity class per axis: ⌈(n − parity) / 2⌉.
         let class = |n: usize, parity: u32| (n - parity as usize).div_ceil(2);
         self.ctx.dispatch(
-            Some((Stage::Correct, level)),
-            &self.ctx.correct,
+            Stage::Correct,
+            Some(level),
             bytemuck::bytes_of(&u),
             &[
                 &st.s,

@@ -12,7 +12,7 @@
 
 use super::Context;
 use super::timing::Labels;
-use crate::backend::Stage;
+use crate::stages::Stage;
 use std::sync::MutexGuard;
 use wgpu::util::DeviceExt;
 
@@ -55,13 +55,14 @@ impl Context {
         self.recorder().submit(&self.queue);
     }
 
-    /// Records one dispatch: `uniform` at binding 0, `buffers` at bindings
-    /// 1.., `groups` workgroups; timed as `label` (a synthesis stage and its
-    /// level) when given and the device has timestamps.
+    /// Records one dispatch of `stage`'s kernel: `uniform` at binding 0,
+    /// `buffers` at bindings 1.., `groups` workgroups; timed as the stage
+    /// at level `timed` when given (the synthesis stages) and the device
+    /// has timestamps.
     pub(super) fn dispatch(
         &self,
-        label: Option<(Stage, usize)>,
-        pipeline: &wgpu::ComputePipeline,
+        stage: Stage,
+        timed: Option<usize>,
         uniform: &[u8],
         buffers: &[&wgpu::Buffer],
         groups: (u32, u32),
@@ -84,24 +85,21 @@ impl Context {
             binding: i,
             resource: b.as_entire_binding(),
         }));
+        let pipeline = self.pipeline(stage);
         let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
             layout: &pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
         let mut rec = self.recorder();
-        let slot = self
-            .queries
-            .as_ref()
-            .zip(label)
-            .and_then(|(q, (stage, level))| {
-                let k = rec.labels.push(std::thread::current().id(), stage, level)?;
-                Some(wgpu::ComputePassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(2 * k),
-                    end_of_pass_write_index: Some(2 * k + 1),
-                })
-            });
+        let slot = self.queries.as_ref().zip(timed).and_then(|(q, level)| {
+            let k = rec.labels.push(std::thread::current().id(), stage, level)?;
+            Some(wgpu::ComputePassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: Some(2 * k),
+                end_of_pass_write_index: Some(2 * k + 1),
+            })
+        });
         {
             let mut pass =
                 rec.encoder(&self.device)

@@ -10,6 +10,7 @@
 
 use super::Context;
 use crate::backend::BackendError;
+use crate::stages::Stage;
 use crate::stages::fill_ssd::{FillSsdUniform, dc_ssd};
 
 /// One source's candidate cells on the device.
@@ -95,8 +96,8 @@ impl Context {
             pad0: 0,
         };
         self.dispatch(
+            Stage::FillSsd,
             None,
-            &self.fill_ssd,
             bytemuck::bytes_of(&u),
             &[&user_buf, &src.buf, &out],
             (super::groups(src.candidates), super::groups(transforms)),

@@ -3,6 +3,7 @@
 
 use super::{Gpu, groups};
 use crate::backend::{BackendError, check_raster};
+use crate::stages::Stage;
 
 /// One level's control raster on the device, one u32 per pixel: type sets
 /// as they are, coherence weights widened from u8 (see
@@ -49,13 +50,13 @@ impl Gpu {
         Ok(wide.into_iter().map(|w| w as u8).collect())
     }
 
-    /// One dispatch of a reduction (`reduce_types`, `reduce_weights`) from
-    /// `child` into a new `width × height` raster; `uniform` is the
-    /// kernel's parameter block.
+    /// One dispatch of a reduction (`stage`: `reduce_types` or
+    /// `reduce_weights`) from `child` into a new `width × height` raster;
+    /// `uniform` is the kernel's parameter block.
     pub(super) fn reduce(
         &self,
         what: &'static str,
-        pipeline: &wgpu::ComputePipeline,
+        stage: Stage,
         uniform: &impl bytemuck::Pod,
         child: &GpuRaster,
         width: usize,
@@ -67,8 +68,8 @@ impl Gpu {
             .unwrap_or(u64::MAX);
         let buf = self.ctx.storage_empty(what, bytes)?;
         self.ctx.dispatch(
+            stage,
             None,
-            pipeline,
             bytemuck::bytes_of(uniform),
             &[&child.buf, &buf],
             (groups(width), groups(height)),

@@ -3,7 +3,8 @@
 //! heights, then the final ones, read back to the host.
 
 use super::{Gpu, GpuState, groups};
-use crate::backend::{BackendError, Stage};
+use crate::backend::BackendError;
+use crate::stages::Stage;
 use crate::stages::reconstruct::ReconstructUniform;
 
 impl Gpu {
@@ -24,8 +25,8 @@ impl Gpu {
         let level = &self.levels[0];
         let groups = (groups(st.width), groups(st.height));
         self.ctx.dispatch(
-            Some((Stage::Reconstruct, 0)),
-            &self.ctx.reconstruct,
+            Stage::Reconstruct,
+            Some(0),
             bytemuck::bytes_of(&u),
             &[
                 &st.s,
@@ -39,8 +40,8 @@ impl Gpu {
         );
         let out = self.ctx.storage_empty("heights out", bytes)?;
         self.ctx.dispatch(
-            Some((Stage::Reconstruct, 0)),
-            &self.ctx.repair_extrema,
+            Stage::RepairExtrema,
+            Some(0),
             bytemuck::bytes_of(&u),
             &[&st.s, &st.v, &level.columns, &self.heights, &blended, &out],
             groups,

@@ -2,6 +2,7 @@
 
 use super::{Context, groups};
 use crate::backend::BackendError;
+use crate::stages::Stage;
 use crate::stages::shade::{ShadeBuffers, ShadeParams};
 
 impl Context {
@@ -19,8 +20,8 @@ impl Context {
         let colours = self.storage("type colours", bytemuck::cast_slice(&some(b.type_colours)))?;
         let out = self.storage_empty("preview", n * 4)?;
         self.dispatch(
+            Stage::Shade,
             None,
-            &self.shade,
             bytemuck::bytes_of(p),
             &[&heights, &types, &tint, &colours, &out],
             (groups(p.width as usize), groups(p.height as usize)),

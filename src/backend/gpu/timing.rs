@@ -8,7 +8,8 @@
 //! calling thread's times, leaving the others' for their own reads.
 
 use super::Context;
-use crate::backend::{BackendError, Stage, StageTime};
+use crate::backend::{BackendError, StageTime};
+use crate::stages::Stage;
 use std::thread::ThreadId;
 use std::time::Duration;
 

@@ -1,7 +1,7 @@
 //! Stage `upsample_jitter` on the GPU (`kernels/upsample_jitter.wgsl`).
 
 use super::{Gpu, GpuState, groups};
-use crate::backend::Stage;
+use crate::stages::Stage;
 use crate::stages::upsample_jitter::{
     STEP_PYRAMID, STEP_VIRTUAL, STEP_WRAP, Step, UpsampleParams, UpsampleUniform,
 };
@@ -45,8 +45,8 @@ impl Gpu {
         // coarsest level's so that the binding is valid.
         let columns = &self.levels[level.min(self.levels.len() - 1)].columns;
         self.ctx.dispatch(
-            Some((Stage::UpsampleJitter, level)),
-            &self.ctx.upsample_jitter,
+            Stage::UpsampleJitter,
+            Some(level),
             bytemuck::bytes_of(&u),
             &[&parent.s, &parent.v, &child.s, &child.v, columns],
             (groups(child.width), groups(child.height)),

@@ -3,9 +3,10 @@
 //! ([`fill_ssd_table`], rayon over candidates, `wide` SIMD
 //! over cells) or, with the `gpu` feature, as `kernels/fill_ssd.wgsl`, with
 //! every source's candidate cells uploaded once per synthesis. Both give
-//! the same table, so the same terrain bytes.
+//! the same table, so the same terrain bytes. Which one runs is the
+//! [`Engine`] the caller chose, as for every stage.
 
-use crate::backend::Choice;
+use crate::backend::engine::Engine;
 use crate::patch::{Library, PatchError};
 use crate::stages::fill_ssd::fill_ssd_table;
 
@@ -22,39 +23,25 @@ pub enum FillCost {
 }
 
 impl FillCost {
-    /// The backend `choice` names for `lib`, and a one-line notice when
-    /// [`Choice::Auto`] found no GPU and stays on the CPU.
-    pub fn choose(choice: Choice, lib: &Library) -> Result<(FillCost, Option<String>), PatchError> {
-        #[cfg(feature = "gpu")]
-        {
-            use crate::backend::gpu::Context;
-            let ctx = match choice {
-                Choice::Cpu => return Ok((FillCost::Cpu, None)),
-                Choice::Gpu => Context::new()?,
-                Choice::Auto => match Context::new() {
-                    Ok(ctx) => ctx,
-                    Err(e) => return Ok((FillCost::Cpu, Some(format!("{e}; using the CPU")))),
-                },
-            };
-            let m = lib.params.patch / crate::patch::place::candidates::COARSE;
-            let sources = lib
-                .sources
-                .iter()
-                .map(|s| ctx.upload_fill_source(&s.fill_cells, m * m))
-                .collect::<Result<_, _>>()?;
-            Ok((FillCost::Gpu { ctx, sources }, None))
-        }
-        #[cfg(not(feature = "gpu"))]
-        {
-            let _ = lib;
-            use crate::backend::BackendError;
-            match choice {
-                Choice::Cpu => Ok((FillCost::Cpu, None)),
-                Choice::Gpu => Err(BackendError::NotCompiled.into()),
-                Choice::Auto => Ok((
-                    FillCost::Cpu,
-                    Some(format!("{}; using the CPU", BackendError::NotCompiled)),
-                )),
+    /// Stage `fill_ssd` for `lib` on `engine` (`Engine::choose`, as for
+    /// a synthesis); on a GPU every source's candidate cells are uploaded
+    /// here, once.
+    #[cfg_attr(not(feature = "gpu"), allow(unused_variables))]
+    pub fn new(engine: &Engine, lib: &Library) -> Result<FillCost, PatchError> {
+        match engine {
+            Engine::Cpu(_) => Ok(FillCost::Cpu),
+            #[cfg(feature = "gpu")]
+            Engine::Gpu(ctx) => {
+                let m = lib.params.patch / crate::patch::place::candidates::COARSE;
+                let sources = lib
+                    .sources
+                    .iter()
+                    .map(|s| ctx.upload_fill_source(&s.fill_cells, m * m))
+                    .collect::<Result<_, _>>()?;
+                Ok(FillCost::Gpu {
+                    ctx: ctx.clone(),
+                    sources,
+                })
             }
         }
     }

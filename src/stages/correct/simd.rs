@@ -60,6 +60,7 @@ mod score;
 use super::nudge::nudge;
 use super::{Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::database::c2::Quad;
+use crate::isa::Isa;
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, FRAC_BITS, round};
 use crate::level::state::State;
@@ -90,9 +91,9 @@ const _: () = assert!(RING > LOOKAHEAD && RING.is_power_of_two());
 /// a fill reads two rows of taps instead of 4, each level row once per
 /// subpass.
 ///
-/// On x86-64 CPUs with AVX2 the same code runs compiled for AVX2 (picked at
-/// run time; the baseline build targets SSE2): the `wide` vectors and the
-/// integer arithmetic give the same results on either, only faster.
+/// On x86-64 CPUs with AVX2 the same code runs compiled for AVX2 where
+/// `isa` asks for it (the baseline build targets SSE2): the `wide` vectors
+/// and the integer arithmetic give the same results on either, only faster.
 pub fn correct_span<const P: u32>(
     atlas: &AtlasLevel<'_>,
     st: &State,
@@ -100,6 +101,7 @@ pub fn correct_span<const P: u32>(
     (ys, x0, x1): (&[usize], usize, usize),
     similar: bool,
     g: &Guide<'_>,
+    isa: Isa,
 ) {
     let span = Span {
         atlas,
@@ -114,9 +116,9 @@ pub fn correct_span<const P: u32>(
     // compiler stopped inlining the pair scorer (a call per pair cost
     // level 1 ~8 %).
     #[cfg(target_arch = "x86_64")]
-    if crate::isa::avx2() {
+    if isa.avx2() {
         // SAFETY: the CPU supports AVX2, BMI1, BMI2, LZCNT and POPCNT
-        // (`isa::avx2` checks them), the features the function enables.
+        // (`Isa::avx2` checks them), the features the function enables.
         unsafe {
             match similar {
                 true => span_avx2::<P, true>(&span),

@@ -183,7 +183,7 @@ pub fn run(a: Args) -> CliResult {
         let report = SizeReport {
             size: format!("{w}x{h}"),
             backend: synth.backend_name(),
-            adapter: adapter(&synth),
+            adapter: synth.engine().adapter(),
             clock: if timings[0].device_clock {
                 "gpu timestamps"
             } else {
@@ -284,16 +284,6 @@ pub fn run(a: Args) -> CliResult {
         );
     }
     Ok(())
-}
-
-/// The adapter's name, when the synthesizer runs on a GPU.
-#[cfg_attr(not(feature = "gpu"), allow(unused_variables))]
-fn adapter(synth: &Synthesizer<'_>) -> Option<String> {
-    #[cfg(feature = "gpu")]
-    if let Some(ctx) = synth.gpu_context() {
-        return Some(ctx.adapter_name());
-    }
-    None
 }
 
 fn print_table(r: &SizeReport) {

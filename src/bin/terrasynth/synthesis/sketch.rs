@@ -5,6 +5,7 @@ use crate::CliResult;
 use crate::args::{BackendArg, Input, parse_size};
 use crate::progress::Bar;
 use std::path::PathBuf;
+use terrasynth::backend::engine::Engine;
 use terrasynth::io::{self, WriteOptions};
 use terrasynth::patch::fill::fill_ssd::FillCost;
 use terrasynth::patch::input::sketch::Sketch;
@@ -86,10 +87,11 @@ pub fn run(a: Args) -> CliResult {
         Library::prepare_cached(&sources, &params, &dir, &bar)?
     };
     let prep_ms = t_prep.elapsed().as_secs_f64() * 1e3;
-    let (cost, notice) = FillCost::choose(a.backend.into(), &lib)?;
+    let (engine, notice) = Engine::choose(a.backend.into())?;
     if let Some(n) = notice {
         eprintln!("note: {n}");
     }
+    let cost = FillCost::new(&engine, &lib)?;
     let result = patch::synthesize_with(&lib, &sketch, w, h, &cost, &bar)?;
     io::write(&result.heightfield, &a.output, &WriteOptions::default())?;
     let t = &result.timings;
@@ -120,7 +122,7 @@ pub fn run(a: Args) -> CliResult {
         eprintln!("feature adherence (ridge mean - valley or background mean) / relief: {adh:.3}");
     }
     if let Some(p) = &a.preview {
-        let preview = render::render(&result.heightfield, &RenderOptions::default())?;
+        let preview = render::render_on(&engine, &result.heightfield, &RenderOptions::default())?;
         render::write_png(p, &preview.image)?;
         eprintln!("wrote {}", p.display());
     }

@@ -294,16 +294,13 @@ pub fn write_coords(
 }
 
 /// The preview, shaded where the synthesis ran (same bytes either way).
-#[cfg_attr(not(feature = "gpu"), allow(unused_variables))]
 fn preview(
     synth: &Synthesizer<'_>,
     hf: &terrasynth::Heightfield,
 ) -> Result<render::Preview, Box<dyn std::error::Error + Send + Sync>> {
-    #[cfg(feature = "gpu")]
-    if let Some(ctx) = synth.gpu_context() {
-        let prep = render::prepare(hf, &RenderOptions::default())?;
-        let pixels = ctx.shade(&prep.params, &prep.buffers())?;
-        return Ok(render::Preview::from_pixels(prep.info, &pixels));
-    }
-    Ok(render::render(hf, &RenderOptions::default())?)
+    Ok(render::render_on(
+        &synth.engine(),
+        hf,
+        &RenderOptions::default(),
+    )?)
 }

@@ -344,7 +344,7 @@ mod tests {
     #[test]
     fn a_chunks_table_holds_each_pixels_sources_and_firsts() {
         #[cfg(target_arch = "x86_64")]
-        if crate::isa::avx2() {
+        if crate::isa::Isa::Avx2.avx2() {
             let mut grid = Grid::new();
             let mut table = super::Table::new();
             let mut h = 0x0BAD_5EEDu32;
