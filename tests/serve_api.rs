@@ -387,7 +387,10 @@ fn pastes_and_new_parameters_start_a_new_session() {
     // Removing the paste (undo) cannot be an edit of this session: the
     // state kept before it is swapped back (tests/serve_paste_undo.rs).
     let u = http::post(a, &format!("/api/sessions/{id}/undo"), None).json();
-    assert_eq!((&u["rebuilt"], &u["restored"]), (&Value::Null, &json!(true)));
+    assert_eq!(
+        (&u["rebuilt"], &u["restored"]),
+        (&Value::Null, &json!(true))
+    );
     // A session opened on a paste kept nothing from before it: removing
     // the paste starts a new session.
     let (opened, _) = common::editor::create_with(a, &d);

@@ -58,7 +58,10 @@ fn undo_redo_and_delete_of_a_paste_swap_kept_states_and_match_fresh_syntheses() 
     let with = fresh_heights(&pasted);
     assert_ne!(with, without, "the paste changes nothing");
     let f = put_scene(a, &id, &pasted, true).json();
-    assert_eq!((&f["rebuilt"], &f["restored"]), (&Value::Null, &json!(false)));
+    assert_eq!(
+        (&f["rebuilt"], &f["restored"]),
+        (&Value::Null, &json!(false))
+    );
     same_bits("pasted", &heights(a, &id), &with);
     let kept = http::get(a, &format!("/api/sessions/{id}")).json()["checkpoint_bytes"]
         .as_u64()

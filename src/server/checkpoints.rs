@@ -90,6 +90,13 @@ impl Checkpoints {
         Some(c)
     }
 
+    /// Takes the newest state.
+    pub fn take_newest(&mut self) -> Option<Checkpoint> {
+        let c = self.kept.pop_back()?;
+        self.bytes -= c.bytes;
+        Some(c)
+    }
+
     /// Drops every state (a new session cannot take them).
     pub fn clear(&mut self) {
         self.kept.clear();

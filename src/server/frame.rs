@@ -216,7 +216,17 @@ impl Editor {
                 self.timing.keep += t.elapsed();
             }
             let t = Instant::now();
-            let list = self.edits.edits(&scene, self.db)?;
+            let list = match self.edits.edits(&scene, self.db) {
+                Ok(list) => list,
+                Err(e) => {
+                    if self.restored {
+                        // Show what was shown: the state left is the newest kept.
+                        self.restored = false;
+                        self.swap_in_newest();
+                    }
+                    return Err(e.into());
+                }
+            };
             self.timing.edits = t.elapsed();
             if list.is_empty() {
                 self.timing.synth = Duration::ZERO;
@@ -262,9 +272,22 @@ impl Editor {
         if self.stale || self.scene.pastes == scene.pastes {
             return false;
         }
-        let Some(mut c) = self.checkpoints.take(scene) else {
-            return false;
-        };
+        match self.checkpoints.take(scene) {
+            Some(c) => self.swap_in(c),
+            None => false,
+        }
+    }
+
+    /// Swaps in the newest kept state (it has the scene shown before the
+    /// last swap).
+    fn swap_in_newest(&mut self) {
+        if let Some(c) = self.checkpoints.take_newest() {
+            self.swap_in(c);
+        }
+    }
+
+    /// Swaps in a kept state and keeps the one it replaces.
+    fn swap_in(&mut self, mut c: Checkpoint) -> bool {
         if !self.session.swap(&mut c.state) {
             return false;
         }

@@ -43,7 +43,14 @@ impl Snapshot {
     /// What its buffers hold, in bytes (estimated from their lengths).
     pub fn bytes(&self) -> usize {
         let s = self;
-        bytes_of(&s.controls, &s.blend, &s.frames, &s.guides, &s.pasted, &s.last)
+        bytes_of(
+            &s.controls,
+            &s.blend,
+            &s.frames,
+            &s.guides,
+            &s.pasted,
+            &s.last,
+        )
     }
 }
 
@@ -86,7 +93,14 @@ impl Session<'_> {
     /// What a [`Session::snapshot`] would hold, in bytes, without taking it.
     pub fn snapshot_bytes(&self) -> usize {
         let s = self;
-        bytes_of(&s.controls, &s.blend, &s.frames, &s.guides, &s.pasted, &s.last)
+        bytes_of(
+            &s.controls,
+            &s.blend,
+            &s.frames,
+            &s.guides,
+            &s.pasted,
+            &s.last,
+        )
     }
 
     /// A copy of the session's state (the kept final states aside: they
@@ -109,8 +123,7 @@ impl Session<'_> {
     /// goes back). Nothing is copied. False, and nothing changes, when `s`
     /// was taken of a session of another size or seed.
     pub fn swap(&mut self, s: &mut Snapshot) -> bool {
-        if s.shape != (self.width, self.height, self.seed) || s.pasted.len() != self.pasted.len()
-        {
+        if s.shape != (self.width, self.height, self.seed) || s.pasted.len() != self.pasted.len() {
             return false;
         }
         std::mem::swap(&mut self.controls, &mut s.controls);
