@@ -2,13 +2,15 @@
 """Server time of a lasso paste, its undo and its redo in `terrasynth serve`
 (issue 43 item 3: undo of a paste rebuilt the whole session).
 
-    python3 benches/paste_undo.py BINARY SIZE [REPS]
+    python3 benches/paste_undo.py BINARY SIZE [REPS] [point]
 
 Starts BINARY serve at SIZE² (seed 1, embedded database), opens a session,
 and REPS times pastes a terrain lasso (each at another place, so no kept
 state matches it), undoes it and redoes it, then undoes it again. Prints
 the medians of the server's own `timing_ms.total` (queue wait excluded)
-and whether the session was rebuilt or a kept state restored.
+and whether the session was rebuilt or a kept state restored. With
+`point`, the design has a point constraint (its sums are part of a kept
+state).
 """
 import json, os, socket, statistics, subprocess, sys, tempfile, time, urllib.request
 
@@ -42,6 +44,9 @@ try:
     first = call("POST", "/api/sessions")
     sid, doc = first["session"], first["scene"]
     s = size / 1024
+    if "point" in sys.argv[4:]:
+        doc = dict(doc, points=[{"at": [800 * s, 200 * s], "height_m": 900, "radius_px": 40 * s}])
+        call("PUT", f"/api/sessions/{sid}/scene?commit=true", doc)
     lasso = [[100 * s, 100 * s], [300 * s, 120 * s], [260 * s, 320 * s], [120 * s, 280 * s]]
     times = {"paste": [], "undo": [], "redo": []}
     how = {"undo": set(), "redo": set()}

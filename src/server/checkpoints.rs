@@ -11,8 +11,8 @@
 //! state, a document that differs in more than its pastes takes the usual
 //! edits (restricted re-synthesis).
 //!
-//! A state costs ~90 B per output pixel (~90 MiB at 1024², ~22 MiB at
-//! 512²), so at most [`MAX_KEPT`] states and [`MAX_BYTES`] are kept, the
+//! A state costs 42–84 B per output pixel (44–88 MB at 1024², 11–22 MB at
+//! 512²; more with constraints), so at most [`MAX_KEPT`] states and [`MAX_BYTES`] are kept, the
 //! oldest dropped first; a paste whose state was dropped is undone as
 //! before, by a new session.
 
@@ -26,7 +26,7 @@ use std::sync::Arc;
 pub const MAX_KEPT: usize = 8;
 
 /// Most bytes the kept states may hold per session (estimated,
-/// [`Snapshot::bytes`]): two 1024² states, eleven 512² ones.
+/// [`Snapshot::bytes`]): two or more 1024² states, [`MAX_KEPT`] 512² ones.
 pub const MAX_BYTES: usize = 256 << 20;
 
 /// A session's state and the scene it shows.

@@ -10,9 +10,10 @@
 //! one shown before, and later edits start from the same state as they
 //! would have then.
 //!
-//! A snapshot is a copy of every per-pixel buffer the session keeps (about
-//! 90 B per output pixel: ~90 MiB at 1024²); [`Snapshot::bytes`] says how
-//! much, so a keeper can bound it.
+//! A snapshot is a copy of every per-pixel buffer the session keeps (~42 B
+//! per output pixel without constraints, ~84 B with them: 44–88 MB at
+//! 1024², measured); [`Snapshot::bytes`] says how much, so a keeper can
+//! bound it.
 
 use super::Session;
 use crate::heightfield::Heightfield;
