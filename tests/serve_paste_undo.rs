@@ -136,3 +136,56 @@ fn a_document_that_removes_a_paste_and_adds_a_point_is_an_edit_of_the_kept_state
         &heights(a, &plain),
     );
 }
+
+/// The kept states are bounded (at most 8 per session, `MAX_KEPT` in
+/// `src/server/checkpoints.rs`): after ten pastes, the last eight undo by
+/// swapping, the two before them by a new session as before, which is
+/// the fresh synthesis of the document left.
+#[test]
+fn kept_states_are_bounded_and_older_pastes_undo_by_a_new_session() {
+    let s = serve(N, None, 2);
+    let a = s.addr;
+    let (id, _) = create_with(a, &doc());
+    let kept = || {
+        http::get(a, &format!("/api/sessions/{id}")).json()["checkpoint_bytes"]
+            .as_u64()
+            .unwrap()
+    };
+    let mut d = doc();
+    let mut docs = vec![d.clone()];
+    d["pastes"] = json!([]);
+    let mut one = 0;
+    for k in 0..10 {
+        let x = 4.0 + 5.0 * k as f64;
+        let paste = json!({"source": "terrain", "lasso": [[x, 4], [x + 6.0, 5], [x + 3.0, 10]], "to": [x + 3.0, 50], "delta_m": 20});
+        d["pastes"].as_array_mut().unwrap().push(paste);
+        assert_eq!(put_scene(a, &id, &d, true).status, 200);
+        docs.push(d.clone());
+        if k == 0 {
+            one = kept();
+        }
+    }
+    let all = kept();
+    assert!(
+        one > 0 && all <= 8 * one + 8 * 1024,
+        "{all} B kept, {one} B for one state"
+    );
+    assert!(all >= 7 * one, "{all} B kept, {one} B for one state");
+    for back in 1..=10 {
+        let u = step(a, &id, "undo");
+        assert_eq!(u["scene"], docs[10 - back]);
+        if back <= 8 {
+            restored(&format!("undo {back}"), &u);
+        } else {
+            assert_eq!(
+                u["rebuilt"], "a paste was removed or changed",
+                "undo {back}"
+            );
+            same_bits(
+                &format!("undo {back}"),
+                &heights(a, &id),
+                &fresh_heights(&docs[10 - back]),
+            );
+        }
+    }
+}
