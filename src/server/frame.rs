@@ -250,10 +250,13 @@ impl Editor {
         self.render(self.rebuilt.is_some())
     }
 
-    /// Keeps the session's state before a paste (unless it could not be
-    /// kept within [`MAX_BYTES`]).
+    /// Keeps the session's state before a paste, unless it could not be
+    /// kept within [`MAX_BYTES`] or the system is short of memory (then
+    /// undoing the paste starts a new session, as without a kept state).
     fn keep(&mut self) {
-        if self.session.snapshot_bytes() > MAX_BYTES {
+        let bytes = self.session.snapshot_bytes();
+        let short = crate::io::available_memory().is_some_and(|a| a < 2 * bytes as u64);
+        if bytes > MAX_BYTES || short {
             return;
         }
         self.checkpoints.push(Checkpoint::new(
