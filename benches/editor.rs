@@ -55,6 +55,14 @@ const KINDS: &[(&str, &str)] = &[
         "undo (of a point move)",
         "await ed.api.idle(); ed.change(d => { d.points[0].at[1] = S * 0.3 + (k % 2) * 20; }, {kind: 'setup'}); await ed.api.idle(); await ed.undo();",
     ),
+    (
+        "undo (of a paste)",
+        "await ed.api.idle(); ed.change(d => { const x = S*0.1 + k*S*0.1; d.pastes.push({source: 'terrain', lasso: [[x, S*0.7], [x + S*0.06, S*0.7], [x + S*0.03, S*0.76]], to: [x + S*0.05, S*0.85], delta_m: 30}); }, {kind: 'setup'}); await ed.api.idle(); await ed.undo();",
+    ),
+    (
+        "redo (of a paste)",
+        "await ed.api.idle(); ed.change(d => { const x = S*0.15 + k*S*0.1; d.pastes.push({source: 'terrain', lasso: [[x, S*0.7], [x + S*0.06, S*0.7], [x + S*0.03, S*0.76]], to: [x + S*0.05, S*0.85], delta_m: 30}); }, {kind: 'setup'}); await ed.api.idle(); await ed.undo(); await ed.api.idle(); await ed.redo();",
+    ),
 ];
 
 const SETUP: &str = "ed.change(d => {

@@ -384,8 +384,17 @@ fn pastes_and_new_parameters_start_a_new_session() {
     let f = put_scene(a, &id, &d, true).json();
     assert_eq!(f["rebuilt"], Value::Null, "{f}");
     assert!(f["changed"]["pixels"].as_u64().unwrap() > 0);
-    // Removing the paste (undo) cannot be an edit of this session.
+    // Removing the paste (undo) cannot be an edit of this session: the
+    // state kept before it is swapped back (tests/serve_paste_undo.rs).
     let u = http::post(a, &format!("/api/sessions/{id}/undo"), None).json();
+    assert_eq!(
+        (&u["rebuilt"], &u["restored"]),
+        (&Value::Null, &json!(true))
+    );
+    // A session opened on a paste kept nothing from before it: removing
+    // the paste starts a new session.
+    let (opened, _) = common::editor::create_with(a, &d);
+    let u = put_scene(a, &opened, &doc(), true).json();
     assert_eq!(u["rebuilt"], "a paste was removed or changed");
     let mut bad = d.clone();
     bad["pastes"][0]["exemplar"] = json!(77);

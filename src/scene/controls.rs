@@ -50,9 +50,13 @@ fn strokes<T: Clone>(v: &Option<T>, is_strokes: impl Fn(&T) -> bool) -> Option<T
 }
 
 /// Turns a sequence of scenes into session edits.
-#[derive(Debug, Default)]
+///
+/// Cloned (the distance fields' cache shared) beside a session's
+/// [`Snapshot`](crate::synth::session::Snapshot): the two together are
+/// what an editor keeps to step back.
+#[derive(Debug, Default, Clone)]
 pub struct SceneEdits {
-    cache: FieldCache,
+    cache: Arc<FieldCache>,
     ids: BTreeMap<String, u64>,
     first: Option<Scene>,
     applied: Applied,

@@ -69,6 +69,8 @@ pub struct Latest {
     pub committed: Value,
     /// What the undo history holds (estimated bytes; `GET` of a session).
     pub history_bytes: usize,
+    /// What the states kept around pastes hold (estimated bytes).
+    pub checkpoint_bytes: usize,
 }
 
 /// A frame's changed part of the preview, as PNG: the page patches its
@@ -292,6 +294,7 @@ impl Handle {
             heightfield: ed.heightfield.clone(),
             committed: ed.history.current().clone(),
             history_bytes: ed.history.bytes(),
+            checkpoint_bytes: ed.checkpoints.bytes(),
         };
         if let Some((rect, png)) = &ed.tile {
             let mut tiles = self.tiles.lock().unwrap_or_else(|e| e.into_inner());

@@ -3,6 +3,7 @@
 //! how to turn a task into a frame (edits of the session, or a new session
 //! when a document cannot be an edit of it).
 
+use super::checkpoints::{Checkpoint, Checkpoints, MAX_BYTES};
 use super::doc::{Policy, rebuild_reason};
 use super::editor::{Reply, Task};
 use super::error::ApiError;
@@ -11,7 +12,7 @@ use super::view::{Style, View, encode_rect, overlay};
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::scene::{Scene, SceneEdits};
-use crate::synth::session::{Frame, Session};
+use crate::synth::session::{Frame, Session, change};
 use crate::synth::union;
 use image::RgbaImage;
 use serde_json::{Value, json};
@@ -26,6 +27,8 @@ fn ms(d: Duration) -> f64 {
 /// Where the time of one frame went.
 #[derive(Debug, Default, Clone, Copy)]
 struct Timing {
+    /// Keeping the state before a paste, or swapping a kept one in.
+    keep: Duration,
     edits: Duration,
     synth: Duration,
     render: Duration,
@@ -59,6 +62,10 @@ pub struct Editor {
     stale: bool,
     /// The sculpt strokes this frame baked (`{index, targets}`).
     baked: Vec<Value>,
+    /// States kept around pastes (undo and redo of a paste swap them).
+    pub checkpoints: Checkpoints,
+    /// Whether this frame's state was a kept one swapped in.
+    restored: bool,
 }
 
 impl Editor {
@@ -90,6 +97,8 @@ impl Editor {
             rebuilt: None,
             stale: false,
             baked: Vec::new(),
+            checkpoints: Checkpoints::default(),
+            restored: false,
         };
         ed.render(true)?;
         Ok(ed)
@@ -141,6 +150,7 @@ impl Editor {
                 self.changed = Some((0, None));
                 self.timing = Timing::default();
                 self.rebuilt = None;
+                self.restored = false;
                 self.render(true)?;
             }
         }
@@ -174,9 +184,15 @@ impl Editor {
         Ok(out)
     }
 
-    /// Applies a checked document: as edits of the session, or in a new
-    /// session when it cannot be an edit (see [`rebuild_reason`]).
+    /// Applies a checked document: as edits of the session (from a kept
+    /// state when one saves a paste or a new session, see
+    /// [`Editor::restore`]), or in a new session when it cannot be an edit
+    /// (see [`rebuild_reason`]).
     fn show(&mut self, doc: Value, scene: Scene) -> Result<(), ApiError> {
+        let shown = self.heightfield.clone();
+        let t = Instant::now();
+        self.restored = self.restore(&scene);
+        self.timing.keep = t.elapsed();
         self.rebuilt = match self.stale {
             true => Some("the previous edit failed"),
             false => rebuild_reason(&self.scene, &scene),
@@ -192,9 +208,25 @@ impl Editor {
             self.timing = timing;
             self.changed = Some(change_of(&self.heightfield, &frame.heightfield));
             self.heightfield = Arc::new(frame.heightfield);
+            self.checkpoints.clear();
         } else {
+            if scene.pastes.len() > self.scene.pastes.len() {
+                let t = Instant::now();
+                self.keep();
+                self.timing.keep += t.elapsed();
+            }
             let t = Instant::now();
-            let list = self.edits.edits(&scene, self.db)?;
+            let list = match self.edits.edits(&scene, self.db) {
+                Ok(list) => list,
+                Err(e) => {
+                    if self.restored {
+                        // Show what was shown: the state left is the newest kept.
+                        self.restored = false;
+                        self.swap_in_newest();
+                    }
+                    return Err(e.into());
+                }
+            };
             self.timing.edits = t.elapsed();
             if list.is_empty() {
                 self.timing.synth = Duration::ZERO;
@@ -208,10 +240,67 @@ impl Editor {
                 self.changed = frame.change.map(|c| (c.pixels, c.bounds));
                 self.heightfield = Arc::new(frame.heightfield);
             }
+            if self.restored {
+                // What the page shows changes by the swap and the edits.
+                self.changed = Some(change_of(&shown, &self.heightfield));
+            }
         }
         self.scene = scene;
         self.doc = doc;
         self.render(self.rebuilt.is_some())
+    }
+
+    /// Keeps the session's state before a paste, unless it could not be
+    /// kept within [`MAX_BYTES`] or the system is short of memory (then
+    /// undoing the paste starts a new session, as without a kept state).
+    fn keep(&mut self) {
+        let bytes = self.session.snapshot_bytes();
+        let short = crate::io::available_memory().is_some_and(|a| a < 2 * bytes as u64);
+        if bytes > MAX_BYTES || short {
+            return;
+        }
+        self.checkpoints.push(Checkpoint::new(
+            self.scene.clone(),
+            self.edits.clone(),
+            self.session.snapshot(),
+            self.heightfield.clone(),
+        ));
+    }
+
+    /// Swaps in a kept state that has `scene`'s pastes when the shown one
+    /// has other pastes (undo, redo or delete of a paste): no synthesis,
+    /// where a new session or the paste would take one. The state left is
+    /// kept in its place (redo swaps it back). True when it swapped.
+    fn restore(&mut self, scene: &Scene) -> bool {
+        if self.stale || self.scene.pastes == scene.pastes {
+            return false;
+        }
+        match self.checkpoints.take(scene) {
+            Some(c) => self.swap_in(c),
+            None => false,
+        }
+    }
+
+    /// Swaps in the newest kept state (it has the scene shown before the
+    /// last swap).
+    fn swap_in_newest(&mut self) {
+        if let Some(c) = self.checkpoints.take_newest() {
+            self.swap_in(c);
+        }
+    }
+
+    /// Swaps in a kept state and keeps the one it replaces.
+    fn swap_in(&mut self, mut c: Checkpoint) -> bool {
+        if !self.session.swap(&mut c.state) {
+            return false;
+        }
+        std::mem::swap(&mut self.edits, &mut c.edits);
+        std::mem::swap(&mut self.scene, &mut c.scene);
+        std::mem::swap(&mut self.heightfield, &mut c.heightfield);
+        // Its size changed with what it holds now.
+        let c = Checkpoint::new(c.scene, c.edits, c.state, c.heightfield);
+        self.checkpoints.push(c);
+        true
     }
 
     /// Updates the preview: the whole of it (`whole`, or when it is
@@ -297,6 +386,7 @@ impl Editor {
             "history": {"undo": undo, "redo": redo},
             "timing_ms": {
                 "queued": waited.map(ms).unwrap_or(0.0),
+                "keep": ms(self.timing.keep),
                 "edits": ms(self.timing.edits),
                 "synth": ms(self.timing.synth),
                 "render": ms(self.timing.render),
@@ -304,6 +394,7 @@ impl Editor {
             },
             "changed": self.changed.map(|(pixels, bounds)| json!({"pixels": pixels, "bounds": bounds})),
             "rebuilt": self.rebuilt,
+            "restored": self.restored,
             "heights_m": stats.map(|s| json!({"min": s.min, "max": s.max})),
             "overlay": overlay(&self.edits, &self.scene),
             "view": self.view,
@@ -334,6 +425,7 @@ fn start(
         .apply(list)
         .map_err(|e| ApiError::invalid("$", e.to_string()))?;
     let timing = Timing {
+        keep: Duration::ZERO,
         edits: edits_time,
         synth: frame.time,
         render: Duration::ZERO,
@@ -354,16 +446,12 @@ fn type_change(old: Option<&[u8]>, new: Option<&[u8]>, width: usize) -> Option<[
     b
 }
 
-/// Pixels that differ between two heightfields (all when sizes differ).
+/// Pixels that differ between two heightfields, and their bounds (all
+/// when sizes differ).
 fn change_of(old: &Heightfield, new: &Heightfield) -> (usize, Option<[usize; 4]>) {
     if (old.width(), old.height()) != (new.width(), new.height()) {
         return (new.len(), Some([0, 0, new.width(), new.height()]));
     }
-    let n = old
-        .data()
-        .iter()
-        .zip(new.data())
-        .filter(|(a, b)| a.to_bits() != b.to_bits())
-        .count();
-    (n, (n > 0).then_some([0, 0, new.width(), new.height()]))
+    let c = change(old, new);
+    (c.pixels, c.bounds)
 }

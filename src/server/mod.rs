@@ -20,6 +20,7 @@
 
 mod assets;
 mod autosave;
+mod checkpoints;
 mod doc;
 mod editor;
 mod error;

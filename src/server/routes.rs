@@ -6,7 +6,7 @@
 //! | `GET /api/info` | database (types, exemplars, height range), loading progress, limits, `recovery` (unsaved work found at start: `{path, modified_ms}`, or null) |
 //! | `GET /api/exemplars/{i}/preview.png` | an exemplar's relief, for lassos on exemplars |
 //! | `POST /api/sessions` | none, or `{"scene": doc}` → first frame + `session` id |
-//! | `GET /api/sessions/{id}` | → the shown document (`scene`) and what its undo history holds (`history_bytes`, estimated) |
+//! | `GET /api/sessions/{id}` | → the shown document (`scene`), what its undo history holds (`history_bytes`, estimated) and what the states kept to undo pastes hold (`checkpoint_bytes`) |
 //! | `PUT /api/sessions/{id}/scene?commit=true` | scene document → frame (`commit=false`: a drag's intermediate state, not an undo step) |
 //! | `POST /api/sessions/{id}/undo`, `…/redo` | → frame + the document now shown |
 //! | `PUT /api/sessions/{id}/view` | `{"contours", "types", "range"}` → frame |
@@ -283,7 +283,7 @@ async fn state(State(app): State<Arc<App>>, PathParam(id): PathParam) -> Api {
         .latest()
         .ok_or_else(|| ApiError::NotReady("the first frame is not ready".into()))?;
     Ok(axum::Json(
-        json!({"revision": latest.revision, "scene": latest.committed, "history_bytes": latest.history_bytes}),
+        json!({"revision": latest.revision, "scene": latest.committed, "history_bytes": latest.history_bytes, "checkpoint_bytes": latest.checkpoint_bytes}),
     ))
 }
 

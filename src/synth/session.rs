@@ -29,6 +29,9 @@ use thiserror::Error;
 
 mod guides;
 mod sculpt;
+mod snapshot;
+
+pub use snapshot::Snapshot;
 
 /// Pixels around a paste left unweighted in its step, so it blends in.
 pub const PASTE_MARGIN: f64 = 8.0;
@@ -532,7 +535,7 @@ fn free_within(c: &dyn super::control::Constraint, weights: &mut [u8], w: usize,
 
 /// Where `new` differs from `old` (same size), bit for bit; in parallel
 /// (it runs on every edit, over every output pixel).
-fn change(old: &Heightfield, new: &Heightfield) -> Change {
+pub fn change(old: &Heightfield, new: &Heightfield) -> Change {
     let w = new.width();
     // Zeroed by the allocator: the pages of rows that compare equal (most
     // of an edit's) are never written. Rows compare as bytes first, one

@@ -48,6 +48,18 @@ pub fn heights(addr: SocketAddr, session: &str) -> Vec<f32> {
         .collect()
 }
 
+/// The heights a fresh synthesis of document `d` gives (a session opened
+/// on it, as `synth --scene` gives: `tests/sculpt.rs`), row-major.
+pub fn fresh_heights(d: &Value) -> Vec<f32> {
+    use terrasynth::scene::{Scene, SceneEdits};
+    let db = database();
+    let scene = Scene::parse(d.to_string().as_bytes(), std::path::Path::new("fresh.json")).unwrap();
+    let mut edits = SceneEdits::new();
+    let mut session = SceneEdits::session(db, &scene).unwrap();
+    let frame = session.apply(edits.edits(&scene, db).unwrap()).unwrap();
+    frame.heightfield.data().to_vec()
+}
+
 /// The side of the API tests' terrains.
 pub const N: usize = 64;
 

@@ -218,6 +218,15 @@ impl Blend {
         self.levels.iter().all(|l| l.reached == 0)
     }
 
+    /// What the sums hold, in bytes (an editing session's snapshot
+    /// reports what it keeps).
+    pub fn bytes(&self) -> usize {
+        self.levels
+            .iter()
+            .map(|l| l.sums.len() * size_of::<Sums>())
+            .sum()
+    }
+
     /// Per level (index = level), the bounds of the pixels whose sums
     /// changed since the last call (region-relative; None: none did).
     pub fn take_touched(&mut self) -> Vec<Option<[usize; 4]>> {
