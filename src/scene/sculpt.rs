@@ -6,7 +6,7 @@ use super::bake::bake;
 use super::*;
 use crate::heightfield::Heightfield;
 use crate::synth::control::SculptLayer;
-use crate::synth::control::sculpt::SculptStroke;
+use crate::synth::control::sculpt::{Brush, SculptStroke};
 use serde_json::{Value, json};
 use std::sync::Arc;
 
@@ -31,6 +31,7 @@ impl Scene {
                 points: s.stroke.points.clone(),
                 radius_px: s.stroke.radius_px,
                 targets,
+                hard: s.stroke.brush == Brush::Erode,
             }));
         }
         Ok(Some(Arc::new(SculptLayer::new(strokes))))
@@ -52,6 +53,7 @@ impl Scene {
                         points: s.stroke.points.clone(),
                         radius_px: s.stroke.radius_px,
                         targets: s.targets.clone()?,
+                        hard: s.stroke.brush == Brush::Erode,
                     }))
                 })
                 .collect();

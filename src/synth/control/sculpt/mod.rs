@@ -22,7 +22,9 @@
 //! shape while the finest levels, whose errors below t are almost left
 //! alone by φ_d, keep the detail the exemplar gives. The blend weight
 //! b = 1/(1 + d) is 1/5 of a point's at its site, so a point or curve
-//! placed on sculpted ground still wins there.
+//! placed on sculpted ground still wins there. Erode strokes are held
+//! hard instead ([`SculptStroke::hard`]): their target is the filter's
+//! own detailed terrain, and its changes are smaller than that tolerance.
 //!
 //! **Where a stroke acts.** An editing session frees (re-synthesizes
 //! unweighted) only the pixels whose target a stroke changed
@@ -89,6 +91,12 @@ pub struct SculptStroke {
     pub points: Vec<DVec2>,
     pub radius_px: f64,
     pub targets: TargetGrid,
+    /// Held to its targets at every level (t = 0), not within the soft
+    /// tolerance of [`S_SCULPT`]: the erode brush's targets are the
+    /// filter's own detailed terrain, whose changes (~10 m) sit well
+    /// inside that tolerance (0.5–0.9 cell of height: 46–83 m on 92.6 m
+    /// cells), so a soft hold left them to chance.
+    pub hard: bool,
 }
 
 impl SculptStroke {
@@ -179,6 +187,11 @@ impl SculptLayer {
 
     /// The target height at (x, y): the last stroke's that covers it.
     pub fn target(&self, x: f64, y: f64) -> Option<f64> {
+        self.covering(x, y).map(|s| s.targets.at(x, y))
+    }
+
+    /// The last stroke that covers (x, y).
+    fn covering(&self, x: f64, y: f64) -> Option<&SculptStroke> {
         let [bx0, by0, bx1, by1] = self.bounds;
         if !(x >= bx0 && y >= by0 && x <= bx1 && y <= by1) {
             return None;
@@ -188,9 +201,8 @@ impl SculptLayer {
         self.buckets[r * self.columns + c]
             .iter()
             .rev()
-            .map(|&k| &self.strokes[k as usize])
+            .map(|&k| &*self.strokes[k as usize])
             .find(|s| s.covers(x, y))
-            .map(|s| s.targets.at(x, y))
     }
 
     /// Bounds within which layers `old` and `new` can differ (None: they
@@ -214,9 +226,9 @@ impl Constraint for SculptLayer {
     }
 
     fn sample(&self, x: f64, y: f64) -> Option<Sample> {
-        self.target(x, y).map(|target_m| Sample {
-            target_m,
-            distance: DISTANCE_PX,
+        self.covering(x, y).map(|s| Sample {
+            target_m: s.targets.at(x, y),
+            distance: if s.hard { 0.0 } else { DISTANCE_PX },
             reach: DISTANCE_PX,
         })
     }
@@ -304,6 +316,7 @@ mod tests {
         Arc::new(SculptStroke {
             points: vec![DVec2::new(x, 50.0)],
             radius_px: r,
+            hard: false,
             targets: TargetGrid {
                 x0: 0.0,
                 y0: 0.0,
