@@ -12,7 +12,7 @@
 //!   (mountains, as sketches ask for) as a patch source, under every
 //!   transform, against a half-filled window of it.
 //!
-//! Variants as in `tests/stage_<x>.rs`: `scalar` (the oracle, where the
+//! Variants as in `tests/stages/<x>.rs`: `scalar` (the oracle, where the
 //! CPU has a SIMD path), `simd` or `cpu` (at the default instruction-set
 //! level, `isa::Isa::default`: `TERRASYNTH_PORTABLE_SIMD=1` benches the
 //! portable copy), and with `--features gpu` and an adapter `gpu` (each

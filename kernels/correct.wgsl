@@ -12,7 +12,7 @@
 // where Rust has arrays: arrays indexed in loops went to the GPU's local
 // memory, and each score read and wrote them. Measured on an H100 at
 // 1024²: `correct` 3.4 → 1.3 ms of device time (a 128² level 0.40 →
-// 0.18 ms), the same bytes (the stage_* and backend_* cross-checks there).
+// 0.18 ms), the same bytes (the `stages` and `backend` cross-checks there).
 
 struct CorrectParams {
     width: u32,

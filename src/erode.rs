@@ -26,7 +26,7 @@
 //! both cases) and cropping ([`window`]). Every value is computed by the
 //! same f32 operations in the same order whatever the window or thread
 //! count (no sums across cells but fixed neighbour orders), so the bytes
-//! agree (`tests/erode.rs`).
+//! agree (`tests/terrain/erode.rs`).
 //!
 //! Measured with `eval` (README, *Erosion*): it moves the drainage and pit
 //! terms towards the real exemplar on steep terrain and on real DEMs made

@@ -99,7 +99,7 @@ fn stages() -> Vec<String> {
 /// The map's table of stages has one row per line of the `stages!` table,
 /// in its order; every file a row names exists; every `src/stages/<x>.rs`
 /// (mod.rs and common.rs aside), `kernels/<x>.wgsl` (common.wgsl aside)
-/// and `tests/stage_<x>.rs` is a stage's.
+/// and `tests/stages/<x>.rs` (the target's main.rs aside) is a stage's.
 #[test]
 fn the_stage_table_matches_the_stages() {
     let doc = architecture();
@@ -116,30 +116,54 @@ fn the_stage_table_matches_the_stages() {
             }
         }
     }
-    let stems = |dir: &str, prefix: &str, ext: &str| -> Vec<String> {
+    let stems = |dir: &str, ext: &str| -> Vec<String> {
         fs::read_dir(root().join(dir))
             .unwrap()
             .filter_map(|e| {
                 let name = e.unwrap().file_name().to_string_lossy().into_owned();
-                name.strip_prefix(prefix)?
-                    .strip_suffix(ext)
-                    .map(str::to_owned)
+                name.strip_suffix(ext).map(str::to_owned)
             })
             .collect()
     };
     let known = stages();
-    for (dir, prefix, ext) in [
-        ("src/stages", "", ".rs"),
-        ("kernels", "", ".wgsl"),
-        ("tests", "stage_", ".rs"),
+    for (dir, ext, aside) in [
+        ("src/stages", ".rs", &["mod", "common"][..]),
+        ("kernels", ".wgsl", &["common"][..]),
+        ("tests/stages", ".rs", &["main"][..]),
     ] {
-        for stem in stems(dir, prefix, ext) {
+        for stem in stems(dir, ext) {
             assert!(
-                known.contains(&stem) || ["mod", "common"].contains(&stem.as_str()),
-                "{dir}/{prefix}{stem}{ext} is no line of the stages! table (src/stages/mod.rs)"
+                known.contains(&stem) || aside.contains(&stem.as_str()),
+                "{dir}/{stem}{ext} is no line of the stages! table (src/stages/mod.rs)"
             );
         }
     }
+}
+
+/// Every test target of a folder (`tests/<target>/main.rs`) declares each
+/// `.rs` file beside its main.rs as a module: Cargo compiles only what
+/// main.rs declares, so a file left out would never run, silently.
+#[test]
+fn every_test_file_of_a_target_folder_is_a_module_of_it() {
+    let mut targets = 0;
+    for entry in fs::read_dir(root().join("tests")).unwrap() {
+        let dir = entry.unwrap().path();
+        let Ok(main) = fs::read_to_string(dir.join("main.rs")) else {
+            continue;
+        };
+        targets += 1;
+        for file in fs::read_dir(&dir).unwrap() {
+            let name = file.unwrap().file_name().to_string_lossy().into_owned();
+            if let Some(stem) = name.strip_suffix(".rs").filter(|s| *s != "main") {
+                assert!(
+                    main.lines().any(|l| l.trim() == format!("mod {stem};")),
+                    "{}/{name} is no module of its main.rs, so it never runs",
+                    dir.display()
+                );
+            }
+        }
+    }
+    assert!(targets >= 8, "{targets} test targets in folders");
 }
 
 /// Every `.rs` file of stage `stem`: its file and its folder's.

@@ -4,11 +4,11 @@ after changing this script and commit the bytes):
 
 - tests/fixtures/: valid files in layouts our writers never produce (tiled
   and compressed TIFF, big-endian GeoTIFF in degrees, legacy Terragen, ESRI
-  grids with centre corners and CRLF), read by tests/io_formats.rs;
-- tests/malformed/: broken files of every format plus expected.json, the
-  error variant and message substring each must produce
-  (tests/io_malformed.rs). Some are cut from tests/golden/, so bless the
-  golden files first.
+  grids with centre corners and CRLF), read by tests/io/formats.rs;
+- tests/malformed/: broken files of every format, one folder per format
+  (tests/malformed/<format>/), plus expected.json, the error variant and
+  message substring each must produce (tests/io/malformed.rs). Some are
+  cut from tests/golden/, so bless the golden files first.
 """
 import json
 import os
@@ -192,10 +192,14 @@ def malformed():
     cases = {}
 
     def case(name, data, variant, contains, names=None, sidecar=None):
-        put(BAD, name, data)
+        # One folder per format (the name's prefix), LERC TIFFs in their own.
+        folder = "tiff/lerc" if name.startswith("tiff_lerc") else name.split("_")[0]
+        directory = os.path.join(BAD, folder)
+        os.makedirs(directory, exist_ok=True)
+        put(directory, name, data)
         if sidecar is not None:
-            put(BAD, os.path.splitext(name)[0] + ".json", sidecar)
-        cases[name] = {"variant": variant, "contains": contains, "names": names or name}
+            put(directory, os.path.splitext(name)[0] + ".json", sidecar)
+        cases[folder + "/" + name] = {"variant": variant, "contains": contains, "names": names or name}
 
     # PNG
     g = golden("png16.png")

@@ -8,7 +8,7 @@
 //! compiled, with or without the `gpu` feature, so a plain `cargo test`
 //! checks every such `#[repr(C)]` struct against the WGSL declaration of
 //! the same name (sizes and member offsets, parsed by naga:
-//! `tests/backend_layout.rs`).
+//! `tests/backend/layout.rs`).
 
 use crate::stages::Stage;
 

@@ -7,7 +7,7 @@
 //! computes — host memory or GPU buffers — so state stays on the GPU across
 //! stages and levels and only results (and requested debug maps) come back.
 //! Both produce the same bytes after every stage (DESIGN §6); the
-//! `backend_*` tests check it. Which one runs — for synthesis, the
+//! `stages` and `backend` test targets check it. Which one runs — for synthesis, the
 //! preview's `shade` and the patch engine's `fill_ssd` alike — is one
 //! [`engine::Engine`], chosen once from the user's [`Choice`].
 

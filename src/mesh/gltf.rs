@@ -5,7 +5,7 @@
 //! like the meshes); every attribute and the indices in their own tightly
 //! packed buffer view, so every accessor is 4-byte aligned. POSITION
 //! accessors carry their exact min/max, as the specification requires.
-//! Checked by the Khronos glTF-Validator in `tests/mesh_clients.rs`.
+//! Checked by the Khronos glTF-Validator in `tests/terrain/mesh_clients.rs`.
 
 use super::{Mesh, MeshError, bounds};
 use crate::io::write_atomic;

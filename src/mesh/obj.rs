@@ -3,7 +3,7 @@
 //! `vn` sharing the vertex's number. Numbers are written in Rust's
 //! shortest round-trip form, so a reader gets the same f32 bits. OBJ's
 //! texture origin is the bottom-left corner: `vt` is (u, 1 − v).
-//! Checked by trimesh in `tests/mesh_clients.rs`.
+//! Checked by trimesh in `tests/terrain/mesh_clients.rs`.
 
 use super::{Mesh, MeshError};
 use crate::io::write_atomic;

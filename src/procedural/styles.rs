@@ -1,5 +1,5 @@
 //! The procedural styles of `terrasynth generate`: eroded alpine ridges,
-//! canyons and mesas, rolling hills (`tests/procedural.rs` pins their
+//! canyons and mesas, rolling hills (`tests/inputs/procedural.rs` pins their
 //! output at the defaults by golden hashes).
 //!
 //! Noise alone does not look like terrain: real landscapes are organised by

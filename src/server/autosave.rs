@@ -227,7 +227,7 @@ fn unsaved(tabs: &mut Vec<Tab>, saved: &Arc<Value>) -> Value {
     tabs.iter()
         .filter_map(|t| t.work.as_ref())
         .fold((**saved).clone(), |doc, w| {
-            super::merge::merge(&w.base, &w.doc, &doc)
+            super::document::merge::merge(&w.base, &w.doc, &doc)
         })
 }
 

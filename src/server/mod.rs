@@ -18,24 +18,14 @@
 //! that the next start offers to recover (`autosave.rs`); exports are
 //! downloads.
 
-mod assets;
+pub mod api;
 mod autosave;
-mod checkpoints;
-mod doc;
+mod document;
 mod editor;
-mod error;
-mod frame;
-mod history;
-mod merge;
-mod output;
-mod patch;
 mod registry;
-pub mod request;
-mod routes;
-mod view;
 
-pub use error::ApiError;
-pub use view::View;
+pub use api::error::ApiError;
+pub use editor::view::View;
 
 use crate::database::{Database, DbError};
 use crate::progress::Progress;
@@ -161,8 +151,8 @@ impl Progress for LoadProgress {
 pub(crate) struct App {
     db: RwLock<DbState>,
     progress: LoadProgress,
-    style: RwLock<Option<Arc<view::Style>>>,
-    policy: Arc<doc::Policy>,
+    style: RwLock<Option<Arc<editor::view::Style>>>,
+    policy: Arc<document::Policy>,
     /// The document a new tab starts from — the scene file as last saved
     /// (or as the server found it, or a blank one) — and its revision.
     /// Why the last save and not the file as found: a tab opened after
@@ -294,7 +284,7 @@ pub fn start(config: Config) -> Result<Running, ServeError> {
         .build()
         .map_err(ServeError::Runtime)?;
     let (tx, rx) = tokio::sync::oneshot::channel::<()>();
-    let router = routes::router(app.clone());
+    let router = api::routes::router(app.clone());
     let listener = {
         let _guard = runtime.enter();
         tokio::net::TcpListener::from_std(listener).map_err(ServeError::Runtime)?
@@ -396,12 +386,12 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
                 )
             });
             (
-                doc::blank(config.size.0, config.size.1, config.seed, dbv.as_ref()),
+                document::blank(config.size.0, config.size.1, config.seed, dbv.as_ref()),
                 dbv,
             )
         }
     };
-    let policy = doc::Policy {
+    let policy = document::Policy {
         file: file.clone(),
         database: db_path,
         database_value,
@@ -473,7 +463,7 @@ fn load_database(app: Arc<App>, source: DbSource) {
                     Err(e) => DbState::Failed(format!("the scene cannot be edited: {e}")),
                     Ok(_) => {
                         *app.style.write().unwrap_or_else(|e| e.into_inner()) =
-                            Some(Arc::new(view::Style::new(db)));
+                            Some(Arc::new(editor::view::Style::new(db)));
                         *app.exemplar_previews
                             .lock()
                             .unwrap_or_else(|e| e.into_inner()) =

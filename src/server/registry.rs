@@ -12,8 +12,8 @@
 //! history as long as no one needs the slot (its document is in the page:
 //! it reopens a session from it if the slot was taken).
 
+use super::api::error::ApiError;
 use super::editor::Handle;
-use super::error::ApiError;
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hasher};
 use std::sync::{Arc, Mutex};

@@ -39,7 +39,7 @@ macro_rules! stages {
             pub const ALL: [Stage; [$(Stage::$variant),*].len()] = [$(Stage::$variant),*];
 
             /// The stage's name: its module, its kernel `kernels/<name>.wgsl`,
-            /// its bench group and its test file `tests/stage_<name>.rs`.
+            /// its bench group and its test module `tests/stages/<name>.rs`.
             pub const fn name(self) -> &'static str {
                 match self {
                     $(Stage::$variant => stringify!($name),)*

@@ -30,7 +30,7 @@
 //! strip, and it joins `p`'s label to wherever it goes through labels that
 //! meet below its highest point (so the graph gives `p` a level no
 //! higher). Levels are copies of heights, never sums, so the result is bit
-//! for bit that of one flood of the whole grid (`tests/water_fast.rs`
+//! for bit that of one flood of the whole grid (`tests/water/fast.rs`
 //! compares the two).
 //!
 //! Why strips: the flood visits cells in height order, scattered over the

@@ -121,25 +121,7 @@ impl Grid<'_> {
                 }
             }
         }
-        std::mem::swap(&mut ring, &mut next);
-        next.clear();
-        let mut step = 2;
-        while !ring.is_empty() {
-            step += 1;
-            for (j, &c) in ring.iter().enumerate() {
-                if let Some(&ahead) = ring.get(j + PREFETCH) {
-                    prefetch(&grad, ahead, self.w);
-                }
-                for k in self.around(c) {
-                    if grad[k] == 0 {
-                        grad[k] = 2 * step;
-                        next.push(k);
-                    }
-                }
-            }
-            std::mem::swap(&mut ring, &mut next);
-            next.clear();
-        }
+        self.sweep(&mut grad, next, 2, 2);
         grad
     }
 
@@ -147,7 +129,7 @@ impl Grid<'_> {
     /// flats; 0 where none is reached.
     fn away_from_higher(&self, flats: &[u32]) -> Vec<u32> {
         let mut higher = self.sweep_array();
-        let mut ring: Vec<usize> = flats
+        let ring: Vec<usize> = flats
             .iter()
             .map(|&f| f as usize)
             .filter(|&f| self.class[f] & HIGHER != 0)
@@ -155,17 +137,24 @@ impl Grid<'_> {
         for &c in &ring {
             higher[c] = 1;
         }
+        self.sweep(&mut higher, ring, 1, 1);
+        higher
+    }
+
+    /// Breadth-first from `ring`, whose cells are set, through the cells
+    /// still 0: ring n after it gets `weight × (step + n)`. The two sweeps
+    /// differ only in their first rings and these numbers.
+    fn sweep(&self, grid: &mut [u32], mut ring: Vec<usize>, mut step: u32, weight: u32) {
         let mut next = Vec::new();
-        let mut step = 1;
         while !ring.is_empty() {
             step += 1;
             for (j, &c) in ring.iter().enumerate() {
                 if let Some(&ahead) = ring.get(j + PREFETCH) {
-                    prefetch(&higher, ahead, self.w);
+                    prefetch(grid, ahead, self.w);
                 }
                 for k in self.around(c) {
-                    if higher[k] == 0 {
-                        higher[k] = step;
+                    if grid[k] == 0 {
+                        grid[k] = weight * step;
                         next.push(k);
                     }
                 }
@@ -173,7 +162,6 @@ impl Grid<'_> {
             std::mem::swap(&mut ring, &mut next);
             next.clear();
         }
-        higher
     }
 }
 

@@ -11,7 +11,7 @@
 //! next segment's first), at a lake or the sea (whose first cell it
 //! includes, so the line touches the water), or at a border outlet. Every
 //! river therefore reaches a lake, the sea or the border, by construction
-//! of the filled surface (every cell drains); `tests/water.rs` checks it.
+//! of the filled surface (every cell drains); `tests/water/network.rs` checks it.
 
 use super::d8::OUTLET;
 use super::lakes::{LAKE, LAND, SEA};

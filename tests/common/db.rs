@@ -37,7 +37,7 @@ pub fn default_db() -> &'static Database {
 }
 
 /// A coast: the top-left 256² of the procedural hills (`generate --style
-/// hills` at its defaults, pinned by `tests/procedural.rs`) flooded to its
+/// hills` at its defaults, pinned by `tests/inputs/procedural.rs`) flooded to its
 /// 30th height percentile, so that 30 % of it is one flat sea (the
 /// `correct` stage's flat-candidate prior acts there), and that sea level
 /// in metres. Flooded valleys, not a real coast: a real coast's open sea is
@@ -65,7 +65,7 @@ pub fn coast_db() -> &'static (Database, f32) {
 }
 
 /// The procedural hills (`generate --style hills` at its defaults, pinned
-/// by `tests/procedural.rs`) as `generate` writes them: 16-bit PNG heights.
+/// by `tests/inputs/procedural.rs`) as `generate` writes them: 16-bit PNG heights.
 fn hills() -> &'static Heightfield {
     static HILLS: OnceLock<Heightfield> = OnceLock::new();
     HILLS.get_or_init(|| {

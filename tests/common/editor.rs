@@ -49,7 +49,7 @@ pub fn heights(addr: SocketAddr, session: &str) -> Vec<f32> {
 }
 
 /// The heights a fresh synthesis of document `d` gives (a session opened
-/// on it, as `synth --scene` gives: `tests/sculpt.rs`), row-major.
+/// on it, as `synth --scene` gives: `tests/synth/sculpt.rs`), row-major.
 pub fn fresh_heights(d: &Value) -> Vec<f32> {
     use terrasynth::scene::{Scene, SceneEdits};
     let db = database();

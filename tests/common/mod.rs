@@ -228,3 +228,19 @@ pub fn run_ok(cmd: &mut Command) -> Output {
 pub fn terrasynth(args: &[&str]) -> Output {
     run_ok(Command::new(env!("CARGO_BIN_EXE_terrasynth")).args(args))
 }
+
+/// A proptest configuration of `cases` cases that keeps its failures
+/// beside the test's own file (`tests/<target>/<module>.proptest-regressions`,
+/// where the committed ones are). Why: proptest's default
+/// (`SourceParallel`) finds the `main.rs` of a test target's folder and
+/// would read and write `tests/proptest-regressions/<module>.txt` instead,
+/// away from the test, and one file for same-named modules of two targets.
+pub fn proptest_cases(cases: u32) -> proptest::test_runner::Config {
+    proptest::test_runner::Config {
+        cases,
+        failure_persistence: Some(Box::new(
+            proptest::test_runner::FileFailurePersistence::WithSource("proptest-regressions"),
+        )),
+        ..proptest::test_runner::Config::default()
+    }
+}

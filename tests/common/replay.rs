@@ -42,8 +42,8 @@ pub fn run_target(format: Option<Format>, data: &[u8]) -> Option<Result<Heightfi
 }
 
 /// Every (file, target format) to replay: the fuzz corpus, the committed
-/// crash regressions (tests/regressions/<target>/), and tests/malformed with
-/// the format its extension names.
+/// crash regressions (tests/regressions/<target>/), and tests/malformed/<format>/
+/// with the format its extension names.
 pub fn cases() -> Vec<(PathBuf, Option<Format>)> {
     let mut out = Vec::new();
     for (target, format) in TARGETS {
@@ -64,14 +64,23 @@ pub fn cases() -> Vec<(PathBuf, Option<Format>)> {
     out
 }
 
+/// The files under `dir`, its subfolders' too (tests/malformed has one
+/// per format), sorted; none where `dir` is missing.
 fn files(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|rd| {
-            rd.map(|e| e.unwrap().path())
-                .filter(|p| p.is_file())
-                .collect()
-        })
-        .unwrap_or_default();
+    let mut v = Vec::new();
+    let mut dirs = vec![dir.to_path_buf()];
+    while let Some(d) = dirs.pop() {
+        let Ok(rd) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for p in rd.map(|e| e.unwrap().path()) {
+            if p.is_dir() {
+                dirs.push(p);
+            } else if p.is_file() {
+                v.push(p);
+            }
+        }
+    }
     v.sort();
     v
 }

@@ -1,4 +1,4 @@
-// The editor's HTTP API (see src/server/routes.rs), with the page's side
+// The editor's HTTP API (see src/server/api/routes.rs), with the page's side
 // of coalescing: at most one scene document in flight; a newer one waits
 // in a single slot, replacing any older waiting one (latest wins), so a
 // drag never queues stale work.

@@ -1,6 +1,6 @@
 //! Stage `correct`'s parameter block and per-pixel control inputs as
 //! `kernels/correct.wgsl` declares them (`#[repr(C)]`, checked against the
-//! WGSL by `tests/backend_layout.rs`).
+//! WGSL by `tests/backend/layout.rs`).
 
 use bytemuck::{Pod, Zeroable};
 

@@ -60,7 +60,7 @@
 //! level 1) the finest levels were free to smooth the face, and the 1:2
 //! cone let the face sit half its distance high. Held over the reach with
 //! s = 0.1 the face is 0.85 m/m and the top edge within 2 % of relief
-//! (`tests/scene_session.rs`); the curve profile test's mean error went
+//! (`tests/synth/scene_session.rs`); the curve profile test's mean error went
 //! 1.24 → 1.17 % of relief and the fine relief within 2 px of the curve
 //! stays 79 % of the unconstrained terrain's (80 % before). A sloped point
 //! holds its plane over its reach the same way (with s = ¼); a flat point

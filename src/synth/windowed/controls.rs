@@ -19,7 +19,7 @@
 //!   for over rectangles ([`WindowControls`]).
 //!
 //! Restricted re-synthesis (`Guides::restrict`) is off: it gives the same
-//! bytes as a full second frame (tested in `tests/synth_control.rs`), and a
+//! bytes as a full second frame (tested in `tests/synth/control.rs`), and a
 //! window's second frame is small anyway.
 
 use super::paste::{self, PasteGeometry};

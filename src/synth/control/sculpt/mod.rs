@@ -29,8 +29,8 @@
 //! **Where a stroke acts.** An editing session frees (re-synthesizes
 //! unweighted) only the pixels whose target a stroke changed
 //! (`synth::session`'s sculpt edit); the synthesis's neighbourhoods carry
-//! the change a few pixels further. Measured (`tests/sculpt.rs`, radius 32,
-//! Pyrenees; `tests/serve_sculpt.rs`, radius 16, the embedded database):
+//! the change a few pixels further. Measured (`tests/synth/sculpt.rs`, radius 32,
+//! Pyrenees; `tests/serve/sculpt.rs`, radius 16, the embedded database):
 //! no pixel farther than the radius + 8 px from the stroke changes, bar a
 //! handful by 0.01 m.
 
