@@ -212,8 +212,7 @@ proptest! {
 #[cfg(feature = "gpu")]
 #[test]
 fn gpu_windows_match_the_cpu() {
-    #[path = "common/gpu.rs"]
-    mod gpu;
+    use crate::common::gpu;
     let Some(ctx) = gpu::context() else { return };
     let cpu = Synthesizer::new(db(), Params::default()).unwrap();
     let mut gpu = Synthesizer::new(db(), Params::default()).unwrap();

@@ -175,8 +175,7 @@ fn bad_paint_is_a_typed_error() {
 #[cfg(feature = "gpu")]
 #[test]
 fn gpu_scene_windows_match_the_cpu() {
-    #[path = "common/gpu.rs"]
-    mod gpu;
+    use crate::common::gpu;
     let Some(ctx) = gpu::context() else { return };
     let s = scene(everything());
     let ws = WindowedScene::new(&s, db()).unwrap();
