@@ -33,7 +33,7 @@
 //! noisy, and away on gentle terrain whose real DEM owes its pits to
 //! SRTM's metre steps.
 
-use crate::heightfield::Heightfield;
+use crate::heightfield::{FirstNodata, Heightfield};
 use crate::synth::cone::Rect;
 use rayon::prelude::*;
 use thiserror::Error;
@@ -164,12 +164,8 @@ pub fn erode(hf: &Heightfield, strength: f32) -> Result<Heightfield, ErodeError>
     if !(strength.is_finite() && (0.0..=MAX_STRENGTH).contains(&strength)) {
         return Err(ErodeError::Strength(strength));
     }
-    if let Some(i) = hf.data().iter().position(|v| v.is_nan()) {
-        return Err(ErodeError::Nodata {
-            count: hf.nodata_count(),
-            x: i % hf.width(),
-            y: i / hf.width(),
-        });
+    if let Some(FirstNodata { count, x, y }) = hf.first_nodata() {
+        return Err(ErodeError::Nodata { count, x, y });
     }
     let (w, h) = (hf.width(), hf.height());
     let g = Grid {

@@ -31,6 +31,15 @@ pub struct Extent {
     pub nodata: usize,
 }
 
+/// [`Heightfield::first_nodata`]: where the first missing sample is (row
+/// order) and how many are missing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FirstNodata {
+    pub count: usize,
+    pub x: usize,
+    pub y: usize,
+}
+
 use crate::georef::Georef;
 
 /// A row-major grid of heights in metres; row 0 is north, column 0 is west.
@@ -188,6 +197,17 @@ impl Heightfield {
     }
     pub fn nodata_count(&self) -> usize {
         self.extent().nodata
+    }
+    /// The first missing sample and the count, `None` when none is missing:
+    /// what every tool that refuses nodata (eval, water, mesh, erode, the
+    /// procedural filters) names in its error, found in one place.
+    pub fn first_nodata(&self) -> Option<FirstNodata> {
+        let i = self.data.iter().position(|v| v.is_nan())?;
+        Some(FirstNodata {
+            count: self.nodata_count(),
+            x: i % self.width,
+            y: i / self.width,
+        })
     }
     /// `Some(mask)` (true = nodata) when any sample is missing, else `None`.
     pub fn nodata_mask(&self) -> Option<Vec<bool>> {

@@ -48,7 +48,7 @@ pub use error::EvalError;
 pub use spectrum::Spectrum;
 pub use types::{TypeUsage, type_usage};
 
-use crate::heightfield::Heightfield;
+use crate::heightfield::{FirstNodata, Heightfield};
 use rayon::prelude::*;
 
 /// Whether a descriptor is a distribution over cells or one number.
@@ -274,12 +274,8 @@ pub fn describe(hf: &Heightfield) -> Result<Descriptors, EvalError> {
 
 /// Refuses a terrain with nodata, naming its first hole.
 pub(crate) fn check_nodata(hf: &Heightfield) -> Result<(), EvalError> {
-    match hf.data().iter().position(|v| v.is_nan()) {
-        Some(i) => Err(EvalError::Nodata {
-            count: hf.nodata_count(),
-            x: i % hf.width(),
-            y: i / hf.width(),
-        }),
+    match hf.first_nodata() {
+        Some(FirstNodata { count, x, y }) => Err(EvalError::Nodata { count, x, y }),
         None => Ok(()),
     }
 }

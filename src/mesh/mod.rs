@@ -24,7 +24,7 @@ pub mod normal_map;
 pub mod obj;
 pub mod rtin;
 
-use crate::heightfield::Heightfield;
+use crate::heightfield::{FirstNodata, Heightfield};
 use crate::io::{IoError, check_memory};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -256,12 +256,8 @@ fn check_heights(hf: &Heightfield) -> Result<(), MeshError> {
             height: h,
         });
     }
-    match hf.data().iter().position(|v| v.is_nan()) {
-        Some(i) => Err(MeshError::Nodata {
-            count: hf.nodata_count(),
-            x: i % w,
-            y: i / w,
-        }),
+    match hf.first_nodata() {
+        Some(FirstNodata { count, x, y }) => Err(MeshError::Nodata { count, x, y }),
         None => Ok(()),
     }
 }

@@ -5,7 +5,7 @@
 //! buffers, one rayon task per row: which thread computes a row can never
 //! change a bit of it.
 
-use crate::heightfield::Heightfield;
+use crate::heightfield::{FirstNodata, Heightfield};
 use rayon::prelude::*;
 
 /// The eight neighbours: (dx, dy, distance in cells).
@@ -55,12 +55,8 @@ pub(crate) fn sweep_add(out: &mut [f32], width: usize, f: impl Fn(usize, usize) 
 
 /// The heights of a heightfield as f64, or the first nodata pixel.
 pub(crate) fn to_f64(hf: &Heightfield) -> Result<Vec<f64>, super::ProceduralError> {
-    if let Some(i) = hf.data().iter().position(|v| v.is_nan()) {
-        return Err(super::ProceduralError::NoData {
-            count: hf.nodata_count(),
-            x: i % hf.width(),
-            y: i / hf.width(),
-        });
+    if let Some(FirstNodata { count, x, y }) = hf.first_nodata() {
+        return Err(super::ProceduralError::NoData { count, x, y });
     }
     Ok(hf.data().iter().map(|&v| v as f64).collect())
 }

@@ -36,7 +36,7 @@ pub mod tiled;
 pub use lakes::{Lake, Thresholds};
 pub use summary::Summary;
 
-use crate::heightfield::Heightfield;
+use crate::heightfield::{FirstNodata, Heightfield};
 use std::time::{Duration, Instant};
 use thiserror::Error;
 
@@ -185,12 +185,8 @@ pub struct Routed {
 }
 
 fn check_heights(hf: &Heightfield) -> Result<(), WaterError> {
-    match hf.data().iter().position(|v| v.is_nan()) {
-        Some(i) => Err(WaterError::Nodata {
-            count: hf.nodata_count(),
-            x: i % hf.width(),
-            y: i / hf.width(),
-        }),
+    match hf.first_nodata() {
+        Some(FirstNodata { count, x, y }) => Err(WaterError::Nodata { count, x, y }),
         None => Ok(()),
     }
 }
