@@ -21,22 +21,20 @@ pub(super) fn points(d: &Doc, ids: &mut Vec<String>) -> R<Vec<PointSpec>> {
         |path, o| {
             let id = r.id(o, path, path.to_string(), ids)?;
             let (at, height_m) = d.height_at(o, path)?;
-            let slope_deg = match o.get("slope_deg") {
-                Some(v) => r.number(
-                    v,
-                    &join(path, "slope_deg"),
-                    Range::closed(0.0, 80.0, "0..=80 degrees"),
-                )?,
-                None => 0.0,
-            };
-            let slope_direction_deg = match o.get("slope_direction_deg") {
-                Some(v) => r.number(
-                    v,
-                    &join(path, "slope_direction_deg"),
-                    Range::closed(-360.0, 360.0, "-360..=360 degrees"),
-                )?,
-                None => 0.0,
-            };
+            let slope_deg = r.number_or(
+                o,
+                path,
+                "slope_deg",
+                Range::closed(0.0, 80.0, "0..=80 degrees"),
+                0.0,
+            )?;
+            let slope_direction_deg = r.number_or(
+                o,
+                path,
+                "slope_direction_deg",
+                Range::closed(-360.0, 360.0, "-360..=360 degrees"),
+                0.0,
+            )?;
             let radius_px = r.number(
                 r.required(o, path, "radius_px", "a radius in pixels")?,
                 &join(path, "radius_px"),

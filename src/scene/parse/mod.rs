@@ -77,10 +77,13 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         "seed",
         u32::MAX as u64,
     )? as u32;
-    let jitter = match m.get("jitter") {
-        Some(v) => r.number(v, "jitter", Range::closed(0.0, 4.0, "0..=4 texels"))?,
-        None => 0.4,
-    };
+    let jitter = r.number_or(
+        m,
+        "$",
+        "jitter",
+        Range::closed(0.0, 4.0, "0..=4 texels"),
+        0.4,
+    )?;
     let passes = match m.get("passes") {
         Some(v) => r.integer(v, "passes", 16)? as u32,
         None => 2,

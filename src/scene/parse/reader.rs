@@ -168,6 +168,23 @@ impl Reader<'_> {
         .collect()
     }
 
+    /// An optional number of `m`: `default` when `key` is absent, else
+    /// checked as [`Reader::number`] does. Every number a scene may leave
+    /// out (jitter, a point's slopes, a stroke's falloff) reads this way.
+    pub(super) fn number_or(
+        &self,
+        m: &Map<String, Value>,
+        path: &str,
+        key: &str,
+        range: Range,
+        default: f64,
+    ) -> R<f64> {
+        match m.get(key) {
+            Some(v) => self.number(v, &join(path, key), range),
+            None => Ok(default),
+        }
+    }
+
     pub(super) fn number(&self, v: &Value, path: &str, range: Range) -> R<f64> {
         match v.as_f64() {
             Some(x) if range.contains(x) => Ok(x),

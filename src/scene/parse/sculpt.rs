@@ -37,10 +37,7 @@ pub(super) fn sculpt(d: &Doc) -> R<Vec<SculptSpec>> {
                 Range::above(0.0, 1.0, "0 < strength <= 1"),
             )?,
         };
-        let falloff = match o.get("falloff") {
-            Some(v) => r.number(v, &join(path, "falloff"), Range::closed(0.0, 1.0, "0..=1"))?,
-            None => 0.5,
-        };
+        let falloff = r.number_or(o, path, "falloff", Range::closed(0.0, 1.0, "0..=1"), 0.5)?;
         let targets = match o.get("targets") {
             Some(v) => Some(grid(r, v, &join(path, "targets"))?),
             None => None,
