@@ -1,8 +1,8 @@
 //! `terrasynth serve`, the editor (feature `serve`): its JSON API, limits
-//! and memory, undo of pastes, tabs, autosave, and the page itself in
-//! headless Chromium (browser, export, sculpt, 3D view;
+//! and memory, undo of pastes, and the page itself in headless Chromium
+//! (browser, export, sculpt, tabs, autosave, 3D view;
 //! `TERRASYNTH_REQUIRE_BROWSER` turns "no browser, skipped" into a
-//! failure).
+//! failure). One target, so the editor's tests share one build.
 #![cfg(feature = "serve")]
 
 #[path = "../common/mod.rs"]
