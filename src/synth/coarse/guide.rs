@@ -2,7 +2,7 @@
 //! where low at the scale of massifs, drawn anew for every seed.
 //!
 //! A smooth random field — integer value noise, [`OCTAVES`] octaves from a
-//! lattice of 2^[`BASE_BITS`] output pixels, each octave half the
+//! lattice of 2^[`Scale::bits`] output pixels, each octave half the
 //! amplitude and lattice of the one before — is read through its own
 //! distribution as a rank u ∈ [0, 1): the piece at a place takes its
 //! source among the exemplars' places whose surroundings stand at quantile
@@ -10,7 +10,8 @@
 //! of highs and lows, the exemplars set everything else, and the output's
 //! altitudes follow the exemplars' distribution whatever the layout: the
 //! rank is local ([`RANK_STEPS`]), so every region of a few hundred
-//! pixels holds the exemplars' whole range of altitudes.
+//! pixels holds the exemplars' whole range of altitudes. The field's scale
+//! follows the exemplars' ([`Scale::of_exemplars`]).
 //!
 //! Why a field and not the exemplars' own layout: the start laid verbatim
 //! exemplar blocks, so every output was the exemplar's own massifs
@@ -32,21 +33,68 @@
 use crate::hash::hash4;
 use std::sync::LazyLock;
 
-/// Lattice of the coarsest octave, log₂ of output pixels: 256 px, a few
-/// massifs across an output the size of the shared DEMs. Measured on the
-/// 8 shared DEMs (seeds 11–13): 512 px kept 65–83 % of their relief where
-/// 256 px kept 71–88 % (an output holds too few highs and lows of the
-/// larger field, and correction levels lone pieces), 128 px left no
-/// massifs larger than a few pieces.
-pub const BASE_BITS: u32 = 8;
+/// The scale of the field: its coarsest lattice, 2^`bits` output pixels,
+/// and the spacing of the grid its local rank is taken on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scale {
+    bits: u32,
+}
 
-/// Octaves of the field (lattices of 256, 128 and 64 px).
+impl Scale {
+    /// The scale for exemplars of median side `side` (output pixels): a
+    /// lattice of the largest power of two below that side, 256 or 512 px
+    /// — the field's coarsest cells are smaller than the exemplar that
+    /// shows how large its landforms are.
+    ///
+    /// Why the exemplars' size: they are the only measure of how large
+    /// the landforms they show are — a 600-px exemplar of a coast holds one
+    /// sea, a 1024-px one a sea and a range. With a 256-px lattice for all
+    /// (issue 46), every region of ~450 px held the whole range of
+    /// altitudes, so the shared DEMs' coasts came out as round lakes
+    /// between islands, each ringed by a narrow steep shore — several
+    /// times the exemplar's coastline, and shore windows (sea against a
+    /// ramp) are alike everywhere: catalan 16 % of windows copied (its
+    /// halves 4 %), median slope 123 %. At 512 px the sea gathers into one
+    /// or two large bodies with broad lowlands (the 8 shared DEMs, 600 to
+    /// 1024 px; seeds 11–13, exemplar size: catalan 112 %, 8 % copied;
+    /// worlds 3× the side, seed 11: 7 of the 8 meet every realism and
+    /// novelty target, 3 of 8 before). Why not 512 px for every exemplar: an
+    /// output smaller than the lattice lies within one or two of its
+    /// cells, and the embedded 512-px exemplars gave 256² outputs of one
+    /// landform (seed 3: 950 m of relief where 256 px gives 2 455 m; a sea
+    /// covering a fifth of seed 2). 128 px left no massifs larger than a
+    /// few pieces; above 512 px nothing was measured.
+    pub fn of_exemplars(side: usize) -> Scale {
+        Scale {
+            bits: if side > 512 { 9 } else { 8 },
+        }
+    }
+
+    /// log₂ of the coarsest octave's lattice, in output pixels.
+    pub fn bits(self) -> u32 {
+        self.bits
+    }
+
+    /// The spacing of the local rank's grid: 32 px at 256, 48 at 512 —
+    /// the window (±[`RANK_STEPS`] nodes, ±224 or ±336 px) sets how large
+    /// a low a region may hold. A 512-px field ranked within ±224 px came
+    /// back as the 256-px field's lakes; within ±448 px the share of sea
+    /// in a riviera-sized output was a lottery again (seed 11: more than
+    /// half of it sea; seeds 12–13 a median slope of 169 %).
+    fn spacing(self) -> i32 {
+        16 + (1 << self.bits) / 16
+    }
+}
+
+/// Octaves of the field (lattices of 256, 128 and 64 px at the 256-px
+/// scale). A fourth octave at the 512-px scale measured the same on the 8
+/// shared DEMs but for the coasts, 2–5 points steeper.
 pub const OCTAVES: u32 = 3;
 
 /// The rank of the field at a place is taken among its values at a grid
-/// of places around it: `(2·RANK_STEPS + 1)²` nodes of the grid of
-/// [`RANK_SPACING`] output pixels anchored at the world's origin, centred
-/// on the node at or before the place (±224 px).
+/// of places around it: `(2·RANK_STEPS + 1)²` nodes of a grid of
+/// [`Scale::spacing`] output pixels anchored at the world's origin,
+/// centred on the node at or before the place.
 ///
 /// Why a local rank and not the field's global distribution: an output
 /// the size of a shared DEM holds only a few lattice cells of the coarsest
@@ -62,13 +110,15 @@ pub const OCTAVES: u32 = 3;
 /// pieces, where 225 per piece were 230 400: 17 ms of a 1024² synthesis on
 /// 2 cores).
 const RANK_STEPS: i32 = 7;
-const RANK_SPACING: i32 = 32;
 
 /// Salt of the field's hashes.
 const SALT: u32 = 0x6A1D_0000;
 
 /// The distribution of the field's local ranks is sampled over
-/// `CDF_REGIONS` regions of `CDF_SIDE²` places (seed 0, far apart).
+/// `CDF_REGIONS` regions of `CDF_SIDE²` places (seed 0, far apart) at the
+/// 256-px scale, 4× as many at 512 px: as many lattice cells either way
+/// (with 256 regions the 512-px field's lowest decile held 12 % of a large
+/// world).
 const CDF_REGIONS: u32 = 256;
 const CDF_SIDE: i32 = 4;
 
@@ -81,10 +131,10 @@ const CDF_SIDE: i32 = 4;
 /// it — measured, the lowest and highest deciles of local ranks held half
 /// the share of the middle ones, and coasts came out with two thirds of
 /// their sea (catalan 14.6 % at the start, exemplar 21.7 %).
-pub fn quantiles(seed: u32, points: &[(i32, i32)]) -> Vec<u32> {
-    let sorted = distribution();
+pub fn quantiles(seed: u32, scale: Scale, points: &[(i32, i32)]) -> Vec<u32> {
+    let sorted = distribution(scale);
     let n = sorted.len() as u64;
-    local_ranks(seed, points)
+    local_ranks(seed, scale, points)
         .into_iter()
         .map(|r| {
             let lo = sorted.partition_point(|&s| s < r) as u64;
@@ -95,39 +145,47 @@ pub fn quantiles(seed: u32, points: &[(i32, i32)]) -> Vec<u32> {
         .collect()
 }
 
-/// The local ranks of [`CDF_REGIONS`] × [`CDF_SIDE`]² places of seed 0,
-/// sorted: computed once per process.
+/// The local ranks of [`CDF_REGIONS`] × [`CDF_SIDE`]² places of seed 0 at
+/// `scale`, sorted: computed once per process and scale.
 ///
 /// Why [`local_ranks`] runs on one thread: this is a lazy static's
 /// initializer, and work handed to rayon's pool from inside it deadlocks
 /// when the pool's threads are themselves waiting for the static (two
 /// syntheses starting at once on 2 cores did). It is small: a 1024² output
 /// ranks 1 024 places among 2 209 nodes in well under a millisecond.
-fn distribution() -> &'static [u32] {
-    static SORTED: LazyLock<Vec<u32>> = LazyLock::new(|| {
-        let mut sorted: Vec<u32> = (0..CDF_REGIONS)
-            .flat_map(|k| {
-                let x0 = (hash4(0, SALT | 1, k, 0) >> 12) as i32;
-                let y0 = (hash4(0, SALT | 2, k, 0) >> 12) as i32;
-                let places: Vec<(i32, i32)> = (0..CDF_SIDE * CDF_SIDE)
-                    .map(|i| {
-                        let (dx, dy) = (i % CDF_SIDE, i / CDF_SIDE);
-                        (x0 + dx * RANK_SPACING + 16, y0 + dy * RANK_SPACING + 16)
-                    })
-                    .collect();
-                local_ranks(0, &places)
-            })
-            .collect();
-        sorted.sort_unstable();
-        sorted
-    });
-    &SORTED
+fn distribution(scale: Scale) -> &'static [u32] {
+    static SORTED: [LazyLock<Vec<u32>>; 2] = [
+        LazyLock::new(|| sample(Scale { bits: 8 })),
+        LazyLock::new(|| sample(Scale { bits: 9 })),
+    ];
+    &SORTED[(scale.bits - 8) as usize]
+}
+
+/// The sorted sample behind [`distribution`].
+fn sample(scale: Scale) -> Vec<u32> {
+    let spacing = scale.spacing();
+    let mut sorted: Vec<u32> = (0..CDF_REGIONS << (2 * (scale.bits - 8)))
+        .flat_map(|k| {
+            let x0 = (hash4(0, SALT | 1, k, 0) >> 12) as i32;
+            let y0 = (hash4(0, SALT | 2, k, 0) >> 12) as i32;
+            let places: Vec<(i32, i32)> = (0..CDF_SIDE * CDF_SIDE)
+                .map(|i| {
+                    let (dx, dy) = (i % CDF_SIDE, i / CDF_SIDE);
+                    (x0 + dx * spacing + 16, y0 + dy * spacing + 16)
+                })
+                .collect();
+            local_ranks(0, scale, &places)
+        })
+        .collect();
+    sorted.sort_unstable();
+    sorted
 }
 
 /// The rank of the field of seed `seed` at each of `points` among its
 /// values at the grid nodes around it, in 1/2^16.
-fn local_ranks(seed: u32, points: &[(i32, i32)]) -> Vec<u32> {
-    let node = |v: i32| v.div_euclid(RANK_SPACING);
+fn local_ranks(seed: u32, scale: Scale, points: &[(i32, i32)]) -> Vec<u32> {
+    let spacing = scale.spacing();
+    let node = |v: i32| v.div_euclid(spacing);
     let (Some(gx0), Some(gx1), Some(gy0), Some(gy1)) = (
         points.iter().map(|p| node(p.0)).min(),
         points.iter().map(|p| node(p.0)).max(),
@@ -142,14 +200,14 @@ fn local_ranks(seed: u32, points: &[(i32, i32)]) -> Vec<u32> {
     let nodes: Vec<i32> = (0..nx * ny)
         .map(|k| {
             let (gx, gy) = (gx0 + k % nx, gy0 + k / nx);
-            field(seed, gx * RANK_SPACING, gy * RANK_SPACING)
+            field(seed, scale, gx * spacing, gy * spacing)
         })
         .collect();
     let n = ((2 * RANK_STEPS + 1) * (2 * RANK_STEPS + 1)) as u64;
     points
         .iter()
         .map(|&(x, y)| {
-            let v = field(seed, x, y);
+            let v = field(seed, scale, x, y);
             let (cx, cy) = (node(x) - gx0, node(y) - gy0);
             let mut below = 0u64;
             for gy in cy - RANK_STEPS..=cy + RANK_STEPS {
@@ -164,9 +222,9 @@ fn local_ranks(seed: u32, points: &[(i32, i32)]) -> Vec<u32> {
 }
 
 /// The field at output pixel (x, y): [`OCTAVES`] octaves of value noise.
-fn field(seed: u32, x: i32, y: i32) -> i32 {
+fn field(seed: u32, scale: Scale, x: i32, y: i32) -> i32 {
     (0..OCTAVES)
-        .map(|o| value_noise(seed, SALT | (o + 8), x, y, BASE_BITS - o) >> o)
+        .map(|o| value_noise(seed, SALT | (o + 8), x, y, scale.bits - o) >> o)
         .sum()
 }
 
@@ -190,10 +248,20 @@ mod tests {
 
     #[test]
     fn ranks_are_uniform_over_a_large_world_and_smooth() {
+        for (side, step) in [(512, 32), (600, 64)] {
+            let scale = Scale::of_exemplars(side);
+            // 256 × 256 places an eighth of a lattice apart: a world of
+            // 32 × 32 lattice cells at either scale.
+            assert_eq!(step, (1 << scale.bits()) / 8);
+            uniform_and_smooth(scale, step);
+        }
+    }
+
+    fn uniform_and_smooth(scale: Scale, step: i32) {
         let places: Vec<(i32, i32)> = (0..256 * 257)
-            .map(|k| ((k % 257) * 32 + 16, (k / 257) * 32 + 16))
+            .map(|k| ((k % 257) * step + 16, (k / 257) * step + 16))
             .collect();
-        let q = quantiles(7, &places);
+        let q = quantiles(7, scale, &places);
         let mut hist = [0u32; 10];
         let (mut steps, mut n) = (0u64, 0u64);
         for (k, &r) in q.iter().enumerate() {
@@ -212,17 +280,17 @@ mod tests {
                 "decile {k}: {c} of {n}"
             );
         }
-        // Neighbours 32 px apart differ by a tenth of the range (measured
-        // 0.11): the field is smooth at the scale of pieces (white noise:
-        // a third).
+        // Neighbours an eighth of a lattice apart differ by a tenth of the
+        // range (measured 0.11 at 256 px): the field is smooth at the scale
+        // of pieces (white noise: a third).
         let mean_step = steps as f64 / n as f64 / 65536.0;
         assert!(mean_step < 0.15, "mean step {mean_step}");
         // Another seed, another field.
         let places: Vec<(i32, i32)> = (0..64).map(|k| (k * 97, 5)).collect();
-        let (a, b) = (quantiles(7, &places), quantiles(8, &places));
+        let (a, b) = (quantiles(7, scale, &places), quantiles(8, scale, &places));
         // A place's quantile is its own: the same whatever else is asked
         // with it (a window of a world asks for fewer places).
-        assert_eq!(quantiles(7, &places[40..45]), a[40..45]);
+        assert_eq!(quantiles(7, scale, &places[40..45]), a[40..45]);
         let same = a.iter().zip(&b).filter(|(a, b)| a == b).count();
         assert!(same < 8, "{same}");
     }

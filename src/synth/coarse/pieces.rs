@@ -62,7 +62,7 @@ pub fn pieces(
             (centre_px(i), centre_px(j))
         })
         .collect();
-    let quantiles = guide::quantiles(seed, &places);
+    let quantiles = guide::quantiles(seed, src.pool.scale(), &places);
     // The pool of every type set painted in the region (the whole pool
     // where a set has no texel at this level: type seeding then does what
     // it can, as it did before).

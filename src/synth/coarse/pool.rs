@@ -1,7 +1,9 @@
 //! Where the coarse start's pieces come from: every interior texel of the
 //! start level, of one exemplar or of all, ranked by the altitude of its
-//! surroundings.
+//! surroundings; and the scale of landforms those exemplars show, which
+//! the altitude guide lays out ([`Scale`]).
 
+use super::guide::Scale;
 use crate::database::layout::MARGIN;
 use crate::level::atlas::AtlasLevel;
 use crate::stages::common::texel_height;
@@ -23,6 +25,8 @@ pub struct Pool {
     /// (x, y) atlas coordinates, by ascending mean height of their
     /// surroundings, ties by position.
     ranked: Vec<(i32, i32)>,
+    /// The guide's scale for these exemplars.
+    scale: Scale,
 }
 
 impl Pool {
@@ -59,9 +63,21 @@ impl Pool {
             })
             .collect();
         keyed.par_sort_unstable();
+        // The exemplars' median side, in output pixels.
+        let mut sides: Vec<usize> = rects
+            .iter()
+            .map(|r| (r.width.min(r.height) as usize) << a.level.index)
+            .collect();
+        sides.sort_unstable();
         Pool {
             ranked: keyed.into_iter().map(|(_, x, y)| (x, y)).collect(),
+            scale: Scale::of_exemplars(sides.get(sides.len() / 2).copied().unwrap_or(0)),
         }
+    }
+
+    /// The altitude guide's scale for the pool's exemplars.
+    pub fn scale(&self) -> Scale {
+        self.scale
     }
 
     /// How many texels the pool holds.
@@ -83,6 +99,7 @@ impl Pool {
     /// place painted with those types.
     pub fn of_types(&self, a: &AtlasLevel<'_>, mask: u32) -> Pool {
         Pool {
+            scale: self.scale,
             ranked: self
                 .ranked
                 .iter()
