@@ -14,7 +14,7 @@ use terrasynth::synth::control::{
 };
 use terrasynth::synth::session::{Edit, Session};
 
-use crate::common::db::{PYRENEES_CATALAN, start_relief, two_dems};
+use crate::common::db::{PYRENEES_CATALAN, TwoDems, start_relief, two_dems};
 use crate::common::dem;
 use crate::common::moved_outside;
 /// The output side, the crops' side.
@@ -82,6 +82,71 @@ fn point_constraint_sets_height_and_slope() {
     // coarse start's pieces (issue 46) mean 1.24 %, worst 2.65 % (seed 12,
     // the raised point), and the bound on the worst is 3.5 % again.
     let Some(db) = db() else { return };
+    let sites = point_sites(db);
+    assert!(
+        sites.median_slope >= SLOPE_MEDIAN_MIN && sites.least_slope >= SLOPE_MIN,
+        "20° asked: median {:.1}°, least {:.1}°",
+        sites.median_slope,
+        sites.least_slope
+    );
+    assert!(
+        sites.mean <= 0.015,
+        "site heights off by {:.2}% of relief on average",
+        sites.mean * 100.0
+    );
+    assert!(
+        sites.worst <= 0.035,
+        "a site height off by {:.2}% of relief",
+        sites.worst * 100.0
+    );
+}
+
+/// The same twenty sites on a database of two 576² crops of the same DEMs:
+/// exemplars larger than 512 px, whose coarse start lays out its highs
+/// and lows on a 512-px field (`synth/coarse/guide.rs`, issue 46) where
+/// the 256² crops above get the 256-px one. Measured: mean 1.29 % of
+/// relief, slopes median 17.3°, least 14.1°; the 256-px field on the same
+/// database gave a median of 18.1° but a least of 11.0°, under the bound.
+/// The worst site is not bounded here: on this database one site lies in
+/// the sea at either scale — a raised sea point (seed 7, 633 m asked, 371
+/// m got: 10.3 %) with the 512-px field, one lowered 507 m below the sea
+/// (seed 11, 8.3 %) with the 256-px one — points in the sea are issue
+/// 40's to fix, not the guide's.
+#[test]
+fn point_constraints_hold_on_the_large_exemplars_scale() {
+    let large = TwoDems {
+        side: 576,
+        ..PYRENEES_CATALAN
+    };
+    let Some(db) = two_dems(large, "control tests on large exemplars") else {
+        return;
+    };
+    let sites = point_sites(db);
+    assert!(
+        sites.median_slope >= SLOPE_MEDIAN_MIN && sites.least_slope >= SLOPE_MIN,
+        "20° asked: median {:.1}°, least {:.1}°",
+        sites.median_slope,
+        sites.least_slope
+    );
+    assert!(
+        sites.mean <= 0.015,
+        "site heights off by {:.2}% of relief on average",
+        sites.mean * 100.0
+    );
+}
+
+/// What [`point_sites`] measured: site height errors (fractions of the
+/// relief) and slopes across the sites (degrees).
+struct Sites {
+    mean: f64,
+    worst: f64,
+    median_slope: f64,
+    least_slope: f64,
+}
+
+/// Two sites (one raised, one lowered, slopes facing +x / +y) on ten
+/// terrains of `db` at N²; every site descends along its direction.
+fn point_sites(db: &Database) -> Sites {
     let rel = start_relief(db);
     let mut errors = Vec::new();
     let mut slopes = Vec::new();
@@ -128,11 +193,6 @@ fn point_constraint_sets_height_and_slope() {
     slopes.sort_by(f64::total_cmp);
     let median = (slopes[9] + slopes[10]) / 2.0;
     println!("slopes across the sites (20° asked): {slopes:.1?}, median {median:.1}°");
-    assert!(
-        median >= SLOPE_MEDIAN_MIN && slopes[0] >= SLOPE_MIN,
-        "20° asked: median {median:.1}°, least {:.1}°",
-        slopes[0]
-    );
     let mean = errors.iter().sum::<f64>() / errors.len() as f64;
     let worst = errors.iter().cloned().fold(0.0, f64::max);
     println!(
@@ -140,16 +200,12 @@ fn point_constraint_sets_height_and_slope() {
         mean * 100.0,
         worst * 100.0
     );
-    assert!(
-        mean <= 0.015,
-        "site heights off by {:.2}% of relief on average",
-        mean * 100.0
-    );
-    assert!(
-        worst <= 0.035,
-        "a site height off by {:.2}% of relief",
-        worst * 100.0
-    );
+    Sites {
+        mean,
+        worst,
+        median_slope: median,
+        least_slope: slopes[0],
+    }
 }
 
 #[test]
