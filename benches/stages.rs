@@ -86,7 +86,7 @@ fn inputs() -> Inputs {
     };
     let preview = render::prepare(&out.heightfield, &RenderOptions::default()).unwrap();
 
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/exemplars");
     let mask = TypeMask::read(&data.join("catalan_coast_hills_types.png")).unwrap();
     let last = mask.indices.iter().filter(|&&t| t != UNCONSTRAINED).max();
     let full = (1u32 << last.map_or(1, |&t| t as u32 + 1)) - 1;

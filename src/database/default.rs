@@ -1,5 +1,5 @@
 //! The embedded default database: four 512² crops of real SRTM DEMs in
-//! `data/` (a coast, a plain, high mountains, rolling hills; sources and
+//! `data/exemplars/` (a coast, a plain, high mountains, rolling hills; sources and
 //! credits in `data/CREDITS.md`) with their type masks (sea, flat, hills,
 //! mountains), compiled into the binary so that `terrasynth synth` works on
 //! a fresh machine with no files. They are real terrain rather than the
@@ -30,22 +30,27 @@ macro_rules! embed {
     ($name:literal) => {
         Embedded {
             name: $name,
-            dem: include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/", $name, ".png")),
+            dem: include_bytes!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/data/exemplars/",
+                $name,
+                ".png"
+            )),
             sidecar: include_bytes!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/data/",
+                "/data/exemplars/",
                 $name,
                 ".json"
             )),
             mask: include_bytes!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/data/",
+                "/data/exemplars/",
                 $name,
                 "_types.png"
             )),
             names: include_bytes!(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/data/",
+                "/data/exemplars/",
                 $name,
                 "_types.json"
             )),

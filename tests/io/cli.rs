@@ -215,7 +215,10 @@ fn a_closed_stdout_ends_a_command_without_a_panic() {
     let (reader, writer) = std::io::pipe().unwrap();
     drop(reader);
     let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
-        .args(["info", repo("data/thuringia_hills.png").to_str().unwrap()])
+        .args([
+            "info",
+            repo("data/exemplars/thuringia_hills.png").to_str().unwrap(),
+        ])
         .stdout(writer)
         .stderr(std::process::Stdio::piped())
         .output()
@@ -249,7 +252,7 @@ fn png8(path: &Path) -> (u32, u32, usize, Vec<u8>) {
 fn masks_for_an_engine_are_at_its_size_in_its_layout() {
     use terrasynth::io::engine::{self, Engine};
     use terrasynth::masks;
-    let dem = repo("data/pyrenees_andorra.png");
+    let dem = repo("data/exemplars/pyrenees_andorra.png");
     let hf = terrasynth::io::read(&dem, &Default::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     for (e, side) in [(Engine::Unreal, 1009u32), (Engine::Unity, 513)] {
