@@ -83,17 +83,7 @@ fn point_constraint_sets_height_and_slope() {
     // the raised point), and the bound on the worst is 3.5 % again.
     let Some(db) = db() else { return };
     let sites = point_sites(db);
-    assert!(
-        sites.median_slope >= SLOPE_MEDIAN_MIN && sites.least_slope >= SLOPE_MIN,
-        "20° asked: median {:.1}°, least {:.1}°",
-        sites.median_slope,
-        sites.least_slope
-    );
-    assert!(
-        sites.mean <= 0.015,
-        "site heights off by {:.2}% of relief on average",
-        sites.mean * 100.0
-    );
+    sites.assert_slopes_and_mean();
     assert!(
         sites.worst <= 0.035,
         "a site height off by {:.2}% of relief",
@@ -122,17 +112,7 @@ fn point_constraints_hold_on_the_large_exemplars_scale() {
         return;
     };
     let sites = point_sites(db);
-    assert!(
-        sites.median_slope >= SLOPE_MEDIAN_MIN && sites.least_slope >= SLOPE_MIN,
-        "20° asked: median {:.1}°, least {:.1}°",
-        sites.median_slope,
-        sites.least_slope
-    );
-    assert!(
-        sites.mean <= 0.015,
-        "site heights off by {:.2}% of relief on average",
-        sites.mean * 100.0
-    );
+    sites.assert_slopes_and_mean();
 }
 
 /// What [`point_sites`] measured: site height errors (fractions of the
@@ -142,6 +122,23 @@ struct Sites {
     worst: f64,
     median_slope: f64,
     least_slope: f64,
+}
+
+impl Sites {
+    /// The slope bounds above and a mean error of at most 1.5 % of relief.
+    fn assert_slopes_and_mean(&self) {
+        assert!(
+            self.median_slope >= SLOPE_MEDIAN_MIN && self.least_slope >= SLOPE_MIN,
+            "20° asked: median {:.1}°, least {:.1}°",
+            self.median_slope,
+            self.least_slope
+        );
+        assert!(
+            self.mean <= 0.015,
+            "site heights off by {:.2}% of relief on average",
+            self.mean * 100.0
+        );
+    }
 }
 
 /// Two sites (one raised, one lowered, slopes facing +x / +y) on ten
