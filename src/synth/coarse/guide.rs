@@ -2,7 +2,7 @@
 //! where low at the scale of massifs, drawn anew for every seed.
 //!
 //! A smooth random field — integer value noise, [`OCTAVES`] octaves from a
-//! lattice of 2^[`Scale::bits`] output pixels, each octave half the
+//! lattice of 256 or 512 output pixels ([`Scale`]), each octave half the
 //! amplitude and lattice of the one before — is read through its own
 //! distribution as a rank u ∈ [0, 1): the piece at a place takes its
 //! source among the exemplars' places whose surroundings stand at quantile
@@ -41,7 +41,8 @@ pub struct Scale {
 }
 
 impl Scale {
-    /// The scale for exemplars of median side `side` (output pixels): a
+    /// The scale for exemplars whose shorter sides' median is `side`
+    /// (output pixels): a
     /// lattice of the largest power of two below that side, 256 or 512 px
     /// — the field's coarsest cells are smaller than the exemplar that
     /// shows how large its landforms are.
@@ -56,9 +57,10 @@ impl Scale {
     /// ramp) are alike everywhere: catalan 16 % of windows copied (its
     /// halves 4 %), median slope 123 %. At 512 px the sea gathers into one
     /// or two large bodies with broad lowlands (the 8 shared DEMs, 600 to
-    /// 1024 px; seeds 11–13, exemplar size: catalan 112 %, 8 % copied;
-    /// worlds 3× the side, seed 11: 7 of the 8 meet every realism and
-    /// novelty target, 3 of 8 before). Why not 512 px for every exemplar: an
+    /// 1024 px; seeds 11–13, exemplar size: catalan 107 %, 9 % copied;
+    /// worlds 3× the side, seed 11: 4 of the 8 meet every realism and
+    /// novelty target, 3 of 8 before, and catalan, olympic and riviera miss
+    /// one each). Why not 512 px for every exemplar: an
     /// output smaller than the lattice lies within one or two of its
     /// cells, and the embedded 512-px exemplars gave 256² outputs of one
     /// landform (seed 3: 950 m of relief where 256 px gives 2 455 m; a sea
@@ -68,11 +70,6 @@ impl Scale {
         Scale {
             bits: if side > 512 { 9 } else { 8 },
         }
-    }
-
-    /// log₂ of the coarsest octave's lattice, in output pixels.
-    pub fn bits(self) -> u32 {
-        self.bits
     }
 
     /// The spacing of the local rank's grid: 32 px at 256, 48 at 512 —
@@ -252,7 +249,7 @@ mod tests {
             let scale = Scale::of_exemplars(side);
             // 256 × 256 places an eighth of a lattice apart: a world of
             // 32 × 32 lattice cells at either scale.
-            assert_eq!(step, (1 << scale.bits()) / 8);
+            assert_eq!(step, (1 << scale.bits) / 8);
             uniform_and_smooth(scale, step);
         }
     }

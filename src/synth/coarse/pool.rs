@@ -33,7 +33,7 @@ impl Pool {
     /// The pool of exemplar `from` (or of every exemplar) at the level of
     /// `a`: every interior texel, ranked by the mean height of the interior
     /// texels within [`REGION_PX`] of it (a square; from summed-area tables,
-    /// in integers).
+    /// in integers); the guide's [`Scale`] from those exemplars' sizes.
     pub fn new(a: &AtlasLevel<'_>, from: Option<usize>) -> Pool {
         let radius = (REGION_PX >> a.level.index).max(1);
         let rects = &a.level.layout.rects;
@@ -63,7 +63,7 @@ impl Pool {
             })
             .collect();
         keyed.par_sort_unstable();
-        // The exemplars' median side, in output pixels.
+        // The median of the exemplars' shorter sides, in output pixels.
         let mut sides: Vec<usize> = rects
             .iter()
             .map(|r| (r.width.min(r.height) as usize) << a.level.index)
