@@ -8,6 +8,7 @@
 //! reason. The mask view ([`Heightfield::nodata_mask`]) is derived, not stored,
 //! so it cannot disagree with the data.
 
+use crate::georef::Georef;
 use crate::size::{SizeError, check_dims};
 
 /// Summary statistics over the valid (non-nodata) samples.
@@ -39,8 +40,6 @@ pub struct FirstNodata {
     pub x: usize,
     pub y: usize,
 }
-
-use crate::georef::Georef;
 
 /// A row-major grid of heights in metres; row 0 is north, column 0 is west.
 #[derive(Debug, Clone, PartialEq)]
