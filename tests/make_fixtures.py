@@ -6,9 +6,10 @@ after changing this script and commit the bytes):
   and compressed TIFF, big-endian GeoTIFF in degrees, legacy Terragen, ESRI
   grids with centre corners and CRLF), read by tests/io/formats.rs;
 - tests/malformed/: broken files of every format, one folder per format
-  (tests/malformed/<format>/), plus expected.json, the error variant and
-  message substring each must produce (tests/io/malformed.rs). Some are
-  cut from tests/golden/, so bless the golden files first.
+  (tests/malformed/<format>/; the TIFFs a subfolder per what they break,
+  tiff/<group>/), plus expected.json, the error variant and message
+  substring each must produce (tests/io/malformed.rs). Some are cut from
+  tests/golden/, so bless the golden files first.
 """
 import json
 import os
@@ -188,12 +189,29 @@ def exr_header(w, h, channels, compression=0):
 
 # ---------------------------------------------------------------- malformed
 
+# The broken TIFFs by what they break: the file's structure (header,
+# directories, data ranges), its samples (size, type, bands), its GeoTIFF
+# and GDAL tags; the LERC ones have tiff/lerc/.
+TIFF_GROUPS = {
+    name: group
+    for group, names in {
+        "structure": "bad_magic bad_version truncated bigtiff_far_ifd tag_past_end strip_cut",
+        "samples": "huge not_justified rgb i64 float16",
+        "geo": "bad_nodata bad_scale geocentric bad_geokeys odd_unit",
+    }.items()
+    for name in ("tiff_%s.tif" % n for n in names.split())
+}
+
+
 def malformed():
     cases = {}
 
     def case(name, data, variant, contains, names=None, sidecar=None):
-        # One folder per format (the name's prefix), LERC TIFFs in their own.
-        folder = "tiff/lerc" if name.startswith("tiff_lerc") else name.split("_")[0]
+        # One folder per format (the name's prefix); the TIFFs, the most
+        # numerous, in a subfolder per what they break (TIFF_GROUPS).
+        folder = name.split("_")[0]
+        if folder == "tiff":
+            folder = "tiff/lerc" if name.startswith("tiff_lerc") else "tiff/" + TIFF_GROUPS[name]
         directory = os.path.join(BAD, folder)
         os.makedirs(directory, exist_ok=True)
         put(directory, name, data)

@@ -27,7 +27,7 @@ pub fn run_target(format: Option<Format>, data: &[u8]) -> Option<Result<Heightfi
     match format {
         Some(f) => Some(io::decode(data, f, None, &ReadOptions::default())),
         None => {
-            // fuzz/fuzz_targets/sidecar.rs: first byte = sidecar length.
+            // fuzz/fuzz_targets/companions/sidecar.rs: first byte = sidecar length.
             let (&split, rest) = data.split_first()?;
             let (json, raw) = rest.split_at((split as usize).min(rest.len()));
             io::Sidecar::parse(json).ok()?;

@@ -35,7 +35,7 @@ fn info_and_convert_report_malformed_files() {
     assert_clean_failure(&out, "asc_bad_number.asc: line 7: invalid number \"1.2.3\"");
     let dir = tempfile::tempdir().unwrap();
     let target = dir.path().join("out.exr");
-    let bad = repo("tests/malformed/tiff/tiff_huge.tif");
+    let bad = repo("tests/malformed/tiff/samples/tiff_huge.tif");
     let out = terrasynth(&["convert", bad.to_str().unwrap(), target.to_str().unwrap()]);
     assert_clean_failure(&out, "100000x100000 is too large");
     assert_eq!(

@@ -91,7 +91,7 @@ fn the_cache_is_read_back_identically_and_damaged_entries_are_rebuilt() {
 
 #[test]
 fn fuzz_seeds_for_cache_entries_decode_or_are_refused() {
-    // As fuzz/fuzz_targets/patch_cache.rs, on every seed and every prefix
+    // As fuzz/fuzz_targets/caches/patch_cache.rs, on every seed and every prefix
     // and single-bit flip of it: no panic, and what decodes re-encodes.
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/patch_cache");
     let mut decoded = 0;

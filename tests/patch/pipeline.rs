@@ -176,7 +176,7 @@ fn fuzz_seeds_for_the_sketch_reader_are_handled() {
     let mut n = 0;
     for e in std::fs::read_dir(&dir).unwrap() {
         let data = std::fs::read(e.unwrap().path()).unwrap();
-        // As fuzz/fuzz_targets/sketch.rs: both readers, no panic; a sketch
+        // As fuzz/fuzz_targets/documents/sketch.rs: both readers, no panic; a sketch
         // that parses rasterises at a small size.
         if let Ok(s) = Sketch::from_json(&data, Path::new("seed")) {
             assert_eq!(s.raster(32, 32).len(), 32 * 32);

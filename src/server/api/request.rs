@@ -1,7 +1,7 @@
 //! Reading what a request carries: its JSON body (media type and size
 //! checked), query parameters, and the small bodies of the view and
 //! new-session endpoints. Pure functions apart from [`json_body`], fuzzed
-//! by `fuzz/fuzz_targets/editor_request.rs`; scene documents themselves
+//! by `fuzz/fuzz_targets/documents/editor_request.rs`; scene documents themselves
 //! go through [`crate::scene`]'s parser (its own fuzz target).
 
 use super::error::ApiError;
