@@ -35,6 +35,21 @@ pub struct Snapshot {
     last: Option<Heightfield>,
 }
 
+/// What the buffers of `$s`, a [`Session`] or a [`Snapshot`] (they hold
+/// the same ones, under the same names), hold in bytes: `bytes_of` them.
+macro_rules! state_bytes {
+    ($s:expr) => {
+        bytes_of(
+            &$s.controls,
+            &$s.blend,
+            &$s.frames,
+            &$s.guides,
+            &$s.pasted,
+            &$s.last,
+        )
+    };
+}
+
 impl Snapshot {
     /// The last frame's heights it holds.
     pub fn heightfield(&self) -> Option<&Heightfield> {
@@ -43,15 +58,7 @@ impl Snapshot {
 
     /// What its buffers hold, in bytes (estimated from their lengths).
     pub fn bytes(&self) -> usize {
-        let s = self;
-        bytes_of(
-            &s.controls,
-            &s.blend,
-            &s.frames,
-            &s.guides,
-            &s.pasted,
-            &s.last,
-        )
+        state_bytes!(self)
     }
 }
 
@@ -93,15 +100,7 @@ fn guide_bytes(g: &Guides) -> usize {
 impl Session<'_> {
     /// What a [`Session::snapshot`] would hold, in bytes, without taking it.
     pub fn snapshot_bytes(&self) -> usize {
-        let s = self;
-        bytes_of(
-            &s.controls,
-            &s.blend,
-            &s.frames,
-            &s.guides,
-            &s.pasted,
-            &s.last,
-        )
+        state_bytes!(self)
     }
 
     /// A copy of the session's state (the kept final states aside: they
