@@ -26,34 +26,27 @@ struct Embedded {
     names: &'static [u8],
 }
 
+/// The bytes of `data/exemplars/<$name><$suffix>`, compiled in.
+macro_rules! exemplar_file {
+    ($name:literal, $suffix:literal) => {
+        include_bytes!(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/data/exemplars/",
+            $name,
+            $suffix
+        ))
+    };
+}
+
+/// One exemplar's four files: heights, sidecar, type mask, type names.
 macro_rules! embed {
     ($name:literal) => {
         Embedded {
             name: $name,
-            dem: include_bytes!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/data/exemplars/",
-                $name,
-                ".png"
-            )),
-            sidecar: include_bytes!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/data/exemplars/",
-                $name,
-                ".json"
-            )),
-            mask: include_bytes!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/data/exemplars/",
-                $name,
-                "_types.png"
-            )),
-            names: include_bytes!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/data/exemplars/",
-                $name,
-                "_types.json"
-            )),
+            dem: exemplar_file!($name, ".png"),
+            sidecar: exemplar_file!($name, ".json"),
+            mask: exemplar_file!($name, "_types.png"),
+            names: exemplar_file!($name, "_types.json"),
         }
     };
 }
