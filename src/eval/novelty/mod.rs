@@ -155,10 +155,7 @@ pub fn copies(
     p: &Params,
 ) -> Result<Novelty, EvalError> {
     let s = prepare(synth, p)?;
-    let ex = exemplars
-        .iter()
-        .map(|e| prepare(e, p))
-        .collect::<Result<Vec<_>, _>>()?;
+    let ex = prepare_all(exemplars, p)?;
     let flat = flat_std(&ex, p);
     score(&s, &ex, flat, p, &|_, _, _| None)
 }
@@ -189,11 +186,7 @@ pub fn repetition(
     let flat = if exemplars.is_empty() {
         flat_std(std::slice::from_ref(&s), p)
     } else {
-        let ex = exemplars
-            .iter()
-            .map(|e| prepare(e, p))
-            .collect::<Result<Vec<_>, _>>()?;
-        flat_std(&ex, p)
+        flat_std(&prepare_all(exemplars, p)?, p)
     };
     let n = p.window / p.downsample;
     // A window must not match itself: positions whose window overlaps it
@@ -211,6 +204,11 @@ pub fn repetition(
     score(&s, std::slice::from_ref(&s), flat, p, &|at, _, o| {
         near(at, o)
     })
+}
+
+/// [`prepare`] of every one of `hfs`, in order.
+fn prepare_all(hfs: &[&Heightfield], p: &Params) -> Result<Vec<Grid>, EvalError> {
+    hfs.iter().map(|hf| prepare(hf, p)).collect()
 }
 
 /// A heightfield's averaged grid, checked: no nodata, at least one window.
