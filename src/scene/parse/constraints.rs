@@ -35,9 +35,10 @@ pub(super) fn points(d: &Doc, ids: &mut Vec<String>) -> R<Vec<PointSpec>> {
                 Range::closed(-360.0, 360.0, "-360..=360 degrees"),
                 0.0,
             )?;
+            let (v, vp) = r.field(o, path, "radius_px", "a radius in pixels")?;
             let radius_px = r.number(
-                r.required(o, path, "radius_px", "a radius in pixels")?,
-                &join(path, "radius_px"),
+                v,
+                &vp,
                 Range::above(0.0, MAX_REACH_PX, "0 < radius <= 4096 pixels"),
             )?;
             Ok(PointSpec {
@@ -73,30 +74,34 @@ pub(super) fn curves(d: &Doc, ids: &mut Vec<String>) -> R<Vec<CurveItem>> {
                 Some(v) => r.integer(v, &join(path, "smoothing"), 8)? as u32,
                 None => 2,
             };
+            let (v, vp) = r.field(o, path, "widgets", "an array of >= 1 widgets")?;
             let widgets = r.items(
-                Some(r.required(o, path, "widgets", "an array of >= 1 widgets")?),
-                &join(path, "widgets"),
+                Some(v),
+                &vp,
                 1,
                 "widgets",
                 &["at", "height_m", "slope_deg", "reach_px"],
                 |path, o| {
+                    let (v, vp) = r.field(o, path, "at", "a fraction of the arc length")?;
                     let at = r.number(
-                        r.required(o, path, "at", "a fraction of the arc length")?,
-                        &join(path, "at"),
+                        v,
+                        &vp,
                         Range::closed(0.0, 1.0, "0..=1 (fraction of the curve's arc length)"),
                     )?;
-                    let height_m = r.height(
-                        r.required(o, path, "height_m", "a height in metres")?,
-                        &join(path, "height_m"),
-                    )?;
+                    let (v, vp) = r.field(o, path, "height_m", "a height in metres")?;
+                    let height_m = r.height(v, &vp)?;
+                    let (v, vp) =
+                        r.field(o, path, "slope_deg", "[left, right] slopes in degrees")?;
                     let slope_deg = r.pair(
-                        r.required(o, path, "slope_deg", "[left, right] slopes in degrees")?,
-                        &join(path, "slope_deg"),
+                        v,
+                        &vp,
                         Range::closed(-MAX_SLOPE_DEG, MAX_SLOPE_DEG, "-85..=85 degrees"),
                     )?;
+                    let (v, vp) =
+                        r.field(o, path, "reach_px", "[left, right] reaches in pixels")?;
                     let reach_px = r.pair(
-                        r.required(o, path, "reach_px", "[left, right] reaches in pixels")?,
-                        &join(path, "reach_px"),
+                        v,
+                        &vp,
                         Range::above(0.0, MAX_REACH_PX, "0 < reach <= 4096 pixels"),
                     )?;
                     Ok(Widget {

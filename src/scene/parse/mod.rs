@@ -72,11 +72,8 @@ pub fn scene(bytes: &[u8], file: &Path) -> R<Scene> {
         )
     })?;
     let (fw, fh) = (size.0 as f64, size.1 as f64);
-    let seed = r.integer(
-        r.required(m, "$", "seed", "an integer seed in 0..=4294967295")?,
-        "seed",
-        u32::MAX as u64,
-    )? as u32;
+    let (v, vp) = r.field(m, "$", "seed", "an integer seed in 0..=4294967295")?;
+    let seed = r.integer(v, &vp, u32::MAX as u64)? as u32;
     let jitter = r.number_or(
         m,
         "$",
@@ -154,15 +151,10 @@ impl Doc<'_> {
     /// place (a point constraint, a junction height).
     fn height_at(&self, o: &Map<String, Value>, path: &str) -> R<(DVec2, f64)> {
         let r = self.r;
-        let at = r.xy(
-            r.required(o, path, "at", "[x, y] in pixels")?,
-            &join(path, "at"),
-            self.size,
-        )?;
-        let height_m = r.height(
-            r.required(o, path, "height_m", "a height in metres")?,
-            &join(path, "height_m"),
-        )?;
+        let (v, vp) = r.field(o, path, "at", "[x, y] in pixels")?;
+        let at = r.xy(v, &vp, self.size)?;
+        let (v, vp) = r.field(o, path, "height_m", "a height in metres")?;
+        let height_m = r.height(v, &vp)?;
         Ok((at, height_m))
     }
 }

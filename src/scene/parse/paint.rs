@@ -59,11 +59,8 @@ pub(super) fn types(d: &Doc) -> R<Option<TypePaint>> {
             }
             None
         } else {
-            let name = r.string(
-                r.required(o, path, "type", "a type name of the database")?,
-                &join(path, "type"),
-                "a type name",
-            )?;
+            let (v, vp) = r.field(o, path, "type", "a type name of the database")?;
+            let name = r.string(v, &vp, "a type name")?;
             Some(name.to_string())
         };
         Ok((name, r.stroke(o, path, d.size)?))
@@ -96,8 +93,7 @@ pub(super) fn pastes(d: &Doc, ids: &mut Vec<String>) -> R<Vec<PasteSpec>> {
         &["id", "source", "exemplar", "lasso", "to", "delta_m", "lift"],
         |path, o| {
             let id = r.id(o, path, path.to_string(), ids)?;
-            let sp = join(path, "source");
-            let sv = r.required(o, path, "source", "\"terrain\" or \"exemplar\"")?;
+            let (sv, sp) = r.field(o, path, "source", "\"terrain\" or \"exemplar\"")?;
             let source = match (sv.as_str(), o.get("exemplar")) {
                 (Some("terrain"), None) => PasteSource::Terrain,
                 (Some("terrain"), Some(e)) => {
@@ -126,11 +122,8 @@ pub(super) fn pastes(d: &Doc, ids: &mut Vec<String>) -> R<Vec<PasteSpec>> {
                 PasteSource::Exemplar(_) => (65535.0, 65535.0),
             };
             let lasso = r.points(o, path, "lasso", 3, "an array of >= 3 [x, y] points", bound)?;
-            let to = r.xy(
-                r.required(o, path, "to", "[x, y] in pixels")?,
-                &join(path, "to"),
-                d.size,
-            )?;
+            let (v, vp) = r.field(o, path, "to", "[x, y] in pixels")?;
+            let to = r.xy(v, &vp, d.size)?;
             let delta_m = match o.get("delta_m") {
                 Some(v) => r.height(v, &join(path, "delta_m"))?,
                 None => 0.0,

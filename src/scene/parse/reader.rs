@@ -106,6 +106,18 @@ impl Reader<'_> {
         })
     }
 
+    /// [`Reader::required`] with the field's path (`path.key`), which the
+    /// typed read of its value names in its errors.
+    pub(super) fn field<'v>(
+        &self,
+        m: &'v Map<String, Value>,
+        path: &str,
+        key: &str,
+        expected: &'static str,
+    ) -> R<(&'v Value, String)> {
+        Ok((self.required(m, path, key, expected)?, join(path, key)))
+    }
+
     pub(super) fn array<'v>(
         &self,
         v: &'v Value,
@@ -155,17 +167,12 @@ impl Reader<'_> {
         expected: &'static str,
         bound: (f64, f64),
     ) -> R<Vec<DVec2>> {
-        let kp = join(path, key);
-        self.array(
-            self.required(m, path, key, expected)?,
-            &kp,
-            min,
-            "[x, y] points",
-        )?
-        .iter()
-        .enumerate()
-        .map(|(k, p)| self.xy(p, &format!("{kp}[{k}]"), bound))
-        .collect()
+        let (v, kp) = self.field(m, path, key, expected)?;
+        self.array(v, &kp, min, "[x, y] points")?
+            .iter()
+            .enumerate()
+            .map(|(k, p)| self.xy(p, &format!("{kp}[{k}]"), bound))
+            .collect()
     }
 
     /// An optional number of `m`: `default` when `key` is absent, else
@@ -297,9 +304,10 @@ impl Reader<'_> {
 
     pub(super) fn stroke(&self, m: &Map<String, Value>, path: &str, size: (f64, f64)) -> R<Stroke> {
         let points = self.points(m, path, "points", 1, "an array of [x, y] points", size)?;
+        let (v, vp) = self.field(m, path, "radius_px", "a brush radius in pixels")?;
         let radius_px = self.number(
-            self.required(m, path, "radius_px", "a brush radius in pixels")?,
-            &join(path, "radius_px"),
+            v,
+            &vp,
             Range::above(0.0, 4096.0, "0 < radius <= 4096 pixels"),
         )?;
         Ok(Stroke { points, radius_px })

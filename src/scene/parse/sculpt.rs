@@ -18,24 +18,20 @@ pub(super) fn sculpt(d: &Doc) -> R<Vec<SculptSpec>> {
     ];
     d.items("sculpt", "sculpt strokes", &keys, |path, o| {
         let names = "\"raise\", \"lower\", \"smooth\", \"flatten\" or \"erode\"";
-        let bv = r.required(o, path, "brush", "a brush name")?;
+        let (bv, bp) = r.field(o, path, "brush", "a brush name")?;
         let brush = bv
             .as_str()
             .and_then(Brush::from_name)
-            .ok_or_else(|| r.invalid(&join(path, "brush"), bv, names))?;
+            .ok_or_else(|| r.invalid(&bp, bv, names))?;
         let s = r.stroke(o, path, d.size)?;
-        let sv = r.required(o, path, "strength", "the brush's strength")?;
+        let (sv, sp) = r.field(o, path, "strength", "the brush's strength")?;
         let strength = match brush.strength_in_metres() {
             true => r.number(
                 sv,
-                &join(path, "strength"),
+                &sp,
                 Range::above(0.0, MAX_ABS_HEIGHT_M, "0 < strength <= 20000 m"),
             )?,
-            false => r.number(
-                sv,
-                &join(path, "strength"),
-                Range::above(0.0, 1.0, "0 < strength <= 1"),
-            )?,
+            false => r.number(sv, &sp, Range::above(0.0, 1.0, "0 < strength <= 1"))?,
         };
         let falloff = r.number_or(o, path, "falloff", Range::closed(0.0, 1.0, "0..=1"), 0.5)?;
         let targets = match o.get("targets") {
@@ -57,8 +53,7 @@ pub(super) fn sculpt(d: &Doc) -> R<Vec<SculptSpec>> {
 
 fn grid(r: &Reader, v: &Value, path: &str) -> R<TargetGrid> {
     let o = r.object(v, path, &["at", "step_px", "size", "heights_m"])?;
-    let ap = join(path, "at");
-    let av = r.required(o, path, "at", "[x, y] of node (0, 0) in pixels")?;
+    let (av, ap) = r.field(o, path, "at", "[x, y] of node (0, 0) in pixels")?;
     let within = Range::closed(-70000.0, 70000.0, "-70000..=70000 pixels");
     let at = match av.as_array().map(|a| a.as_slice()) {
         Some([x, y]) => [
@@ -67,13 +62,9 @@ fn grid(r: &Reader, v: &Value, path: &str) -> R<TargetGrid> {
         ],
         _ => return Err(r.invalid(&ap, av, "[x, y] in pixels")),
     };
-    let step = r.number(
-        r.required(o, path, "step_px", "the node spacing in pixels")?,
-        &join(path, "step_px"),
-        Range::above(0.0, 256.0, "0 < step <= 256 pixels"),
-    )?;
-    let sp = join(path, "size");
-    let sv = r.required(o, path, "size", "[nodes across, nodes down]")?;
+    let (v, vp) = r.field(o, path, "step_px", "the node spacing in pixels")?;
+    let step = r.number(v, &vp, Range::above(0.0, 256.0, "0 < step <= 256 pixels"))?;
+    let (sv, sp) = r.field(o, path, "size", "[nodes across, nodes down]")?;
     let nodes = |v: &Value| v.as_u64().filter(|&n| n >= 1).map(|n| n as usize);
     let size = match sv.as_array().map(|a| a.as_slice()) {
         Some([w, h]) => nodes(w).zip(nodes(h)),
@@ -81,8 +72,7 @@ fn grid(r: &Reader, v: &Value, path: &str) -> R<TargetGrid> {
     }
     .filter(|(w, h)| w.saturating_mul(*h) <= MAX_NODES)
     .ok_or_else(|| r.invalid(&sp, sv, "[w, h], each >= 1, w·h <= 1000000"))?;
-    let hp = join(path, "heights_m");
-    let hv = r.required(o, path, "heights_m", "the node heights in metres")?;
+    let (hv, hp) = r.field(o, path, "heights_m", "the node heights in metres")?;
     let heights = match hv.as_array() {
         Some(a) if a.len() == size.0 * size.1 => a,
         _ => {
