@@ -21,8 +21,8 @@ pub(super) const REACH_PER_SUBPASS: usize = 2;
 #[derive(Default)]
 pub struct Frames {
     /// Per level, per pass (read with [`Frames::levels`]: crate code that
-    /// changes them also clears [`Frames::states`], which outside code
-    /// could not).
+    /// changes them also clears [`Frames::states`] or writes the same into
+    /// them, which outside code could not).
     pub(crate) levels: Vec<Vec<PassResult>>,
     /// Level 0's fixed-point heights (stage `reconstruct`'s output), which
     /// an edit's re-synthesis recomputes only where S and V can change;
@@ -34,7 +34,7 @@ pub struct Frames {
     /// its window into it instead of building the level's state afresh
     /// from that result (at 1024² a 12 MB copy into new pages per edit,
     /// ~14 % of an edit's CPU time). Code that changes [`Frames::levels`]
-    /// clears it.
+    /// clears it or writes the same into it.
     pub(crate) states: Vec<Option<State>>,
 }
 
