@@ -46,6 +46,15 @@ impl Clone for Frames {
             states: Vec::new(),
         }
     }
+
+    /// Into `self`'s buffers where they are large enough (an editor's
+    /// recycled [`crate::synth::session::Snapshot`]): a copy without
+    /// allocating or faulting in new pages.
+    fn clone_from(&mut self, source: &Frames) {
+        self.levels.clone_from(&source.levels);
+        self.heights.clone_from(&source.heights);
+        self.states.clear();
+    }
 }
 
 impl PartialEq for Frames {
@@ -85,10 +94,25 @@ impl Frames {
 }
 
 /// One level's S and V after one pass.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct PassResult {
     pub coords: Vec<Coord>,
     pub offsets: Vec<i32>,
+}
+
+impl Clone for PassResult {
+    fn clone(&self) -> PassResult {
+        PassResult {
+            coords: self.coords.clone(),
+            offsets: self.offsets.clone(),
+        }
+    }
+
+    /// Into `self`'s buffers (see [`Frames`]' `clone_from`).
+    fn clone_from(&mut self, source: &PassResult) {
+        self.coords.clone_from(&source.coords);
+        self.offsets.clone_from(&source.offsets);
+    }
 }
 
 /// The union of two optional bounds.
