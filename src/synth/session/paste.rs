@@ -104,12 +104,12 @@ impl Session<'_> {
             let shift = |o: i64| o.div_euclid(1 << level);
             let (ox, oy) = (shift(p.offset.0), shift(p.offset.1));
             let atlas = AtlasLevel::new(db, level);
-            let in_mask = |u: i64, v: i64| {
-                u >= 0
-                    && v >= 0
-                    && u < sw as i64
-                    && v < sh as i64
-                    && mask[v as usize * sw + u as usize]
+            // The pixels of the bounds no seam reaches (ground pastes):
+            // `lift::near_seam`, negated, of all of them at once.
+            let bw = b[2] - b[0];
+            let clear = match p.lift {
+                Lift::Ground => interior(&mask, sw, b, lift::seam_reach(level)),
+                Lift::Source => Vec::new(),
             };
             // Read every source value first: source and target may overlap.
             let mut writes = Vec::new();
@@ -138,7 +138,7 @@ impl Session<'_> {
                     }
                 };
                 let (x, y) = (x as usize, y as usize);
-                if p.lift == Lift::Ground && lift::near_seam(level, x, y, in_mask) {
+                if p.lift == Lift::Ground && !clear[(y - b[1]) * bw + x - b[0]] {
                     let ground = passes.last().map(|r| (r.coords[t], r.offsets[t]));
                     if let Some(g) = ground {
                         lift::seam(&atlas, &mut values, g, p.depth(level, x, y));
@@ -203,6 +203,29 @@ fn lasso_bounds(lasso: &[(f64, f64)], w: usize, h: usize) -> [usize; 4] {
     [lo(x0, w), lo(y0, h), hi(x1, w), hi(y1, h)]
 }
 
+/// Per pixel of `b` (row-major, `b`'s width): whether every pixel within
+/// `r` (Chebyshev) is set in `mask` (`sw` wide, set only inside `b`; a
+/// pixel beyond the grid is not set) — [`lift::near_seam`]'s test,
+/// negated, for all pixels at once: its square search per pixel took
+/// ~5 ms of a 1024² paste. Separable, like [`near_fresh`].
+fn interior(mask: &[bool], sw: usize, b: [usize; 4], r: usize) -> Vec<bool> {
+    let (bw, bh) = (b[2] - b[0], b[3] - b[1]);
+    let mut rows = vec![false; bw * bh];
+    for y in 0..bh {
+        let row = &mask[(b[1] + y) * sw + b[0]..][..bw];
+        for x in r..bw.saturating_sub(r) {
+            rows[y * bw + x] = row[x - r..=x + r].iter().all(|&m| m);
+        }
+    }
+    let mut out = vec![false; bw * bh];
+    for y in r..bh.saturating_sub(r) {
+        for x in 0..bw {
+            out[y * bw + x] = (y - r..=y + r).all(|v| rows[v * bw + x]);
+        }
+    }
+    out
+}
+
 /// The pixels (indices) of a `w × h` grid within `m` pixels (Chebyshev
 /// distance) of a set pixel of `fresh`, whose set pixels lie in `bounds`
 /// (none beyond `bounds` widened by `m` is near one). The square is
@@ -257,6 +280,28 @@ mod tests {
             })
             .collect();
         assert_eq!(got, want);
+    }
+
+    #[test]
+    fn interior_negates_near_seam() {
+        let lasso = [(3.2, 4.0), (20.7, 5.5), (11.0, 15.9), (6.5, 9.0)];
+        let (sw, sh) = (24, 18);
+        let b = lasso_bounds(&lasso, sw, sh);
+        let mask: Vec<bool> = (0..sw * sh)
+            .map(|k| inside(&lasso, (k % sw) as f64 + 0.5, (k / sw) as f64 + 0.5))
+            .collect();
+        let in_mask = |u: i64, v: i64| {
+            u >= 0 && v >= 0 && u < sw as i64 && v < sh as i64 && mask[v as usize * sw + u as usize]
+        };
+        for level in 0..3 {
+            let inner = interior(&mask, sw, b, lift::seam_reach(level));
+            for y in b[1]..b[3] {
+                for x in b[0]..b[2] {
+                    let got = !inner[(y - b[1]) * (b[2] - b[0]) + x - b[0]];
+                    assert_eq!(got, lift::near_seam(level, x, y, in_mask), "({x}, {y})");
+                }
+            }
+        }
     }
 
     #[test]
