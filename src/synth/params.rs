@@ -140,7 +140,7 @@ pub struct Synthesis {
 
 /// Control inputs of one synthesis, per level (index = level; levels the
 /// correction never visits are ignored).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct Guides {
     pub levels: Vec<LevelGuide>,
     /// Re-synthesize only where this frame can differ from the previous
@@ -155,7 +155,7 @@ pub struct Guides {
 }
 
 /// One level's control rasters (level-sized, row-major).
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct LevelGuide {
     /// Geometric targets (every level: see `control::blend`).
     pub targets: Option<Vec<Target>>,
@@ -167,4 +167,39 @@ pub struct LevelGuide {
     /// type sets, raised weights, pasted candidates) differ from the
     /// previous frame's; None if none do. Used when [`Guides::restrict`].
     pub dirty: Option<[usize; 4]>,
+}
+
+/// Clones that can reuse the target's buffers (`clone_from`): an editor
+/// refills a recycled [`crate::synth::session::Snapshot`] without
+/// allocating or faulting in new pages.
+impl Clone for Guides {
+    fn clone(&self) -> Guides {
+        Guides {
+            levels: self.levels.clone(),
+            restrict: self.restrict,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Guides) {
+        self.levels.clone_from(&source.levels);
+        self.restrict = source.restrict;
+    }
+}
+
+impl Clone for LevelGuide {
+    fn clone(&self) -> LevelGuide {
+        LevelGuide {
+            targets: self.targets.clone(),
+            allowed: self.allowed.clone(),
+            weights: self.weights.clone(),
+            dirty: self.dirty,
+        }
+    }
+
+    fn clone_from(&mut self, source: &LevelGuide) {
+        self.targets.clone_from(&source.targets);
+        self.allowed.clone_from(&source.allowed);
+        self.weights.clone_from(&source.weights);
+        self.dirty = source.dirty;
+    }
 }

@@ -21,8 +21,8 @@ pub(super) const REACH_PER_SUBPASS: usize = 2;
 #[derive(Default)]
 pub struct Frames {
     /// Per level, per pass (read with [`Frames::levels`]: crate code that
-    /// changes them also clears [`Frames::states`], which outside code
-    /// could not).
+    /// changes them also clears [`Frames::states`] or writes the same into
+    /// them, which outside code could not).
     pub(crate) levels: Vec<Vec<PassResult>>,
     /// Level 0's fixed-point heights (stage `reconstruct`'s output), which
     /// an edit's re-synthesis recomputes only where S and V can change;
@@ -34,7 +34,7 @@ pub struct Frames {
     /// its window into it instead of building the level's state afresh
     /// from that result (at 1024² a 12 MB copy into new pages per edit,
     /// ~14 % of an edit's CPU time). Code that changes [`Frames::levels`]
-    /// clears it.
+    /// clears it or writes the same into it.
     pub(crate) states: Vec<Option<State>>,
 }
 
@@ -45,6 +45,15 @@ impl Clone for Frames {
             heights: self.heights.clone(),
             states: Vec::new(),
         }
+    }
+
+    /// Into `self`'s buffers where they are large enough (an editor's
+    /// recycled [`crate::synth::session::Snapshot`]): a copy without
+    /// allocating or faulting in new pages.
+    fn clone_from(&mut self, source: &Frames) {
+        self.levels.clone_from(&source.levels);
+        self.heights.clone_from(&source.heights);
+        self.states.clear();
     }
 }
 
@@ -85,10 +94,25 @@ impl Frames {
 }
 
 /// One level's S and V after one pass.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 pub struct PassResult {
     pub coords: Vec<Coord>,
     pub offsets: Vec<i32>,
+}
+
+impl Clone for PassResult {
+    fn clone(&self) -> PassResult {
+        PassResult {
+            coords: self.coords.clone(),
+            offsets: self.offsets.clone(),
+        }
+    }
+
+    /// Into `self`'s buffers (see [`Frames`]' `clone_from`).
+    fn clone_from(&mut self, source: &PassResult) {
+        self.coords.clone_from(&source.coords);
+        self.offsets.clone_from(&source.offsets);
+    }
 }
 
 /// The union of two optional bounds.

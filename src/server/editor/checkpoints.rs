@@ -45,14 +45,21 @@ impl Checkpoint {
         state: Snapshot,
         heightfield: Arc<Heightfield>,
     ) -> Checkpoint {
-        let rasters = edits.type_raster().map_or(0, <[u8]>::len);
         Checkpoint {
-            bytes: state.bytes() + rasters + size_of::<Checkpoint>(),
+            bytes: Checkpoint::bytes_for(state.bytes(), &edits),
             scene,
             edits,
             state,
             heightfield,
         }
+    }
+}
+
+impl Checkpoint {
+    /// What [`Checkpoints`] counts for a checkpoint whose state holds
+    /// `state` bytes ([`Snapshot::bytes`]).
+    pub fn bytes_for(state: usize, edits: &SceneEdits) -> usize {
+        state + edits.type_raster().map_or(0, <[u8]>::len) + size_of::<Checkpoint>()
     }
 }
 
@@ -77,6 +84,19 @@ impl Checkpoints {
                 self.bytes -= old.bytes;
             }
         }
+    }
+
+    /// Takes the oldest state when keeping one more of `bytes` (as
+    /// [`Checkpoint::bytes_for`] counts) would drop it: its buffers can take
+    /// the new state's copy ([`crate::synth::session::Session::snapshot_into`]).
+    pub fn recycle(&mut self, bytes: usize) -> Option<Snapshot> {
+        let full = self.kept.len() >= MAX_KEPT || self.bytes + bytes > MAX_BYTES;
+        if !full || bytes > MAX_BYTES {
+            return None;
+        }
+        let old = self.kept.pop_front()?;
+        self.bytes -= old.bytes;
+        Some(old.state)
     }
 
     /// Takes the newest state that has exactly `scene`'s pastes and of

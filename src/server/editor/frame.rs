@@ -259,10 +259,20 @@ impl Editor {
         if bytes > MAX_BYTES || short {
             return;
         }
+        let state = match self
+            .checkpoints
+            .recycle(Checkpoint::bytes_for(bytes, &self.edits))
+        {
+            Some(mut s) => {
+                self.session.snapshot_into(&mut s);
+                s
+            }
+            None => self.session.snapshot(),
+        };
         self.checkpoints.push(Checkpoint::new(
             self.scene.clone(),
             self.edits.clone(),
-            self.session.snapshot(),
+            state,
             self.heightfield.clone(),
         ));
     }

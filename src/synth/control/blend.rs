@@ -131,7 +131,7 @@ struct Sums {
 
 /// Running sums of one level, over its pixels `[x0, x0 + width) ×
 /// [y0, y0 + height)` (the whole level, or a window's cone region).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 struct LevelSums {
     x0: usize,
     y0: usize,
@@ -150,6 +150,26 @@ struct LevelSums {
     touched: Option<[usize; 4]>,
 }
 
+impl Clone for LevelSums {
+    fn clone(&self) -> LevelSums {
+        let mut c = LevelSums {
+            sums: Vec::new(),
+            ..*self
+        };
+        c.sums.clone_from(&self.sums);
+        c
+    }
+
+    /// Into `self`'s sums (see [`Blend`]'s `clone_from`).
+    fn clone_from(&mut self, source: &LevelSums) {
+        self.sums.clone_from(&source.sums);
+        *self = LevelSums {
+            sums: std::mem::take(&mut self.sums),
+            ..*source
+        };
+    }
+}
+
 impl PartialEq for LevelSums {
     /// Equal sums, an unallocated level counting as all zero.
     fn eq(&self, other: &LevelSums) -> bool {
@@ -165,11 +185,28 @@ impl PartialEq for LevelSums {
 }
 
 /// The overlap blend of all geometric constraints of one output size.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Blend {
     q: Quantization,
     /// Index = level.
     levels: Vec<LevelSums>,
+}
+
+impl Clone for Blend {
+    fn clone(&self) -> Blend {
+        Blend {
+            q: self.q,
+            levels: self.levels.clone(),
+        }
+    }
+
+    /// Into `self`'s buffers where they are large enough (an editor's
+    /// recycled [`crate::synth::session::Snapshot`]: level 0's sums are
+    /// 24 MB at 1024²), without allocating or faulting in new pages.
+    fn clone_from(&mut self, source: &Blend) {
+        self.q = source.q;
+        self.levels.clone_from(&source.levels);
+    }
 }
 
 impl Blend {

@@ -103,11 +103,17 @@ pub fn seam(atlas: &AtlasLevel<'_>, values: &mut [(Coord, i32)], ground: (Coord,
     values.iter_mut().for_each(|v| v.1 += step);
 }
 
+/// How far (level-`level` pixels, Chebyshev) [`near_seam`] looks for a
+/// pixel not written.
+pub fn seam_reach(level: usize) -> usize {
+    (SEAM / (1u64 << level) as f64).ceil() as usize + 1
+}
+
 /// Whether level-`level` source pixel (x, y) may lie in the seam: some
 /// pixel within `SEAM` output px (and one more pixel) is not written
 /// (`writes`). A cheap test before the exact distance to the lasso.
 pub fn near_seam(level: usize, x: usize, y: usize, writes: impl Fn(i64, i64) -> bool) -> bool {
-    let r = (SEAM / (1u64 << level) as f64).ceil() as i64 + 1;
+    let r = seam_reach(level) as i64;
     let (x, y) = (x as i64, y as i64);
     (-r..=r).any(|dy| (-r..=r).any(|dx| !writes(x + dx, y + dy)))
 }
