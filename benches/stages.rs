@@ -87,7 +87,8 @@ fn inputs() -> Inputs {
     let preview = render::prepare(&out.heightfield, &RenderOptions::default()).unwrap();
 
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/exemplars");
-    let mask = TypeMask::read(&data.join("catalan_coast_hills_types.png")).unwrap();
+    let mask =
+        TypeMask::read(&data.join("catalan_coast_hills/catalan_coast_hills_types.png")).unwrap();
     let last = mask.indices.iter().filter(|&&t| t != UNCONSTRAINED).max();
     let full = (1u32 << last.map_or(1, |&t| t as u32 + 1)) - 1;
     let types = mask
@@ -111,7 +112,11 @@ fn inputs() -> Inputs {
         })
         .collect();
 
-    let hf = terrasynth::io::read(&data.join("pyrenees_andorra.png"), &Default::default()).unwrap();
+    let hf = terrasynth::io::read(
+        &data.join("pyrenees_andorra/pyrenees_andorra.png"),
+        &Default::default(),
+    )
+    .unwrap();
     let patch = terrasynth::patch::Params::default();
     let src = PreparedSource::prepare("pyrenees_andorra", &hf, &patch, 1.0).unwrap();
     let m = patch.patch / COARSE;

@@ -1,6 +1,6 @@
 //! The embedded default database: four 512² crops of real SRTM DEMs in
-//! `data/exemplars/` (a coast, a plain, high mountains, rolling hills; sources and
-//! credits in `data/CREDITS.md`) with their type masks (sea, flat, hills,
+//! `data/exemplars/`, a folder each (a coast, a plain, high mountains,
+//! rolling hills; sources and credits in `data/CREDITS.md`) with their type masks (sea, flat, hills,
 //! mountains), compiled into the binary so that `terrasynth synth` works on
 //! a fresh machine with no files. They are real terrain rather than the
 //! crate's own procedural styles (`terrasynth generate`) because the first
@@ -26,12 +26,14 @@ struct Embedded {
     names: &'static [u8],
 }
 
-/// The bytes of `data/exemplars/<$name><$suffix>`, compiled in.
+/// The bytes of `data/exemplars/<$name>/<$name><$suffix>`, compiled in.
 macro_rules! exemplar_file {
     ($name:literal, $suffix:literal) => {
         include_bytes!(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/data/exemplars/",
+            $name,
+            "/",
             $name,
             $suffix
         ))

@@ -217,7 +217,9 @@ fn a_closed_stdout_ends_a_command_without_a_panic() {
     let out = Command::new(env!("CARGO_BIN_EXE_terrasynth"))
         .args([
             "info",
-            repo("data/exemplars/thuringia_hills.png").to_str().unwrap(),
+            repo("data/exemplars/thuringia_hills/thuringia_hills.png")
+                .to_str()
+                .unwrap(),
         ])
         .stdout(writer)
         .stderr(std::process::Stdio::piped())
@@ -252,7 +254,7 @@ fn png8(path: &Path) -> (u32, u32, usize, Vec<u8>) {
 fn masks_for_an_engine_are_at_its_size_in_its_layout() {
     use terrasynth::io::engine::{self, Engine};
     use terrasynth::masks;
-    let dem = repo("data/exemplars/pyrenees_andorra.png");
+    let dem = repo("data/exemplars/pyrenees_andorra/pyrenees_andorra.png");
     let hf = terrasynth::io::read(&dem, &Default::default()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     for (e, side) in [(Engine::Unreal, 1009u32), (Engine::Unity, 513)] {
