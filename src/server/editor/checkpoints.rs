@@ -53,9 +53,7 @@ impl Checkpoint {
             heightfield,
         }
     }
-}
 
-impl Checkpoint {
     /// What [`Checkpoints`] counts for a checkpoint whose state holds
     /// `state` bytes ([`Snapshot::bytes`]).
     pub fn bytes_for(state: usize, edits: &SceneEdits) -> usize {

@@ -187,17 +187,12 @@ fn lasso_bounds(lasso: &[(f64, f64)], w: usize, h: usize) -> [usize; 4] {
     if lasso.iter().any(|&(x, y)| !x.is_finite() || !y.is_finite()) {
         return [0, 0, w, h];
     }
-    let fold = |f: fn(f64, f64) -> f64, init: f64, v: fn(&(f64, f64)) -> f64| {
-        lasso.iter().map(v).fold(init, f)
-    };
-    let (x0, x1) = (
-        fold(f64::min, f64::INFINITY, |p| p.0),
-        fold(f64::max, f64::NEG_INFINITY, |p| p.0),
-    );
-    let (y0, y1) = (
-        fold(f64::min, f64::INFINITY, |p| p.1),
-        fold(f64::max, f64::NEG_INFINITY, |p| p.1),
-    );
+    let (mut x0, mut y0) = (f64::INFINITY, f64::INFINITY);
+    let (mut x1, mut y1) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for &(x, y) in lasso {
+        (x0, x1) = (x0.min(x), x1.max(x));
+        (y0, y1) = (y0.min(y), y1.max(y));
+    }
     let lo = |v: f64, n: usize| ((v - 1.5).floor().max(0.0) as usize).min(n);
     let hi = |v: f64, n: usize| ((v + 1.5).ceil().max(0.0) as usize).min(n);
     [lo(x0, w), lo(y0, h), hi(x1, w), hi(y1, h)]
