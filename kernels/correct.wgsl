@@ -81,9 +81,11 @@ struct GuideCell {
 // The parent level's offsets V (a placeholder when has_parent is 0).
 @group(0) @binding(8) var<storage, read> parent_v: array<i32>;
 
-// The pixel's Prior::v (set once per invocation in `main`; every score of
-// the pixel reads it, like the `prior` argument of the Rust scores).
+// The pixel's Prior::v and Prior::held (set once per invocation in `main`;
+// every score of the pixel reads them, like the `prior` argument of the
+// Rust scores).
 var<private> prior_v: i32;
+var<private> prior_held: bool;
 
 // correct::parent_v: the parent's V at child (x, y), bilinear (9, 3, 3, 1
 // of 16 from the parent under it and the three nearest, clamped at the
@@ -104,7 +106,7 @@ fn parent_offset(x: u32, y: u32) -> i32 {
         + parent_v[qy * w + qx] + 8) >> 4u;
 }
 
-// correct::{W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight};
+// correct::{W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight, FLAT_FIT.weight};
 // types::SEEDS_PER_TYPE; nudge::MAX_ERROR.
 const W_FREE: u32 = 4u;
 const SEEDS_PER_ALLOWED_TYPE: u32 = 9u;
@@ -112,6 +114,7 @@ const SEED_SALT: u32 = 2120089600u;
 const SEEDS_PER_TYPE: u32 = 64u;
 const MAX_ERROR: i32 = 16777216;
 const FLAT_WEIGHT: i32 = 8;
+const FLAT_FIT_WEIGHT: i32 = 44;
 
 // correct::CLAMP.
 const CLAMP: i32 = 9459;
@@ -190,16 +193,23 @@ fn score_with(ns: Hood, qx: i32, qy: i32, kappa: u32, fixed: bool, fixed_h: i32)
     let d2 = ns.c - 3 * m2;
     let d3 = ns.d - 3 * m3;
     let sum1 = d0.x + d1.x + d2.x + d3.x;
-    // Prior::for_candidate: flat candidates take FLAT (weight 8 towards 0).
+    // Prior::is_flat and Prior::fit: a flat candidate's offset is fitted
+    // with FLAT_FIT's weight (FLAT's where a constraint holds the pixel)
+    // and priced with FLAT's, towards 0.
     var w = i32(p.prior);
+    var fit_w = w;
     var anchor = prior_v;
     if (w > 0 && m0.x == m1.x && m0.x == m2.x && m0.x == m3.x) {
         w = FLAT_WEIGHT;
+        fit_w = FLAT_FIT_WEIGHT;
+        if (prior_held) {
+            fit_w = FLAT_WEIGHT;
+        }
         anchor = 0;
     }
     // Prior::optimal and Prior::cost.
-    let den = 12 + 3 * w;
-    var h = div_floor(sum1 + 3 * w * anchor + den / 2, den);
+    let den = 12 + 3 * fit_w;
+    var h = div_floor(sum1 + 3 * fit_w * anchor + den / 2, den);
     if (fixed) {
         h = fixed_h;
     }
@@ -455,6 +465,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (p.has_parent != 0u) {
         prior_v = parent_offset(ux, uy);
     }
+    prior_held = (p.flags & F_TARGETS) != 0u && guide[uy * p.width + ux].blend_target.y >= 0;
 
     let ns = Hood(
         diagonal(x, y, -1, -1),

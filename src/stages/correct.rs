@@ -30,12 +30,28 @@
 //! form becomes `h = ⌊(Σ d₁ + 3P·V_parent + ⌊(12 + 3P)/2⌋) / (12 + 3P)⌋`.
 //!
 //! **Flat candidates** (the four diagonal texels at one height: the sea, a
-//! lake, a salt flat) take the prior [`FLAT`] instead: weight 8 towards
-//! offset 0, i.e. towards their own altitude. A flat candidate fits any
-//! height equally well, so next to land it was lifted to the land's mean,
-//! and the parent anchor carried that lift down level after level: on the
-//! coastal DEMs the sea came out as a green plain 5–130 m up (median +41 m
-//! on riviera). Its own altitude is the one thing a flat texel knows. (P = 0
+//! lake, a salt flat) keep close to their own altitude: their offset is
+//! fitted as if their prior weighed 44 towards offset 0 ([`FLAT_FIT`]), a
+//! twelfth of the free fit's lift, and priced at weight 8 ([`FLAT`]). A
+//! flat candidate fits any height equally well, so next to land it was
+//! lifted to the land's mean, and the parent anchor carried that lift down
+//! level after level: on the coastal DEMs the sea came out as a green plain
+//! 5–130 m up (median +41 m on riviera). With weight 8 for both (the most
+//! the u32 score bound allows for the price, see [`CLAMP`]) the sea beside
+//! the shore still rose by a third of the land's height above it, a ramp
+//! all along every coast that took 2.5–5 points of sea from the coastal
+//! DEMs (olympic: 22 % sea, exemplar 25 %), made their median slope
+//! 111–123 % of the exemplar's, and gave catalan most of its copied
+//! windows (shore ramps are alike everywhere: 9 %, its halves 4 %). Taken
+//! exactly at its own altitude (offset 0), the sea kept its share but its
+//! shores froze where the start put them: straight, axis-aligned cliffs
+//! 100–150 px long. A twelfth keeps the shore mobile and the sea at sea
+//! level (seeds 11–13, exemplar size: median slope olympic 123 → 116 %,
+//! riviera 120 → 113 %, catalan 107 → 106 % with 9 → 7 % of its windows
+//! copied). Where a geometric constraint reaches ([`Prior::held`]) the fit
+//! keeps [`FLAT`]'s weight: at a twelfth, a point raised over the sea got
+//! a third of its height less and the slope around it flattened (the
+//! 576-px exemplars' point test: least slope 10.5°, 12° asked). (P = 0
 //! keeps the paper's rule for every candidate.)
 //!
 //! Integer arithmetic (DESIGN §6), identical in the WGSL mirror:
@@ -200,13 +216,18 @@ impl<'a> ParentRow<'a> {
 pub struct Prior {
     pub weight: u32,
     pub v: i32,
+    /// Whether a geometric constraint reaches the pixel (its target's
+    /// tolerance ≥ 0): there a flat candidate is fitted with [`FLAT`]'s
+    /// weight, not [`FLAT_FIT`]'s, so the sea can still be lifted (or
+    /// lowered) to a constraint's target.
+    pub held: bool,
 }
 
 impl Prior {
     /// The prior of pixel (x, y) under `parent` (the level above; none at
     /// the coarsest corrected level, whose start has V = 0).
     #[inline(always)]
-    pub fn at(weight: u32, parent: Option<&State>, x: usize, y: usize) -> Prior {
+    pub fn at(weight: u32, parent: Option<&State>, x: usize, y: usize, held: bool) -> Prior {
         // A `match`, not `Option::map_or`: the profile found `map_or` left
         // out of line in the SIMD span (a call per pixel, 3.7 % of the
         // time at 1024²).
@@ -214,7 +235,7 @@ impl Prior {
             Some(pa) => parent_v(pa, x, y),
             None => 0,
         };
-        Prior { weight, v }
+        Prior { weight, v, held }
     }
 
     /// The optimal offset for `sum1 = Σ_δ d₁(δ)` (nearest, ties up).
@@ -232,21 +253,43 @@ impl Prior {
     }
 }
 
-/// The prior of flat candidates (module docs): weight 8 (the most the u32
-/// score bound allows, see [`CLAMP`]; 2 and 4 left dimples in the sea:
-/// pits ×2.6–15 on riviera) towards offset 0.
-pub const FLAT: Prior = Prior { weight: 8, v: 0 };
+/// The prior that prices a flat candidate's offset (module docs): weight 8
+/// towards offset 0, the most the u32 score bound allows (see [`CLAMP`]);
+/// 2 and 4 left dimples in the sea (pits ×2.6–15 on riviera).
+pub const FLAT: Prior = Prior {
+    weight: 8,
+    v: 0,
+    held: false,
+};
+
+/// The prior a flat candidate's offset is fitted with (module docs): as if
+/// weighing 44, a twelfth of the free fit's lift (Σ d₁ / 144 where the free
+/// fit is Σ d₁ / 12), where [`FLAT`]'s 8 gave a third. Only the fit: its
+/// cost is [`FLAT`]'s, which the score bound caps.
+pub const FLAT_FIT: Prior = Prior {
+    weight: 44,
+    v: 0,
+    held: false,
+};
 
 impl Prior {
-    /// The prior that scores a candidate whose four diagonal texels have
-    /// mode-1 heights `m`: [`FLAT`] when they are all equal (and the stage
-    /// has a prior at all), else `self`.
+    /// Whether a candidate whose four diagonal texels have mode-1 heights
+    /// `m` is flat: all four equal, and the stage has a prior at all.
     #[inline(always)]
-    pub fn for_candidate(self, m: [i32; 4]) -> Prior {
-        if self.weight > 0 && m[0] == m[1] && m[0] == m[2] && m[0] == m[3] {
-            FLAT
+    pub fn is_flat(self, m: [i32; 4]) -> bool {
+        self.weight > 0 && m[0] == m[1] && m[0] == m[2] && m[0] == m[3]
+    }
+
+    /// The prior that scores a candidate (`flat` from [`Prior::is_flat`])
+    /// and its offset: the one `fixed` by a constraint, else the closed
+    /// form [`Prior::optimal`] — [`FLAT_FIT`]'s for a flat candidate.
+    #[inline(always)]
+    pub fn fit(self, flat: bool, fixed: Option<i32>, sum1: i32) -> (Prior, i32) {
+        if flat {
+            let fit = if self.held { FLAT } else { FLAT_FIT };
+            (FLAT, fixed.unwrap_or_else(|| fit.optimal(sum1)))
         } else {
-            self
+            (self, fixed.unwrap_or_else(|| self.optimal(sum1)))
         }
     }
 }

@@ -349,7 +349,7 @@ fn correct_constants_match() {
     use terrasynth::database::types::SEEDS_PER_TYPE;
     use terrasynth::stages::correct::nudge::MAX_ERROR;
     use terrasynth::stages::correct::{
-        CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, SEED_SALT,
+        CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, FLAT_FIT, SEED_SALT,
         SEEDS_PER_ALLOWED_TYPE, W_FREE,
     };
     let src = Stage::Correct.wgsl();
@@ -370,6 +370,7 @@ fn correct_constants_match() {
     for (name, v) in [
         ("MAX_ERROR", MAX_ERROR),
         ("FLAT_WEIGHT", FLAT.weight as i32),
+        ("FLAT_FIT_WEIGHT", FLAT_FIT.weight as i32),
     ] {
         assert!(
             src.contains(&format!("const {name}: i32 = {v};")),

@@ -77,8 +77,7 @@ fn score_with(
         heights[k] = m[0] as i32;
         sum1 += d[k][0];
     }
-    let prior = prior.for_candidate(heights);
-    let h = fixed.unwrap_or_else(|| prior.optimal(sum1));
+    let (prior, h) = prior.fit(prior.is_flat(heights), fixed, sum1);
     let mut s = prior.cost(h);
     for dk in &d {
         let r1 = (dk[0] - 3 * h).clamp(-CLAMP, CLAMP);
@@ -299,7 +298,8 @@ pub fn correct_guided(
         .filter(|&y| y >= y0)
         .for_each(|y| {
             for x in (p.px as usize..x1.min(w)).step_by(2).filter(|&x| x >= x0) {
-                let prior = Prior::at(p.prior, parent, x, y);
+                let held = g.targets.is_some_and(|t| t[y * w + x].tol >= 0);
+                let prior = Prior::at(p.prior, parent, x, y, held);
                 let at = (x as i32, y as i32);
                 let (s, v) = correct_pixel_guided(atlas, st, at, p.similar, g, prior);
                 st.set(y * w + x, s, v);

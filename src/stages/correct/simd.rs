@@ -258,6 +258,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
             let prior = Prior {
                 weight: P,
                 v: anchors[k],
+                held: g.targets.is_some_and(|t| t[i].tol >= 0),
             };
             // Type-constrained pixels take the scalar path (rejection and
             // seeding live there; they are few and at coarse levels).
@@ -269,7 +270,7 @@ fn correct_chunk<const P: u32, const AVX2: bool, const C2: bool>(
                 _ => {
                     let at = (x0 + 2 * k, y);
                     let p = &ring[k % RING];
-                    decide::<P, AVX2>(atlas, st, &ns, at, p, C2, g, prior.v)
+                    decide::<P, AVX2>(atlas, st, &ns, at, p, C2, g, prior)
                 }
             };
             st.set(i, s, v);
@@ -291,7 +292,7 @@ fn decide<const P: u32, const AVX2: bool>(
     p: &Pending,
     similar: bool,
     g: &Guide<'_>,
-    vp: i32,
+    prior: Prior,
 ) -> (Coord, i32) {
     let pixel = at.1 * st.width + at.0;
     let app = atlas.level.appearance;
@@ -311,9 +312,9 @@ fn decide<const P: u32, const AVX2: bool>(
         let free = w >= W_FREE;
         let fixed = (!free).then_some(v);
         let t = Quad::around(app, idx, col.stride as i32);
-        let (sc, h_prev) = score_with::<P>(ns, &t, 1, fixed, vp);
+        let (sc, h_prev) = score_with::<P>(ns, &t, 1, fixed, prior);
         let bar = weigh(sc, w);
-        let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), bar, vp);
+        let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), bar, prior);
         if i == usize::MAX {
             return match free {
                 true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
@@ -322,7 +323,7 @@ fn decide<const P: u32, const AVX2: bool>(
         }
         return finish(atlas, st, at, p, (cost, i, hh), g);
     }
-    let winner = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), u32::MAX, vp);
+    let winner = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), u32::MAX, prior);
     finish(atlas, st, at, p, winner, g)
 }
 

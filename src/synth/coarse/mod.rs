@@ -7,9 +7,10 @@
 //! level ≤ L an exact copy of the centre, tiled toroidally when the output
 //! is larger than the exemplar.
 //!
-//! **With jitter**, level L starts as a mosaic of square **pieces** of
-//! the exemplars, [`Params::piece_size`](crate::synth::Params) output
-//! pixels across (32 by default): each piece copies the exemplar around a
+//! **With jitter**, level L starts as a mosaic of **pieces** of the
+//! exemplars, one per cell of a grid of
+//! [`Params::piece_size`](crate::synth::Params) output pixels (32 by
+//! default), cut along wavy edges ([`pieces`]): each piece copies the exemplar around a
 //! texel drawn from the [`Pool`] of every interior texel ranked by the
 //! altitude of its surroundings, at the rank an altitude guide — a smooth
 //! random field of its own (`guide.rs`) — sets for the piece's place

@@ -24,11 +24,13 @@ const SALT: u32 = 0xC0A5_0000;
 const BAND_PER_MILLE: u32 = 20;
 
 /// Level L of an output over `region` (absolute level-L pixels: the whole
-/// level, or a window's cone): the level is cut into square pieces of
-/// `side` texels on a grid anchored at the world's origin; piece (i, j)
-/// copies the exemplar around one texel of the pool — drawn by a hash of
-/// the seed and (i, j) from the pool's ranks around the guide's rank at
-/// the piece's centre — mirrored at the interior's edges; each pixel gets
+/// level, or a window's cone): the level is cut into pieces, one per cell
+/// of a grid of `side` texels anchored at the world's origin, each pixel
+/// to the piece whose centre ([`feature`]) is nearest to it once warped
+/// ([`nearest`]: a Voronoi mosaic with wavy edges); piece (i, j) copies
+/// the exemplar around one texel of the pool, placed at its centre — drawn
+/// by a hash of the seed and (i, j) from the pool's ranks around the
+/// guide's rank there — mirrored at the interior's edges; each pixel gets
 /// the level's jitter (`jitter`, fixed point, the same hash as
 /// `upsample_jitter`) and offset V = 0 (its own altitude).
 ///
@@ -36,6 +38,13 @@ const BAND_PER_MILLE: u32 = 20;
 /// constrains a pixel, its piece is drawn the same way from the pool of
 /// those types' texels; a pixel's piece is thus a function of its own type
 /// set, not of its neighbours', so a painted edge cuts a piece in two.
+///
+/// Why not square pieces: correction reshapes most joins, but not all — a
+/// sea piece beside a land piece kept its straight edge as a straight
+/// shore, and the grid showed through as box-shaped massifs and
+/// staircase coasts (issue 46). Cut along wavy edges at random angles,
+/// the joins that survive look like the exemplar's own boundaries (on the
+/// 8 shared DEMs the figures are the same to a point or two).
 ///
 /// A piece depends on the seed, its position and the pixel's type set
 /// alone, so any window of a world starts from the same pieces.
@@ -48,18 +57,23 @@ pub fn pieces(
     allowed: Option<&[u32]>,
 ) -> State {
     let (w, h) = (region.width(), region.height());
-    // The pieces the region touches, and the texel each is centred on.
-    let piece = |v: usize| (v as i32).div_euclid(side);
-    let (i0, j0) = (piece(region.x0), piece(region.y0));
-    let (ni, nj) = (
-        (piece(region.x1 - 1) - i0 + 1) as usize,
-        (piece(region.y1 - 1) - j0 + 1) as usize,
+    // The pieces whose cells lie within the warp's reach of the region,
+    // and the texel each is centred on.
+    let cell = |v: i32| v.div_euclid(side);
+    let reach = 2;
+    let (i0, j0) = (
+        cell(region.x0 as i32) - reach,
+        cell(region.y0 as i32) - reach,
     );
-    let centre_px = |i: i32| (i * side * 2 + side) << l >> 1;
+    let (ni, nj) = (
+        (cell(region.x1 as i32 - 1) + reach - i0 + 1) as usize,
+        (cell(region.y1 as i32 - 1) + reach - j0 + 1) as usize,
+    );
+    let ij = |k: usize| (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
     let places: Vec<(i32, i32)> = (0..ni * nj)
         .map(|k| {
-            let (i, j) = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
-            (centre_px(i), centre_px(j))
+            let (fx, fy) = feature(seed, side, ij(k));
+            ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1)
         })
         .collect();
     let quantiles = guide::quantiles(seed, src.pool.scale(), &places);
@@ -84,18 +98,14 @@ pub fn pieces(
     };
     let centres: Vec<(i32, i32)> = (0..ni * nj)
         .into_par_iter()
-        .map(|k| {
-            let ij = (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
-            draw(src.pool, quantiles[k], seed, ij)
-        })
+        .map(|k| draw(src.pool, quantiles[k], seed, ij(k)))
         .collect();
     let st = State::new(w, h);
     (0..h).into_par_iter().for_each(|r| {
         let y = (region.y0 + r) as i32;
-        let j = y.div_euclid(side);
         for c in 0..w {
             let x = (region.x0 + c) as i32;
-            let i = x.div_euclid(side);
+            let ((i, j), (fx, fy)) = nearest(seed, side, (x, y));
             let k = (j - j0) as usize * ni + (i - i0) as usize;
             let (cx, cy) = match allowed.map_or(ALL_TYPES, |a| a[r * w + c]) {
                 ALL_TYPES => centres[k],
@@ -104,8 +114,8 @@ pub fn pieces(
             let col = src.atlas.columns[cx as usize];
             let (x0, y0) = (col.min_x, MARGIN as i32);
             let (nx, ny) = (col.max_x - x0 + 1, col.max_y - y0 + 1);
-            let tx = x0 + mirror(cx - x0 + x - i * side - side / 2, nx);
-            let ty = y0 + mirror(cy - y0 + y - j * side - side / 2, ny);
+            let tx = x0 + mirror(cx - x0 + x - fx, nx);
+            let ty = y0 + mirror(cy - y0 + y - fy, ny);
             let (jx, jy) = upsample_jitter::jitter(seed, l as u32, x as u32, y as u32, jitter);
             let s = Coord {
                 x: inside((tx << FRAC_BITS) + jx, x0, nx),
@@ -115,6 +125,72 @@ pub fn pieces(
         }
     });
     st
+}
+
+/// The centre of piece (i, j) (level-L texels): a place of its cell of
+/// the `side`-texel grid, drawn by a hash, at most 3/8 of a side from the
+/// cell's centre (so every piece keeps a share of its cell).
+fn feature(seed: u32, side: i32, (i, j): (i32, i32)) -> (i32, i32) {
+    let a = side * 3 / 8;
+    let off = |salt: u32| {
+        below(
+            hash4(seed, SALT | salt, i as u32, j as u32),
+            (2 * a + 1) as u32,
+        ) as i32
+            - a
+    };
+    (i * side + side / 2 + off(1), j * side + side / 2 + off(2))
+}
+
+/// The piece texel (x, y) belongs to, and its centre: the nearest
+/// [`feature`] (squared distance; ties to the first in row order) to the
+/// place displaced by a smooth field of up to a third of a side, so the
+/// cells' straight Voronoi edges come out wavy. The displaced place lies
+/// within a cell of (x, y)'s and the nearest centre within a cell of it:
+/// `pieces` takes the cells two around the region.
+fn nearest(seed: u32, side: i32, (x, y): (i32, i32)) -> ((i32, i32), (i32, i32)) {
+    let amp = side / 3;
+    let (wx, wy) = (
+        x + warp(seed, 3, side, x, y, amp),
+        y + warp(seed, 4, side, x, y, amp),
+    );
+    let (ci, cj) = (wx.div_euclid(side), wy.div_euclid(side));
+    let mut best = ((ci, cj), feature(seed, side, (ci, cj)), i64::MAX);
+    for dj in -1..=1 {
+        for di in -1..=1 {
+            let ij = (ci + di, cj + dj);
+            let f = feature(seed, side, ij);
+            let (dx, dy) = (i64::from(f.0 - wx), i64::from(f.1 - wy));
+            let d = dx * dx + dy * dy;
+            if d < best.2 {
+                best = (ij, f, d);
+            }
+        }
+    }
+    (best.0, best.1)
+}
+
+/// Value noise in `[−amp, amp]` on a lattice of `side` texels: hashed
+/// values interpolated bilinearly in integers.
+fn warp(seed: u32, salt: u32, side: i32, x: i32, y: i32, amp: i32) -> i32 {
+    if amp == 0 {
+        return 0;
+    }
+    let (cx, cy) = (x.div_euclid(side), y.div_euclid(side));
+    let (fx, fy) = (i64::from(x.rem_euclid(side)), i64::from(y.rem_euclid(side)));
+    let v = |dx: i32, dy: i32| {
+        i64::from(
+            below(
+                hash4(seed, SALT | salt, (cx + dx) as u32, (cy + dy) as u32),
+                (2 * amp + 1) as u32,
+            ) as i32
+                - amp,
+        )
+    };
+    let n = i64::from(side);
+    let top = v(0, 0) * (n - fx) + v(1, 0) * fx;
+    let bottom = v(0, 1) * (n - fx) + v(1, 1) * fx;
+    (top * (n - fy) + bottom * fy).div_euclid(n * n) as i32
 }
 
 /// The quantile a painted pixel draws at: the guide's `u` pulled halfway

@@ -2,7 +2,7 @@
 //! the cost of each gathered candidate against it, two diagonals per
 //! vector.
 
-use super::super::{CLAMP, DIAGONALS, FLAT, Prior};
+use super::super::{CLAMP, DIAGONALS, Prior};
 use super::gather::Pending;
 use super::grid::{Grid, at, window};
 use crate::database::c2::Quad;
@@ -30,7 +30,7 @@ pub(super) fn score_with<const P: u32>(
     t: &Quad,
     kappa: u32,
     fixed: Option<i32>,
-    vp: i32,
+    prior: Prior,
 ) -> (u32, i32) {
     // DIAGONALS order: (−1,−1), (1,−1), (−1,1), (1,1).
     let [a, b, c, d] = t.0;
@@ -41,21 +41,11 @@ pub(super) fn score_with<const P: u32>(
     let (a, b) = (d01.to_array(), d23.to_array());
     let (ma, mb) = (m01.to_array(), m23.to_array());
     let sum1 = a[0] + a[4] + b[0] + b[4];
-    // Both priors have constant weights, so each closed form divides by a
-    // constant (the branch picks one, never a run-time divisor).
-    let flat = Prior { weight: P, v: vp }.for_candidate([ma[0], ma[4], mb[0], mb[4]]) == FLAT;
-    let prior = if flat {
-        FLAT
-    } else {
-        Prior { weight: P, v: vp }
-    };
-    let h = fixed.unwrap_or_else(|| {
-        if flat {
-            FLAT.optimal(sum1)
-        } else {
-            Prior { weight: P, v: vp }.optimal(sum1)
-        }
-    });
+    // P, FLAT's and FLAT_FIT's weights are constants, so each closed form
+    // divides by a constant (`Prior::fit` picks one, never a run-time
+    // divisor).
+    let prior = Prior { weight: P, ..prior };
+    let (prior, h) = prior.fit(prior.is_flat([ma[0], ma[4], mb[0], mb[4]]), fixed, sum1);
     let h3 = 3 * h;
     let off = i32x8::new([h3, 0, 0, 0, h3, 0, 0, 0]);
     // Clamping after the saturating narrowing equals clamping before it
@@ -152,7 +142,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
     ns: &Neighbourhood,
     (p, similar): (&Pending, bool),
     bar: u32,
-    vp: i32,
+    prior: Prior,
 ) -> (u32, usize, i32) {
     let mut best = (bar, usize::MAX, 0i32);
     let pairs = &p.pairs[..p.count / 2];
@@ -165,7 +155,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
             for (j, pair) in pairs.iter().enumerate() {
                 // SAFETY: the CPU has AVX2 (as above) and C₁ is an
                 // interior coordinate (see `avx2::score_pair`).
-                let (sc, hh) = unsafe { avx2::score_c1::<P>(app, &ns, pair, vp) };
+                let (sc, hh) = unsafe { avx2::score_c1::<P>(app, &ns, pair, prior) };
                 if sc < best.0 {
                     best = (sc, 2 * j, hh);
                 }
@@ -175,7 +165,7 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
         for (j, pair) in pairs.iter().enumerate() {
             // SAFETY: the CPU has AVX2 (as above), C₁ is an interior
             // coordinate (see `avx2::score_pair`) and u a texel.
-            let scored = unsafe { avx2::score_pair::<P>(app, c2, &ns, pair, vp) };
+            let scored = unsafe { avx2::score_pair::<P>(app, c2, &ns, pair, prior) };
             for (i, (sc, hh)) in scored.into_iter().enumerate() {
                 if sc < best.0 {
                     best = (sc, 2 * j + i, hh);
@@ -186,12 +176,12 @@ pub(super) fn best_of<const P: u32, const AVX2: bool>(
     }
     for (j, pair) in pairs.iter().enumerate() {
         let c1 = Quad::beside(app, pair.up, pair.down);
-        let (sc, hh) = score_with::<P>(ns, &c1, 1, None, vp);
+        let (sc, hh) = score_with::<P>(ns, &c1, 1, None, prior);
         if sc < best.0 {
             best = (sc, 2 * j, hh);
         }
         if similar {
-            let (sc, hh) = score_with::<P>(ns, &c2[pair.u as usize], 2, None, vp);
+            let (sc, hh) = score_with::<P>(ns, &c2[pair.u as usize], 2, None, prior);
             if sc < best.0 {
                 best = (sc, 2 * j + 1, hh);
             }

@@ -18,7 +18,7 @@
 //! after the saturating narrowing (as in [`super::score_with`]), and the
 //! squares summed by `madd` (16 terms ≤ 9459² each: no i32 overflow).
 
-use super::super::super::{CLAMP, FLAT, Prior};
+use super::super::super::{CLAMP, Prior};
 use super::super::gather::Pair;
 use super::Neighbourhood;
 use crate::database::c2::Quad;
@@ -122,13 +122,8 @@ fn residuals_of<const P: u32>(ns: &Ns256, t: __m256i) -> Residuals {
 /// pairs (eight i32 lanes; their sum is the score before the prior).
 #[inline]
 #[target_feature(enable = "avx2")]
-fn fit<const P: u32>(r: &Residuals, sum1: i32, vp: i32) -> (i32, u32, __m256i) {
-    let (prior, h) = if r.flat {
-        (FLAT, FLAT.optimal(sum1))
-    } else {
-        let prior = Prior { weight: P, v: vp };
-        (prior, prior.optimal(sum1))
-    };
+fn fit<const P: u32>(r: &Residuals, sum1: i32, prior: Prior) -> (i32, u32, __m256i) {
+    let (prior, h) = Prior { weight: P, ..prior }.fit(r.flat, None, sum1);
     // 3h in the mode-0 lanes (the low half of each 64-bit lane), 0 in the
     // others: one broadcast, no blend.
     let off = _mm256_set1_epi64x(i64::from((3 * h) as u32));
@@ -160,12 +155,12 @@ pub(super) unsafe fn score_c1<const P: u32>(
     app: &[u64],
     ns: &Ns256,
     pair: &Pair,
-    vp: i32,
+    prior: Prior,
 ) -> (u32, i32) {
     // SAFETY: forwarded from the caller.
     let a = unsafe { residuals::<P>(app, ns, pair) };
     // Σ d₁: the mode-0 lanes 0, 2, 4, 6 of `even`.
-    let (h, cost, squares) = fit::<P>(&a, lane_sum(a.even), vp);
+    let (h, cost, squares) = fit::<P>(&a, lane_sum(a.even), prior);
     // The squares sum to at most 16·9459² < 2³¹; with the prior < 2³².
     (hsum(squares).wrapping_add(cost), h)
 }
@@ -201,7 +196,7 @@ pub(super) unsafe fn score_pair<const P: u32>(
     c2: &[Quad],
     ns: &Ns256,
     pair: &Pair,
-    vp: i32,
+    prior: Prior,
 ) -> [(u32, i32); 2] {
     // SAFETY: forwarded from the caller.
     let a = unsafe { residuals::<P>(app, ns, pair) };
@@ -213,8 +208,8 @@ pub(super) unsafe fn score_pair<const P: u32>(
     let x = _mm256_blend_epi32::<0b1010_1010>(a.even, _mm256_slli_epi64::<32>(b.even));
     let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
     let sums = _mm_cvtsi128_si64(_mm_add_epi32(x, _mm_unpackhi_epi64(x, x)));
-    let (ha, ca, sa) = fit::<P>(&a, sums as i32, vp);
-    let (hb, cb, sb) = fit::<P>(&b, (sums >> 32) as i32, vp);
+    let (ha, ca, sa) = fit::<P>(&a, sums as i32, prior);
+    let (hb, cb, sb) = fit::<P>(&b, (sums >> 32) as i32, prior);
     // [a, a, b, b | a, a, b, b] → [a, a, b, b] → [a, b, a, b].
     let x = _mm256_hadd_epi32(sa, sb);
     let x = _mm_add_epi32(_mm256_castsi256_si128(x), _mm256_extracti128_si256::<1>(x));
@@ -248,7 +243,11 @@ mod tests {
             let mut within = || (next() % (2 * scale)) as i32 - scale as i32;
             let (h, v) = (within(), within());
             for weight in PRIORS {
-                let prior = Prior { weight, v };
+                let prior = Prior {
+                    weight,
+                    v,
+                    held: false,
+                };
                 assert_eq!(cost(prior, h), prior.cost(h), "P {weight}, h {h}, V {v}");
             }
         }
