@@ -15,8 +15,12 @@
 //!
 //! [`FieldCache`] keys fields on the resampled shape, so changing a widget's
 //! height, slope or reach reuses the field; only a reach that outgrows the
-//! computed margin (or a new shape) recomputes it.
+//! computed margin (or a new shape) recomputes it. Beside each field it
+//! keeps the last few envelopes built on it, keyed on the reach tracks, so
+//! changing a height or slope reuses the envelope too.
 
+use super::envelope::Envelope;
+use super::profile::Track;
 use super::segments::Segments;
 use glam::DVec2;
 use rayon::prelude::*;
@@ -115,12 +119,24 @@ impl DistanceField {
     }
 }
 
+/// Envelopes kept per field: an editor alternates between a few reaches
+/// (undo, redo) while heights change freely.
+const ENVELOPES_PER_FIELD: usize = 4;
+
 /// Distance fields by shape, shared by the curves of a scene and across the
 /// frames of an editing session.
 #[derive(Debug, Default)]
 pub struct FieldCache {
-    fields: Mutex<HashMap<u64, Arc<DistanceField>>>,
+    fields: Mutex<HashMap<u64, Entry>>,
     computed: AtomicUsize,
+}
+
+/// A field and the envelopes last built on it, most recent first, with
+/// the left and right reach tracks each was built from.
+#[derive(Debug)]
+struct Entry {
+    field: Arc<DistanceField>,
+    envelopes: Vec<([Track; 2], Arc<Envelope>)>,
 }
 
 impl FieldCache {
@@ -137,23 +153,69 @@ impl FieldCache {
     /// shape was seen with a margin at least as large.
     pub fn get(&self, points: &[DVec2], margin: f64) -> Option<Arc<DistanceField>> {
         let key = shape_key(points);
-        if let Some(f) = self.fields.lock().expect("not poisoned").get(&key)
-            && f.margin >= margin
-            && same_shape(&f.segments, points)
+        if let Some(e) = self.fields.lock().expect("not poisoned").get(&key)
+            && e.field.margin >= margin
+            && same_shape(&e.field.segments, points)
         {
-            return Some(f.clone());
+            return Some(e.field.clone());
         }
         let f = Arc::new(DistanceField::compute(points, margin)?);
         self.computed.fetch_add(1, Ordering::Relaxed);
-        self.fields
-            .lock()
-            .expect("not poisoned")
-            .insert(key, f.clone());
+        let entry = Entry {
+            field: f.clone(),
+            envelopes: Vec::new(),
+        };
+        self.fields.lock().expect("not poisoned").insert(key, entry);
         Some(f)
+    }
+
+    /// The envelope on `field` (one [`FieldCache::get`] gave) for these
+    /// reach tracks: a kept one, else `compute`'s, kept. The envelope is a
+    /// function of the field and the reach tracks only (the curve's points
+    /// are the field's segments), so a kept one is the very same.
+    pub fn envelope(
+        &self,
+        field: &Arc<DistanceField>,
+        reach: &[Track; 2],
+        compute: impl FnOnce() -> Envelope,
+    ) -> Arc<Envelope> {
+        let key = shape_key_of(&field.segments);
+        fn kept<'a>(
+            fields: &'a mut HashMap<u64, Entry>,
+            key: u64,
+            field: &Arc<DistanceField>,
+        ) -> Option<&'a mut Entry> {
+            fields
+                .get_mut(&key)
+                .filter(|e| Arc::ptr_eq(&e.field, field))
+        }
+        if let Some(e) = kept(&mut self.fields.lock().expect("not poisoned"), key, field)
+            && let Some(k) = e.envelopes.iter().position(|(r, _)| r == reach)
+        {
+            let hit = e.envelopes.remove(k);
+            e.envelopes.insert(0, hit.clone());
+            return hit.1;
+        }
+        // Computed unlocked: other curves of the scene build meanwhile.
+        let env = Arc::new(compute());
+        if let Some(e) = kept(&mut self.fields.lock().expect("not poisoned"), key, field) {
+            e.envelopes.insert(0, (reach.clone(), env.clone()));
+            e.envelopes.truncate(ENVELOPES_PER_FIELD);
+        }
+        env
     }
 }
 
 fn shape_key(points: &[DVec2]) -> u64 {
+    shape_key_iter(points.iter().copied())
+}
+
+/// The key of the points a field's segments join.
+fn shape_key_of(s: &Segments) -> u64 {
+    shape_key_iter(s.a.iter().chain(s.b.last()).copied())
+}
+
+fn shape_key_iter(points: impl Iterator<Item = DVec2>) -> u64 {
     // DefaultHasher::new() has fixed keys: stable within and across runs.
     let mut h = std::collections::hash_map::DefaultHasher::new();
     for p in points {
