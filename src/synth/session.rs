@@ -2,7 +2,8 @@
 //! re-synthesized coherently with the previous frame.
 //!
 //! Per frame, W⁰ (quarters) is 4 (unweighted) inside the influence of the
-//! constraints, type paint and pastes edited in this step (and where a
+//! constraints, type paint and pastes edited in this step (a replaced
+//! constraint: where its samples changed, see [`mark`]; and where a
 //! sculpt edit changed the target), 1 (coherent,
 //! 0.25) elsewhere and 0 where frozen (freezing brush, pasted regions);
 //! W^i follows by `reduce_weights`. The previous frame's per-pass results
@@ -11,8 +12,7 @@
 //! [`crate::synth::Guides::restrict`]).
 
 use super::control::{
-    Blend, Centres, Constraint, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource,
-    UNCONSTRAINED,
+    Blend, Constraint, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED,
 };
 use super::window::row_bounds;
 use super::{Frames, Guides, Params, SynthError, Synthesizer, union};
@@ -26,6 +26,7 @@ use std::time::Duration;
 use thiserror::Error;
 
 mod guides;
+mod mark;
 mod paste;
 mod sculpt;
 mod snapshot;
@@ -210,14 +211,17 @@ impl<'db> Session<'db> {
         for e in edits {
             match e {
                 Edit::SetConstraint(id, c) => {
-                    if let Some(old) = self.controls.constraints.insert(id, c.clone()) {
-                        self.place(&*old, -1, &mut weights);
+                    let old = self.controls.constraints.insert(id, c.clone());
+                    if let Some(old) = &old {
+                        self.blend(&**old, -1);
                     }
-                    self.place(&*c, 1, &mut weights);
+                    self.blend(&*c, 1);
+                    mark::free_changed(&*c, old.as_deref(), &mut weights, w0, h0);
                 }
                 Edit::RemoveConstraint(id) => {
                     let old = self.controls.constraints.remove(&id).expect("checked");
-                    self.place(&*old, -1, &mut weights);
+                    self.blend(&*old, -1);
+                    mark::free_changed(&*old, None, &mut weights, w0, h0);
                 }
                 Edit::PaintTypes(map) => {
                     let before = self.controls.types.take();
@@ -300,19 +304,15 @@ impl<'db> Session<'db> {
         })
     }
 
-    /// Adds `c` to the blend (`sign` 1) or takes it out (−1), and marks
-    /// its reach unweighted in `weights` (level 0); both read the finest
-    /// level's samples from those it keeps ([`Constraint::centres`]).
-    fn place(&mut self, c: &dyn Constraint, sign: i64, weights: &mut [u8]) {
-        let kept = c.centres();
-        match (kept, sign > 0) {
+    /// Adds `c` to the blend (`sign` 1) or takes it out (−1), reading the
+    /// finest level's samples from those it keeps ([`Constraint::centres`]).
+    fn blend(&mut self, c: &dyn Constraint, sign: i64) {
+        match (c.centres(), sign > 0) {
             (Some(k), true) => self.blend.add_kept(c, k),
             (Some(k), false) => self.blend.subtract_kept(c, k),
             (None, true) => self.blend.add(c),
             (None, false) => self.blend.subtract(c),
         }
-        let (w, h) = level_size(self.width, self.height, 0);
-        free_within(c, kept, weights, w, h);
     }
 
     /// Validates an edit before anything changes.
@@ -372,49 +372,6 @@ impl<'db> Session<'db> {
         }
     }
 }
-/// Marks level-0 pixels within a constraint's reach unweighted, reading
-/// `kept` samples where it has them: tile rows in parallel, skipping tiles
-/// no sample can reach ([`Hold::max_reach`], [`Constraint::distance_bound`])
-/// as [`Blend`] does. Sampling serially, tile by tile, this took ~28 ms of
-/// a 1024-px curve's edit (old and new reach).
-///
-/// [`Hold::max_reach`]: super::control::Hold::max_reach
-fn free_within(c: &dyn Constraint, kept: Option<&Centres>, weights: &mut [u8], w: usize, h: usize) {
-    const TILE: usize = 8;
-    let [x0, y0, x1, y1] = c.bounds();
-    let clip = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n);
-    let (xs, ys) = (
-        clip(x0, w)..clip(x1 + 1.0, w),
-        clip(y0, h)..clip(y1 + 1.0, h),
-    );
-    let max_reach = c.hold().max_reach;
-    weights[ys.start * w..ys.end * w]
-        .par_chunks_mut(TILE * w)
-        .enumerate()
-        .for_each(|(k, rows)| {
-            let (ty, n) = (ys.start + k * TILE, rows.len() / w);
-            for tx in xs.clone().step_by(TILE) {
-                let tx1 = (tx + TILE).min(xs.end);
-                let spread = ((tx1 - 1 - tx) as f64).hypot((n - 1) as f64);
-                let centre = ((tx + tx1) as f64 / 2.0, (2 * ty + n) as f64 / 2.0);
-                if c.distance_bound(centre.0, centre.1) - spread / 2.0 > max_reach {
-                    continue;
-                }
-                for (j, row) in rows.chunks_mut(w).enumerate() {
-                    for (x, wt) in row.iter_mut().enumerate().take(tx1).skip(tx) {
-                        let s = match kept {
-                            Some(k) => k.get(c, x, ty + j),
-                            None => c.sample(x as f64 + 0.5, (ty + j) as f64 + 0.5),
-                        };
-                        if s.is_some_and(|s| s.distance <= s.reach) {
-                            *wt = W_FREE;
-                        }
-                    }
-                }
-            }
-        });
-}
-
 /// Where `new` differs from `old` (same size), bit for bit; in parallel
 /// (it runs on every edit, over every output pixel).
 pub fn change(old: &Heightfield, new: &Heightfield) -> Change {
@@ -451,44 +408,6 @@ pub fn change(old: &Heightfield, new: &Heightfield) -> Change {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn marking_by_tiles_and_kept_samples_marks_every_pixel_within_reach() {
-        use crate::synth::control::curve::{CurveSpec, FieldCache, Widget, build};
-        use glam::DVec2;
-        let spec = CurveSpec {
-            points: vec![
-                DVec2::new(-20.0, 30.0),
-                DVec2::new(60.0, 90.0),
-                DVec2::new(150.0, 40.0),
-            ],
-            widgets: vec![Widget {
-                at: 0.3,
-                height_m: 100.0,
-                slope_deg: [10.0, -20.0],
-                reach_px: [25.0, 9.0],
-            }],
-            smoothing: 2,
-        };
-        let (curves, _) = build(&[spec], &[], 30.0, &FieldCache::new()).unwrap();
-        let c = &curves[0];
-        let (w, h) = (130, 110);
-        let mut want = vec![W_COHERENT; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let s = c.sample(x as f64 + 0.5, y as f64 + 0.5);
-                if s.is_some_and(|s| s.distance <= s.reach) {
-                    want[y * w + x] = W_FREE;
-                }
-            }
-        }
-        assert!(want.contains(&W_FREE) && want.contains(&W_COHERENT));
-        for kept in [None, c.centres()] {
-            let mut got = vec![W_COHERENT; w * h];
-            free_within(c, kept, &mut got, w, h);
-            assert!(got == want, "kept: {}", kept.is_some());
-        }
-    }
 
     #[test]
     fn change_counts_and_bounds_the_differing_pixels() {
