@@ -22,7 +22,7 @@
 //!   and the clamp keeps the search local (envelope rebuild of a 1024-px
 //!   meander, reach 60 px: 578 → 304 ms on 2 cores, `benches/curve.rs`).
 
-use super::field::{DistanceField, NONE};
+use super::field::{DistanceField, NONE, TILE, far_tile, tiles};
 use super::segments::{Hit, Segments};
 use glam::DVec2;
 use rayon::prelude::*;
@@ -227,7 +227,8 @@ pub const BAND: f64 = 16.0;
 
 /// Effective reach per node: `d + s`, `s` the signed distance to `loops`
 /// (lattice coordinates; positive inside by the even-odd rule) clamped to
-/// ±[`BAND`]; rows in parallel.
+/// ±[`BAND`]; tile rows in parallel, tiles all farther than [`BAND`] from
+/// the loops taking ±[`BAND`] without a query each ([`far_tile`]).
 pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> Vec<f32> {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for lp in loops {
@@ -238,31 +239,44 @@ pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> V
     }
     let segs = Segments::new(a, b);
     let mut out = vec![0f32; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
-        let y = j as f64;
-        // Even-odd crossings of this row (half-open in y).
-        let mut xs: Vec<f64> = Vec::new();
-        for k in 0..segs.len() {
-            let (p, q) = (segs.a[k], segs.b[k]);
-            if (p.y <= y) != (q.y <= y) {
-                xs.push(p.x + (y - p.y) / (q.y - p.y) * (q.x - p.x));
+    out.par_chunks_mut(TILE * w)
+        .enumerate()
+        .for_each(|(t, rows)| {
+            let (j0, n) = (t * TILE, rows.len() / w);
+            // Tiles all farther than BAND from the boundary: s = ±BAND.
+            let far: Vec<bool> = tiles(w)
+                .map(|(i0, i1)| far_tile(&segs, DVec2::new(i0 as f64, j0 as f64), i1 - i0, n, BAND))
+                .collect();
+            for (dj, row) in rows.chunks_mut(w).enumerate() {
+                let j = j0 + dj;
+                let y = j as f64;
+                // Even-odd crossings of this row (half-open in y).
+                let mut xs: Vec<f64> = Vec::new();
+                for k in 0..segs.len() {
+                    let (p, q) = (segs.a[k], segs.b[k]);
+                    if (p.y <= y) != (q.y <= y) {
+                        xs.push(p.x + (y - p.y) / (q.y - p.y) * (q.x - p.x));
+                    }
+                }
+                xs.sort_by(f64::total_cmp);
+                for (i, slot) in row.iter_mut().enumerate() {
+                    let x = i as f64;
+                    let di = d[j * w + i];
+                    if !di.is_finite() {
+                        *slot = -1.0;
+                        continue;
+                    }
+                    let inside = xs.partition_point(|&c| c <= x) % 2 == 1;
+                    let s = match far[i / TILE] {
+                        true => BAND,
+                        false => segs
+                            .closest(DVec2::new(x, y), BAND)
+                            .map_or(BAND, |h| h.dist),
+                    };
+                    *slot = (di + if inside { s } else { -s }) as f32;
+                }
             }
-        }
-        xs.sort_by(f64::total_cmp);
-        for (i, slot) in row.iter_mut().enumerate() {
-            let x = i as f64;
-            let di = d[j * w + i];
-            if !di.is_finite() {
-                *slot = -1.0;
-                continue;
-            }
-            let inside = xs.partition_point(|&c| c <= x) % 2 == 1;
-            let s = segs
-                .closest(DVec2::new(x, y), BAND)
-                .map_or(BAND, |h| h.dist);
-            *slot = (di + if inside { s } else { -s }) as f32;
-        }
-    });
+        });
     out
 }
 
@@ -289,5 +303,36 @@ mod tests {
         let r = effective_reach(&loops, &d, w, h);
         assert!(r[20 * w + 20] > 11.5 && r[20 * w + 20] < 12.5);
         assert!(r[0] < 0.0);
+    }
+
+    #[test]
+    fn effective_reach_is_the_clamped_signed_distance_at_every_node() {
+        // A disc of radius 30 in an 81² lattice: nodes deep inside and
+        // far outside (skipped tiles) and near the boundary.
+        let (w, h) = (81, 81);
+        let f: Vec<f64> = (0..w * h)
+            .map(|k| DVec2::new((k % w) as f64, (k / w) as f64).distance(DVec2::splat(40.0)) - 30.0)
+            .collect();
+        let loops = isocurves(&f, w, h);
+        let d: Vec<f64> = (0..w * h).map(|k| (k % 7) as f64).collect();
+        let r = effective_reach(&loops, &d, w, h);
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        for lp in &loops {
+            for k in 0..lp.len() {
+                a.push(lp[k]);
+                b.push(lp[(k + 1) % lp.len()]);
+            }
+        }
+        let segs = Segments::new(a, b);
+        for j in 0..h {
+            for i in 0..w {
+                let p = DVec2::new(i as f64, j as f64);
+                let s = segs.closest(p, BAND).map_or(BAND, |h| h.dist);
+                let inside = p.distance(DVec2::splat(40.0)) < 30.0;
+                let want = (d[j * w + i] + if inside { s } else { -s }) as f32;
+                assert_eq!(r[j * w + i].to_bits(), want.to_bits(), "({i}, {j})");
+            }
+        }
     }
 }

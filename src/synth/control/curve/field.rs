@@ -52,7 +52,8 @@ pub struct DistanceField {
 
 impl DistanceField {
     /// Computes the field around `points` (resampled) out to `margin` pixels,
-    /// rows in parallel. `None` when the lattice would exceed [`MAX_NODES`].
+    /// tile rows in parallel, tiles beyond the margin skipped ([`far_tile`]).
+    /// `None` when the lattice would exceed [`MAX_NODES`].
     pub fn compute(points: &[DVec2], margin: f64) -> Option<DistanceField> {
         let segments = Segments::polyline(points, false);
         let (mut lo, mut hi) = (points[0], points[0]);
@@ -69,15 +70,24 @@ impl DistanceField {
             return None;
         }
         let mut seg = vec![NONE; width * height];
-        seg.par_chunks_mut(width).enumerate().for_each(|(j, row)| {
-            let y = (y0 + j as i64) as f64;
-            for (i, slot) in row.iter_mut().enumerate() {
-                let p = DVec2::new((x0 + i as i64) as f64, y);
-                if let Some(h) = segments.closest(p, margin) {
-                    *slot = h.seg;
+        let node = |i: usize, j: usize| DVec2::new((x0 + i as i64) as f64, (y0 + j as i64) as f64);
+        seg.par_chunks_mut(TILE * width)
+            .enumerate()
+            .for_each(|(t, rows)| {
+                let j0 = t * TILE;
+                for (i0, i1) in tiles(width) {
+                    if far_tile(&segments, node(i0, j0), i1 - i0, rows.len() / width, margin) {
+                        continue;
+                    }
+                    for (j, row) in rows.chunks_mut(width).enumerate() {
+                        for (i, slot) in row.iter_mut().enumerate().take(i1).skip(i0) {
+                            if let Some(h) = segments.closest(node(i, j0 + j), margin) {
+                                *slot = h.seg;
+                            }
+                        }
+                    }
                 }
-            }
-        });
+            });
         Some(DistanceField {
             segments,
             x0,
@@ -122,6 +132,32 @@ impl DistanceField {
 /// Envelopes kept per field: an editor alternates between a few reaches
 /// (undo, redo) while heights change freely.
 const ENVELOPES_PER_FIELD: usize = 4;
+
+/// Side of the tiles of lattice nodes tested at once for lying beyond a
+/// distance ([`far_tile`]).
+pub const TILE: usize = 8;
+
+/// Column ranges `[i0, i1)` of the tiles of a `width`-node row.
+pub fn tiles(width: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..width)
+        .step_by(TILE)
+        .map(move |i0| (i0, (i0 + TILE).min(width)))
+}
+
+/// Whether every node of the `w × h` tile of lattice nodes whose first
+/// node is at `corner` lies farther than `dist` from every segment (so
+/// [`Segments::closest`] within `dist` finds nothing for any of them): its
+/// centre does by more than the half-diagonal (and a pixel of slack for
+/// rounding). One query instead of `w·h` that each search out to `dist`:
+/// nodes far from the curve are the costliest to query, and at the
+/// corners of a curve's lattice most are.
+pub fn far_tile(segments: &Segments, corner: DVec2, w: usize, h: usize, dist: f64) -> bool {
+    let (a, b) = ((w - 1) as f64, (h - 1) as f64);
+    let centre = corner + DVec2::new(a, b) / 2.0;
+    segments
+        .closest(centre, dist + a.hypot(b) / 2.0 + 1.0)
+        .is_none()
+}
 
 /// Distance fields by shape, shared by the curves of a scene and across the
 /// frames of an editing session.
@@ -279,6 +315,24 @@ mod tests {
                 let d = f.closest(p).unwrap().dist;
                 assert!(d >= brute && d - brute < 0.1, "{p}: {d} vs {brute}");
             }
+        }
+    }
+
+    #[test]
+    fn skipping_far_tiles_changes_no_node() {
+        let pts = wiggle();
+        for margin in [3.0, 12.0, 40.0] {
+            let f = DistanceField::compute(&pts, margin).unwrap();
+            let mut skipped = 0;
+            for j in 0..f.height {
+                for i in 0..f.width {
+                    let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
+                    let want = f.segments.closest(p, margin).map_or(NONE, |h| h.seg);
+                    assert_eq!(f.seg[j * f.width + i], want, "margin {margin}, ({i}, {j})");
+                    skipped += (want == NONE) as usize;
+                }
+            }
+            assert!(skipped > 0, "margin {margin}");
         }
     }
 
