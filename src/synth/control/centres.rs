@@ -12,9 +12,9 @@
 use super::{Constraint, Sample};
 use rayon::prelude::*;
 
-/// Most pixels kept (32 B each: 64 MiB); a larger constraint is sampled
+/// Most pixels kept (32 B each: 32 MiB); a larger constraint is sampled
 /// on demand as before.
-pub const MAX_PIXELS: usize = 1 << 21;
+pub const MAX_PIXELS: usize = 1 << 20;
 
 /// Samples at the centres `(x + ½, y + ½)` of the output pixels
 /// `[x0, x0 + width) × [y0, y0 + height)`.
