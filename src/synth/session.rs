@@ -2,7 +2,8 @@
 //! re-synthesized coherently with the previous frame.
 //!
 //! Per frame, W⁰ (quarters) is 4 (unweighted) inside the influence of the
-//! constraints, type paint and pastes edited in this step (and where a
+//! constraints, type paint and pastes edited in this step (a replaced
+//! constraint: where its samples changed, see [`mark`]; and where a
 //! sculpt edit changed the target), 1 (coherent,
 //! 0.25) elsewhere and 0 where frozen (freezing brush, pasted regions);
 //! W^i follows by `reduce_weights`. The previous frame's per-pass results
@@ -11,7 +12,7 @@
 //! [`crate::synth::Guides::restrict`]).
 
 use super::control::{
-    Blend, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED,
+    Blend, Constraint, ConstraintId, Controls, FIRST_LEVEL, Paste, PasteSource, UNCONSTRAINED,
 };
 use super::window::row_bounds;
 use super::{Frames, Guides, Params, SynthError, Synthesizer, union};
@@ -25,6 +26,7 @@ use std::time::Duration;
 use thiserror::Error;
 
 mod guides;
+mod mark;
 mod paste;
 mod sculpt;
 mod snapshot;
@@ -38,7 +40,7 @@ pub const PASTE_MARGIN: f64 = 8.0;
 #[derive(Debug, Clone)]
 pub enum Edit {
     /// Adds a constraint, or replaces the one with this id.
-    SetConstraint(ConstraintId, Arc<dyn super::control::Constraint>),
+    SetConstraint(ConstraintId, Arc<dyn Constraint>),
     RemoveConstraint(ConstraintId),
     /// Replaces R⁰ (see [`Controls::types`]); None clears it.
     PaintTypes(Option<Vec<u8>>),
@@ -206,23 +208,20 @@ impl<'db> Session<'db> {
         };
         let (w0, h0) = level_size(self.width, self.height, 0);
         let mut weights = vec![W_COHERENT; w0 * h0];
-        let mark = |c: &dyn super::control::Constraint, weights: &mut Vec<u8>| {
-            free_within(c, weights, w0, h0)
-        };
         for e in edits {
             match e {
                 Edit::SetConstraint(id, c) => {
-                    if let Some(old) = self.controls.constraints.insert(id, c.clone()) {
-                        self.blend.subtract(&*old);
-                        mark(&*old, &mut weights);
+                    let old = self.controls.constraints.insert(id, c.clone());
+                    if let Some(old) = &old {
+                        self.blend(&**old, -1);
                     }
-                    self.blend.add(&*c);
-                    mark(&*c, &mut weights);
+                    self.blend(&*c, 1);
+                    mark::free_changed(&*c, old.as_deref(), &mut weights, w0, h0);
                 }
                 Edit::RemoveConstraint(id) => {
                     let old = self.controls.constraints.remove(&id).expect("checked");
-                    self.blend.subtract(&*old);
-                    mark(&*old, &mut weights);
+                    self.blend(&*old, -1);
+                    mark::free_changed(&*old, None, &mut weights, w0, h0);
                 }
                 Edit::PaintTypes(map) => {
                     let before = self.controls.types.take();
@@ -305,6 +304,17 @@ impl<'db> Session<'db> {
         })
     }
 
+    /// Adds `c` to the blend (`sign` 1) or takes it out (−1), reading the
+    /// finest level's samples from those it keeps ([`Constraint::centres`]).
+    fn blend(&mut self, c: &dyn Constraint, sign: i64) {
+        match (c.centres(), sign > 0) {
+            (Some(k), true) => self.blend.add_kept(c, k),
+            (Some(k), false) => self.blend.subtract_kept(c, k),
+            (None, true) => self.blend.add(c),
+            (None, false) => self.blend.subtract(c),
+        }
+    }
+
     /// Validates an edit before anything changes.
     fn check(&self, e: &Edit) -> Result<(), SessionError> {
         let n = self.width * self.height;
@@ -362,20 +372,6 @@ impl<'db> Session<'db> {
         }
     }
 }
-/// Marks level-0 pixels within a constraint's reach unweighted.
-fn free_within(c: &dyn super::control::Constraint, weights: &mut [u8], w: usize, h: usize) {
-    let [x0, y0, x1, y1] = c.bounds();
-    let clip = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n);
-    for y in clip(y0, h)..clip(y1 + 1.0, h) {
-        for x in clip(x0, w)..clip(x1 + 1.0, w) {
-            let s = c.sample(x as f64 + 0.5, y as f64 + 0.5);
-            if s.is_some_and(|s| s.distance <= s.reach) {
-                weights[y * w + x] = W_FREE;
-            }
-        }
-    }
-}
-
 /// Where `new` differs from `old` (same size), bit for bit; in parallel
 /// (it runs on every edit, over every output pixel).
 pub fn change(old: &Heightfield, new: &Heightfield) -> Change {

@@ -82,7 +82,7 @@
 //! unconstrained terrain's (within 6 px, 99 %). Type constraints stay off
 //! on the finest two levels ([`super::FIRST_LEVEL`]).
 
-use super::{Constraint, Hold};
+use super::{Centres, Constraint, Hold};
 use crate::database::Quantization;
 use crate::synth::cone::Rect;
 use crate::synth::union;
@@ -242,12 +242,23 @@ impl Blend {
 
     /// Adds a constraint's contribution.
     pub fn add(&mut self, c: &dyn Constraint) {
-        self.apply(c, 1);
+        self.apply(c, 1, None);
     }
 
     /// Removes a contribution added before (exactly).
     pub fn subtract(&mut self, c: &dyn Constraint) {
-        self.apply(c, -1);
+        self.apply(c, -1, None);
+    }
+
+    /// [`Blend::add`], the finest level's samples read from `kept` (`c`'s
+    /// [`Constraint::centres`]): the same sums.
+    pub fn add_kept(&mut self, c: &dyn Constraint, kept: &Centres) {
+        self.apply(c, 1, Some(kept));
+    }
+
+    /// [`Blend::subtract`], the finest level's samples read from `kept`.
+    pub fn subtract_kept(&mut self, c: &dyn Constraint, kept: &Centres) {
+        self.apply(c, -1, Some(kept));
     }
 
     /// Whether no constraint contributes anywhere.
@@ -270,7 +281,7 @@ impl Blend {
         self.levels.iter_mut().map(|l| l.touched.take()).collect()
     }
 
-    fn apply(&mut self, c: &dyn Constraint, sign: i64) {
+    fn apply(&mut self, c: &dyn Constraint, sign: i64, kept: Option<&Centres>) {
         let q = self.q;
         let [x0, y0, x1, y1] = c.bounds();
         let hold = c.hold();
@@ -290,6 +301,7 @@ impl Blend {
             let (ys, xs) = (range(y0, y1, level.y0, h), range(x0, x1, level.x0, w));
             let stamp = Stamp {
                 c,
+                kept: kept.filter(|_| i == 0),
                 sign,
                 q: &q,
                 hold: &hold,
@@ -396,6 +408,8 @@ fn target(s: &Sums, px_to_units: f64) -> Target {
 /// added tile row by tile row.
 struct Stamp<'a> {
     c: &'a dyn Constraint,
+    /// `c`'s kept samples, at the finest level only (its pixel centres).
+    kept: Option<&'a Centres>,
     /// +1 to add the constraint, −1 to take it away.
     sign: i64,
     q: &'a Quantization,
@@ -451,7 +465,10 @@ impl Stamp<'_> {
     /// it does not reach the pixel, else the change in reached pixels.
     fn pixel(&self, cell: &mut Sums, x: usize, y: usize) -> Option<i64> {
         let at = |v: usize| (v as f64 + 0.5) * self.scale;
-        let s = self.c.sample(at(x), at(y))?;
+        let s = match self.kept {
+            Some(k) => k.get(self.c, x, y)?,
+            None => self.c.sample(at(x), at(y))?,
+        };
         // NaN distances (a broken constraint) never count.
         let inside = s.distance <= s.reach.min(self.cap);
         if !inside {

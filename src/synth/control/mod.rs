@@ -12,12 +12,14 @@
 //! ((x + 0.5)·2^i, (y + 0.5)·2^i).
 
 pub mod blend;
+pub mod centres;
 pub mod curve;
 pub mod lift;
 pub mod point;
 pub mod sculpt;
 
 pub use blend::{Blend, Targets};
+pub use centres::Centres;
 pub use lift::Lift;
 pub use point::PointConstraint;
 pub use sculpt::SculptLayer;
@@ -57,6 +59,14 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     fn distance_bound(&self, x: f64, y: f64) -> f64;
     /// How tightly it holds the terrain around its site ([`blend`]).
     fn hold(&self) -> Hold;
+    /// Its samples at the finest level's pixel centres, where it keeps
+    /// them (a curve, whose samples are costly): an editing session reads
+    /// them to take it out of the blend again. Not to be called from
+    /// within a parallel loop that may sample the same constraint (the
+    /// first call takes them, in parallel).
+    fn centres(&self) -> Option<&Centres> {
+        None
+    }
 }
 
 /// How tightly a geometric constraint holds the terrain (see [`blend`]).

@@ -124,8 +124,8 @@ proptest! {
     }
 }
 
-#[test]
-fn skipped_tiles_hold_no_curve_sample_within_its_reach() {
+/// A meandering curve over a 300 × 240 output, its reach varying.
+fn meander() -> crate::synth::control::curve::Curve {
     use crate::synth::control::curve::{CurveSpec, FieldCache, Widget, build};
     use glam::DVec2;
     let points = (0..=12)
@@ -145,7 +145,28 @@ fn skipped_tiles_hold_no_curve_sample_within_its_reach() {
         widgets: vec![widget(0.0, 50.0), widget(1.0, 6.0)],
         smoothing: 2,
     };
-    let (curves, _) = build(&[spec], &[], 30.0, &FieldCache::new()).unwrap();
+    let (mut curves, _) = build(&[spec], &[], 30.0, &FieldCache::new()).unwrap();
+    curves.remove(0)
+}
+
+#[test]
+fn kept_samples_give_the_same_sums() {
+    let c = meander();
+    let kept = c.centres().expect("a curve keeps its samples");
+    let (mut a, mut b) = (Blend::new(300, 240, 6, q()), Blend::new(300, 240, 6, q()));
+    a.add(&c);
+    b.add_kept(&c, kept);
+    assert_eq!(a, b);
+    assert_eq!(a.take_touched(), b.take_touched());
+    a.subtract(&c);
+    b.subtract_kept(&c, kept);
+    assert_eq!(a, b);
+    assert!(b.is_empty());
+}
+
+#[test]
+fn skipped_tiles_hold_no_curve_sample_within_its_reach() {
+    let curves = [meander()];
     let mut b = Blend::new(300, 240, 6, q());
     b.add(&curves[0]);
     for level in 0..=6 {

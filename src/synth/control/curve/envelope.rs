@@ -22,10 +22,69 @@
 //!   and the clamp keeps the search local (envelope rebuild of a 1024-px
 //!   meander, reach 60 px: 578 → 304 ms on 2 cores, `benches/curve.rs`).
 
-use super::segments::Segments;
+use super::field::{DistanceField, NONE, TILE, far_tile, tiles};
+use super::segments::{Hit, Segments};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// A curve's area of effect on its field's lattice. It depends on the
+/// field and the reach along the curve alone (not on heights or slopes),
+/// so [`super::FieldCache`] keeps it beside the field: changing a widget's
+/// height rebuilt it for ~30 ms per edit of a 1024-px curve.
+#[derive(Debug, Default)]
+pub struct Envelope {
+    /// Effective reach per field node (see [`effective_reach`]).
+    pub reach_eff: Vec<f32>,
+    /// The smoothed boundary (closed loops), output pixels.
+    pub smoothed: Vec<Vec<DVec2>>,
+    /// The boundary before smoothing, output pixels.
+    pub raw: Vec<Vec<DVec2>>,
+}
+
+impl Envelope {
+    /// Raw envelope `d − reach` per node of `f` (`reach` of a node's
+    /// closest point), its isocurve, the isocurve smoothed with `sigma`,
+    /// and the effective reach; rows in parallel.
+    pub fn compute(
+        f: &DistanceField,
+        sigma: f64,
+        reach: impl Fn(Hit, DVec2) -> f64 + Sync,
+    ) -> Envelope {
+        let (w, h) = (f.width, f.height);
+        let mut d = vec![f64::INFINITY; w * h];
+        let mut excess = vec![f64::INFINITY; w * h];
+        d.par_chunks_mut(w)
+            .zip(excess.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(j, (drow, erow))| {
+                for i in 0..w {
+                    let s = f.node(i as i64, j as i64);
+                    if s == NONE {
+                        continue;
+                    }
+                    let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
+                    let hit = f.segments.project(s, p);
+                    drow[i] = hit.dist;
+                    erow[i] = hit.dist - reach(hit, p);
+                }
+            });
+        let origin = DVec2::new(f.x0 as f64, f.y0 as f64);
+        let raw = isocurves(&excess, w, h);
+        let smoothed: Vec<Vec<DVec2>> = raw.iter().map(|l| smooth_loop(l, sigma)).collect();
+        let reach_eff = effective_reach(&smoothed, &d, w, h);
+        let shift = |ls: &[Vec<DVec2>]| -> Vec<Vec<DVec2>> {
+            ls.iter()
+                .map(|l| l.iter().map(|p| *p + origin).collect())
+                .collect()
+        };
+        Envelope {
+            reach_eff,
+            smoothed: shift(&smoothed),
+            raw: shift(&raw),
+        }
+    }
+}
 
 /// Gaussian σ along the boundary, output pixels, for a curve whose largest
 /// reach is `max_reach`: 0.4 of it, within 1..=48. Steps at the medial
@@ -168,7 +227,8 @@ pub const BAND: f64 = 16.0;
 
 /// Effective reach per node: `d + s`, `s` the signed distance to `loops`
 /// (lattice coordinates; positive inside by the even-odd rule) clamped to
-/// ±[`BAND`]; rows in parallel.
+/// ±[`BAND`]; tile rows in parallel, tiles all farther than [`BAND`] from
+/// the loops taking ±[`BAND`] without a query each ([`far_tile`]).
 pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> Vec<f32> {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for lp in loops {
@@ -179,31 +239,44 @@ pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> V
     }
     let segs = Segments::new(a, b);
     let mut out = vec![0f32; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(j, row)| {
-        let y = j as f64;
-        // Even-odd crossings of this row (half-open in y).
-        let mut xs: Vec<f64> = Vec::new();
-        for k in 0..segs.len() {
-            let (p, q) = (segs.a[k], segs.b[k]);
-            if (p.y <= y) != (q.y <= y) {
-                xs.push(p.x + (y - p.y) / (q.y - p.y) * (q.x - p.x));
+    out.par_chunks_mut(TILE * w)
+        .enumerate()
+        .for_each(|(t, rows)| {
+            let (j0, n) = (t * TILE, rows.len() / w);
+            // Tiles all farther than BAND from the boundary: s = ±BAND.
+            let far: Vec<bool> = tiles(w)
+                .map(|(i0, i1)| far_tile(&segs, DVec2::new(i0 as f64, j0 as f64), i1 - i0, n, BAND))
+                .collect();
+            for (dj, row) in rows.chunks_mut(w).enumerate() {
+                let j = j0 + dj;
+                let y = j as f64;
+                // Even-odd crossings of this row (half-open in y).
+                let mut xs: Vec<f64> = Vec::new();
+                for k in 0..segs.len() {
+                    let (p, q) = (segs.a[k], segs.b[k]);
+                    if (p.y <= y) != (q.y <= y) {
+                        xs.push(p.x + (y - p.y) / (q.y - p.y) * (q.x - p.x));
+                    }
+                }
+                xs.sort_by(f64::total_cmp);
+                for (i, slot) in row.iter_mut().enumerate() {
+                    let x = i as f64;
+                    let di = d[j * w + i];
+                    if !di.is_finite() {
+                        *slot = -1.0;
+                        continue;
+                    }
+                    let inside = xs.partition_point(|&c| c <= x) % 2 == 1;
+                    let s = match far[i / TILE] {
+                        true => BAND,
+                        false => segs
+                            .closest(DVec2::new(x, y), BAND)
+                            .map_or(BAND, |h| h.dist),
+                    };
+                    *slot = (di + if inside { s } else { -s }) as f32;
+                }
             }
-        }
-        xs.sort_by(f64::total_cmp);
-        for (i, slot) in row.iter_mut().enumerate() {
-            let x = i as f64;
-            let di = d[j * w + i];
-            if !di.is_finite() {
-                *slot = -1.0;
-                continue;
-            }
-            let inside = xs.partition_point(|&c| c <= x) % 2 == 1;
-            let s = segs
-                .closest(DVec2::new(x, y), BAND)
-                .map_or(BAND, |h| h.dist);
-            *slot = (di + if inside { s } else { -s }) as f32;
-        }
-    });
+        });
     out
 }
 
@@ -230,5 +303,36 @@ mod tests {
         let r = effective_reach(&loops, &d, w, h);
         assert!(r[20 * w + 20] > 11.5 && r[20 * w + 20] < 12.5);
         assert!(r[0] < 0.0);
+    }
+
+    #[test]
+    fn effective_reach_is_the_clamped_signed_distance_at_every_node() {
+        // A disc of radius 30 in an 81² lattice: nodes deep inside and
+        // far outside (skipped tiles) and near the boundary.
+        let (w, h) = (81, 81);
+        let f: Vec<f64> = (0..w * h)
+            .map(|k| DVec2::new((k % w) as f64, (k / w) as f64).distance(DVec2::splat(40.0)) - 30.0)
+            .collect();
+        let loops = isocurves(&f, w, h);
+        let d: Vec<f64> = (0..w * h).map(|k| (k % 7) as f64).collect();
+        let r = effective_reach(&loops, &d, w, h);
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        for lp in &loops {
+            for k in 0..lp.len() {
+                a.push(lp[k]);
+                b.push(lp[(k + 1) % lp.len()]);
+            }
+        }
+        let segs = Segments::new(a, b);
+        for j in 0..h {
+            for i in 0..w {
+                let p = DVec2::new(i as f64, j as f64);
+                let s = segs.closest(p, BAND).map_or(BAND, |h| h.dist);
+                let inside = p.distance(DVec2::splat(40.0)) < 30.0;
+                let want = (d[j * w + i] + if inside { s } else { -s }) as f32;
+                assert_eq!(r[j * w + i].to_bits(), want.to_bits(), "({i}, {j})");
+            }
+        }
     }
 }

@@ -15,8 +15,12 @@
 //!
 //! [`FieldCache`] keys fields on the resampled shape, so changing a widget's
 //! height, slope or reach reuses the field; only a reach that outgrows the
-//! computed margin (or a new shape) recomputes it.
+//! computed margin (or a new shape) recomputes it. Beside each field it
+//! keeps the last few envelopes built on it, keyed on the reach tracks, so
+//! changing a height or slope reuses the envelope too.
 
+use super::envelope::Envelope;
+use super::profile::Track;
 use super::segments::Segments;
 use glam::DVec2;
 use rayon::prelude::*;
@@ -48,7 +52,8 @@ pub struct DistanceField {
 
 impl DistanceField {
     /// Computes the field around `points` (resampled) out to `margin` pixels,
-    /// rows in parallel. `None` when the lattice would exceed [`MAX_NODES`].
+    /// tile rows in parallel, tiles beyond the margin skipped ([`far_tile`]).
+    /// `None` when the lattice would exceed [`MAX_NODES`].
     pub fn compute(points: &[DVec2], margin: f64) -> Option<DistanceField> {
         let segments = Segments::polyline(points, false);
         let (mut lo, mut hi) = (points[0], points[0]);
@@ -65,15 +70,24 @@ impl DistanceField {
             return None;
         }
         let mut seg = vec![NONE; width * height];
-        seg.par_chunks_mut(width).enumerate().for_each(|(j, row)| {
-            let y = (y0 + j as i64) as f64;
-            for (i, slot) in row.iter_mut().enumerate() {
-                let p = DVec2::new((x0 + i as i64) as f64, y);
-                if let Some(h) = segments.closest(p, margin) {
-                    *slot = h.seg;
+        let node = |i: usize, j: usize| DVec2::new((x0 + i as i64) as f64, (y0 + j as i64) as f64);
+        seg.par_chunks_mut(TILE * width)
+            .enumerate()
+            .for_each(|(t, rows)| {
+                let j0 = t * TILE;
+                for (i0, i1) in tiles(width) {
+                    if far_tile(&segments, node(i0, j0), i1 - i0, rows.len() / width, margin) {
+                        continue;
+                    }
+                    for (j, row) in rows.chunks_mut(width).enumerate() {
+                        for (i, slot) in row.iter_mut().enumerate().take(i1).skip(i0) {
+                            if let Some(h) = segments.closest(node(i, j0 + j), margin) {
+                                *slot = h.seg;
+                            }
+                        }
+                    }
                 }
-            }
-        });
+            });
         Some(DistanceField {
             segments,
             x0,
@@ -115,12 +129,50 @@ impl DistanceField {
     }
 }
 
+/// Envelopes kept per field: an editor alternates between a few reaches
+/// (undo, redo) while heights change freely.
+const ENVELOPES_PER_FIELD: usize = 4;
+
+/// Side of the tiles of lattice nodes tested at once for lying beyond a
+/// distance ([`far_tile`]).
+pub const TILE: usize = 8;
+
+/// Column ranges `[i0, i1)` of the tiles of a `width`-node row.
+pub fn tiles(width: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..width)
+        .step_by(TILE)
+        .map(move |i0| (i0, (i0 + TILE).min(width)))
+}
+
+/// Whether every node of the `w × h` tile of lattice nodes whose first
+/// node is at `corner` lies farther than `dist` from every segment (so
+/// [`Segments::closest`] within `dist` finds nothing for any of them): its
+/// centre does by more than the half-diagonal (and a pixel of slack for
+/// rounding). One query instead of `w·h` that each search out to `dist`:
+/// nodes far from the curve are the costliest to query, and at the
+/// corners of a curve's lattice most are.
+pub fn far_tile(segments: &Segments, corner: DVec2, w: usize, h: usize, dist: f64) -> bool {
+    let (a, b) = ((w - 1) as f64, (h - 1) as f64);
+    let centre = corner + DVec2::new(a, b) / 2.0;
+    segments
+        .closest(centre, dist + a.hypot(b) / 2.0 + 1.0)
+        .is_none()
+}
+
 /// Distance fields by shape, shared by the curves of a scene and across the
 /// frames of an editing session.
 #[derive(Debug, Default)]
 pub struct FieldCache {
-    fields: Mutex<HashMap<u64, Arc<DistanceField>>>,
+    fields: Mutex<HashMap<u64, Entry>>,
     computed: AtomicUsize,
+}
+
+/// A field and the envelopes last built on it, most recent first, with
+/// the left and right reach tracks each was built from.
+#[derive(Debug)]
+struct Entry {
+    field: Arc<DistanceField>,
+    envelopes: Vec<([Track; 2], Arc<Envelope>)>,
 }
 
 impl FieldCache {
@@ -137,23 +189,69 @@ impl FieldCache {
     /// shape was seen with a margin at least as large.
     pub fn get(&self, points: &[DVec2], margin: f64) -> Option<Arc<DistanceField>> {
         let key = shape_key(points);
-        if let Some(f) = self.fields.lock().expect("not poisoned").get(&key)
-            && f.margin >= margin
-            && same_shape(&f.segments, points)
+        if let Some(e) = self.fields.lock().expect("not poisoned").get(&key)
+            && e.field.margin >= margin
+            && same_shape(&e.field.segments, points)
         {
-            return Some(f.clone());
+            return Some(e.field.clone());
         }
         let f = Arc::new(DistanceField::compute(points, margin)?);
         self.computed.fetch_add(1, Ordering::Relaxed);
-        self.fields
-            .lock()
-            .expect("not poisoned")
-            .insert(key, f.clone());
+        let entry = Entry {
+            field: f.clone(),
+            envelopes: Vec::new(),
+        };
+        self.fields.lock().expect("not poisoned").insert(key, entry);
         Some(f)
+    }
+
+    /// The envelope on `field` (one [`FieldCache::get`] gave) for these
+    /// reach tracks: a kept one, else `compute`'s, kept. The envelope is a
+    /// function of the field and the reach tracks only (the curve's points
+    /// are the field's segments), so a kept one is the very same.
+    pub fn envelope(
+        &self,
+        field: &Arc<DistanceField>,
+        reach: &[Track; 2],
+        compute: impl FnOnce() -> Envelope,
+    ) -> Arc<Envelope> {
+        let key = shape_key_of(&field.segments);
+        fn kept<'a>(
+            fields: &'a mut HashMap<u64, Entry>,
+            key: u64,
+            field: &Arc<DistanceField>,
+        ) -> Option<&'a mut Entry> {
+            fields
+                .get_mut(&key)
+                .filter(|e| Arc::ptr_eq(&e.field, field))
+        }
+        if let Some(e) = kept(&mut self.fields.lock().expect("not poisoned"), key, field)
+            && let Some(k) = e.envelopes.iter().position(|(r, _)| r == reach)
+        {
+            let hit = e.envelopes.remove(k);
+            e.envelopes.insert(0, hit.clone());
+            return hit.1;
+        }
+        // Computed unlocked: other curves of the scene build meanwhile.
+        let env = Arc::new(compute());
+        if let Some(e) = kept(&mut self.fields.lock().expect("not poisoned"), key, field) {
+            e.envelopes.insert(0, (reach.clone(), env.clone()));
+            e.envelopes.truncate(ENVELOPES_PER_FIELD);
+        }
+        env
     }
 }
 
 fn shape_key(points: &[DVec2]) -> u64 {
+    shape_key_iter(points.iter().copied())
+}
+
+/// The key of the points a field's segments join.
+fn shape_key_of(s: &Segments) -> u64 {
+    shape_key_iter(s.a.iter().chain(s.b.last()).copied())
+}
+
+fn shape_key_iter(points: impl Iterator<Item = DVec2>) -> u64 {
     // DefaultHasher::new() has fixed keys: stable within and across runs.
     let mut h = std::collections::hash_map::DefaultHasher::new();
     for p in points {
@@ -217,6 +315,24 @@ mod tests {
                 let d = f.closest(p).unwrap().dist;
                 assert!(d >= brute && d - brute < 0.1, "{p}: {d} vs {brute}");
             }
+        }
+    }
+
+    #[test]
+    fn skipping_far_tiles_changes_no_node() {
+        let pts = wiggle();
+        for margin in [3.0, 12.0, 40.0] {
+            let f = DistanceField::compute(&pts, margin).unwrap();
+            let mut skipped = 0;
+            for j in 0..f.height {
+                for i in 0..f.width {
+                    let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
+                    let want = f.segments.closest(p, margin).map_or(NONE, |h| h.seg);
+                    assert_eq!(f.seg[j * f.width + i], want, "margin {margin}, ({i}, {j})");
+                    skipped += (want == NONE) as usize;
+                }
+            }
+            assert!(skipped > 0, "margin {margin}");
         }
     }
 

@@ -31,7 +31,8 @@ pub mod segments;
 pub mod smooth;
 mod spec;
 
-use super::{Constraint, Hold, Sample};
+use super::{Centres, Constraint, Hold, Sample};
+use envelope::Envelope;
 use field::DistanceField;
 pub use field::FieldCache;
 use glam::DVec2;
@@ -42,7 +43,7 @@ pub use spec::{
     CurveError, CurveSpec, JUNCTION_SNAP, JunctionHeight, MAX_LENGTH_PX, MAX_REACH_PX,
     MAX_SLOPE_DEG, Widget,
 };
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Side indices of two-sided properties.
 pub const LEFT: usize = 0;
@@ -77,12 +78,12 @@ pub struct Curve {
     cum: Vec<f64>,
     tracks: Tracks,
     cell_m: f64,
-    /// Effective reach per field node (see [`envelope`]).
-    reach_eff: Vec<f32>,
-    /// The smoothed envelope boundary, output pixels.
-    envelope: Vec<Vec<DVec2>>,
-    /// The raw envelope boundary before smoothing, output pixels.
-    raw_envelope: Vec<Vec<DVec2>>,
+    /// The area of effect, shared with every curve of the same shape and
+    /// reach (see [`FieldCache::envelope`]).
+    env: Arc<Envelope>,
+    /// Its samples at the finest level's pixel centres, taken on first use
+    /// (see [`Centres`]).
+    centres: OnceLock<Option<Centres>>,
 }
 
 /// A curve's height, left/right slope and left/right reach along its arc
@@ -99,7 +100,7 @@ impl std::fmt::Debug for Curve {
             .field("points", &self.points.len())
             .field("length_px", &self.length())
             .field("field", &(self.field.width, self.field.height))
-            .field("envelope_loops", &self.envelope.len())
+            .field("envelope_loops", &self.env.smoothed.len())
             .finish()
     }
 }
@@ -229,51 +230,13 @@ impl Curve {
             cum,
             tracks,
             cell_m,
-            reach_eff: Vec::new(),
-            envelope: Vec::new(),
-            raw_envelope: Vec::new(),
+            env: Arc::default(),
+            centres: OnceLock::new(),
         };
-        curve.build_envelope(sigma);
+        curve.env = cache.envelope(&curve.field, &curve.tracks.reach, || {
+            Envelope::compute(&curve.field, sigma, |hit, p| curve.reach(hit, p))
+        });
         Ok(curve)
-    }
-
-    /// Raw envelope `d − reach(t)` per node, its isocurve, the smoothed
-    /// isocurve, and the effective reach.
-    fn build_envelope(&mut self, sigma: f64) {
-        use rayon::prelude::*;
-        let f = &self.field;
-        let (w, h) = (f.width, f.height);
-        let mut d = vec![f64::INFINITY; w * h];
-        let mut excess = vec![f64::INFINITY; w * h];
-        d.par_chunks_mut(w)
-            .zip(excess.par_chunks_mut(w))
-            .enumerate()
-            .for_each(|(j, (drow, erow))| {
-                for i in 0..w {
-                    let s = f.node(i as i64, j as i64);
-                    if s == field::NONE {
-                        continue;
-                    }
-                    let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
-                    let hit = f.segments.project(s, p);
-                    drow[i] = hit.dist;
-                    erow[i] = hit.dist - self.props(hit, p).reach_px;
-                }
-            });
-        let origin = DVec2::new(f.x0 as f64, f.y0 as f64);
-        let raw = envelope::isocurves(&excess, w, h);
-        let smoothed: Vec<Vec<DVec2>> = raw
-            .iter()
-            .map(|l| envelope::smooth_loop(l, sigma))
-            .collect();
-        self.reach_eff = envelope::effective_reach(&smoothed, &d, w, h);
-        let shift = |ls: &[Vec<DVec2>]| -> Vec<Vec<DVec2>> {
-            ls.iter()
-                .map(|l| l.iter().map(|p| *p + origin).collect())
-                .collect()
-        };
-        self.envelope = shift(&smoothed);
-        self.raw_envelope = shift(&raw);
     }
 
     /// Arc length of the smoothed curve, pixels.
@@ -309,12 +272,12 @@ impl Curve {
 
     /// The smoothed area-of-effect boundary (closed loops), output pixels.
     pub fn envelope(&self) -> &[Vec<DVec2>] {
-        &self.envelope
+        &self.env.smoothed
     }
 
     /// The boundary before isocurve smoothing, for comparison.
     pub fn raw_envelope(&self) -> &[Vec<DVec2>] {
-        &self.raw_envelope
+        &self.env.raw
     }
 
     /// The shared distance field this curve uses.
@@ -324,7 +287,7 @@ impl Curve {
 
     /// Effective reach at lattice node `(i, j)` of [`Curve::field`].
     pub fn reach_at_node(&self, i: usize, j: usize) -> f32 {
-        self.reach_eff[j * self.field.width + i]
+        self.env.reach_eff[j * self.field.width + i]
     }
 
     /// The raw (unsmoothed) reach the closest point asks for at node `(i, j)`.
@@ -333,15 +296,36 @@ impl Curve {
         let s = f.node(i as i64, j as i64);
         (s != field::NONE).then(|| {
             let p = DVec2::new((f.x0 + i as i64) as f64, (f.y0 + j as i64) as f64);
-            self.props(f.segments.project(s, p), p).reach_px
+            self.reach(f.segments.project(s, p), p)
         })
     }
 
     /// The properties for position `p` whose closest curve point is `hit`:
     /// the side's own slope and reach, or in an end cap the left and right
-    /// values blended by the angle around the end point (a cubic Hermite
-    /// step from the left normal, 0°, to the right normal, 180°).
+    /// values blended by the angle around the end point (see
+    /// [`Curve::side`]).
     pub fn props(&self, hit: Hit, p: DVec2) -> Props {
+        let (s, right) = self.side(hit, p);
+        Props {
+            s,
+            right,
+            height_m: self.tracks.height.at(s),
+            slope_deg: mix(&self.tracks.slope, s, right),
+            reach_px: mix(&self.tracks.reach, s, right),
+        }
+    }
+
+    /// [`Props::reach_px`] alone (what the envelope is made of).
+    fn reach(&self, hit: Hit, p: DVec2) -> f64 {
+        let (s, right) = self.side(hit, p);
+        mix(&self.tracks.reach, s, right)
+    }
+
+    /// Arc length of `hit` and how far `p` is on its right side: 0 or 1
+    /// beside the curve, in an end cap a cubic Hermite step of the angle
+    /// around the end point from the left normal, 0°, to the right
+    /// normal, 180°.
+    fn side(&self, hit: Hit, p: DVec2) -> (f64, f64) {
         let k = hit.seg as usize;
         let n = self.points.len() - 1;
         let s = self.cum[k] + hit.u * (self.cum[k + 1] - self.cum[k]);
@@ -372,14 +356,7 @@ impl Curve {
             };
             if fwd.perp_dot(v) > 0.0 { 1.0 } else { 0.0 }
         };
-        let mix = |t: &[Track; 2]| t[LEFT].at(s) * (1.0 - right) + t[RIGHT].at(s) * right;
-        Props {
-            s,
-            right,
-            height_m: self.tracks.height.at(s),
-            slope_deg: mix(&self.tracks.slope),
-            reach_px: mix(&self.tracks.reach),
-        }
+        (s, right)
     }
 
     /// Effective reach at output position `p`, bilinear between nodes.
@@ -392,12 +369,18 @@ impl Curve {
             if i < 0.0 || j < 0.0 || i >= f.width as f64 || j >= f.height as f64 {
                 return -1.0;
             }
-            self.reach_eff[j as usize * f.width + i as usize] as f64
+            self.env.reach_eff[j as usize * f.width + i as usize] as f64
         };
         let top = at(i0, j0) * (1.0 - tx) + at(i0 + 1.0, j0) * tx;
         let bottom = at(i0, j0 + 1.0) * (1.0 - tx) + at(i0 + 1.0, j0 + 1.0) * tx;
         top * (1.0 - ty) + bottom * ty
     }
+}
+
+/// A two-sided property at arc length `s`, `right` of the way from its
+/// left value to its right one.
+fn mix(t: &[Track; 2], s: f64, right: f64) -> f64 {
+    t[LEFT].at(s) * (1.0 - right) + t[RIGHT].at(s) * right
 }
 
 impl Constraint for Curve {
@@ -422,6 +405,10 @@ impl Constraint for Curve {
         ]
     }
 
+    fn centres(&self) -> Option<&Centres> {
+        self.centres.get_or_init(|| Centres::new(self)).as_ref()
+    }
+
     fn sample(&self, x: f64, y: f64) -> Option<Sample> {
         let p = DVec2::new(x, y);
         let hit = self.field.closest(p)?;
@@ -429,9 +416,12 @@ impl Constraint for Curve {
         if hit.dist > reach {
             return None;
         }
-        let pr = self.props(hit, p);
+        // Height and slope only: the reach is the envelope's.
+        let (s, right) = self.side(hit, p);
+        let slope_deg = mix(&self.tracks.slope, s, right);
         Some(Sample {
-            target_m: pr.height_m + pr.slope_deg.to_radians().tan() * hit.dist * self.cell_m,
+            target_m: self.tracks.height.at(s)
+                + slope_deg.to_radians().tan() * hit.dist * self.cell_m,
             distance: hit.dist,
             reach,
         })

@@ -384,3 +384,129 @@ mod prop {
         }
     }
 }
+
+/// A sample's bits (`==` on floats would let −0 pass for 0).
+fn bits(s: Option<Sample>) -> Option<[u64; 3]> {
+    s.map(|s| [s.target_m, s.distance, s.reach].map(f64::to_bits))
+}
+
+/// Whether two curves are the same constraint, bit for bit: shape, field,
+/// envelope, and every sample at the pixel centres and lattice nodes
+/// around them (also as [`Curve::centres`] keeps them).
+fn assert_same_curve(a: &Curve, b: &Curve, what: &str) {
+    assert_eq!((&a.points, &a.cum), (&b.points, &b.cum), "{what}: shape");
+    let (fa, fb) = (&a.field, &b.field);
+    assert_eq!(
+        (fa.x0, fa.y0, fa.width, fa.height, fa.margin.to_bits()),
+        (fb.x0, fb.y0, fb.width, fb.height, fb.margin.to_bits()),
+        "{what}: lattice"
+    );
+    assert!(fa.seg == fb.seg, "{what}: closest segments");
+    let reach = |c: &Curve| {
+        c.env
+            .reach_eff
+            .iter()
+            .map(|r| r.to_bits())
+            .collect::<Vec<_>>()
+    };
+    assert!(reach(a) == reach(b), "{what}: effective reach");
+    assert_eq!(a.envelope(), b.envelope(), "{what}: envelope");
+    assert_eq!(a.raw_envelope(), b.raw_envelope(), "{what}: raw envelope");
+    let (ka, kb) = (a.centres().unwrap(), b.centres().unwrap());
+    let [x0, y0, x1, y1] = a.bounds();
+    for y in (y0 as i64 - 2).max(0)..y1 as i64 + 2 {
+        for x in (x0 as i64 - 2).max(0)..x1 as i64 + 2 {
+            let (fx, fy) = (x as f64, y as f64);
+            let here = bits(a.sample(fx + 0.5, fy + 0.5));
+            assert_eq!(
+                here,
+                bits(b.sample(fx + 0.5, fy + 0.5)),
+                "{what}: ({x}, {y})"
+            );
+            let (xu, yu) = (x as usize, y as usize);
+            assert_eq!(bits(ka.get(a, xu, yu)), here, "{what}: kept ({x}, {y})");
+            assert_eq!(bits(kb.get(b, xu, yu)), here, "{what}: kept ({x}, {y})");
+            assert_eq!(
+                bits(a.sample(fx, fy)),
+                bits(b.sample(fx, fy)),
+                "{what}: node ({x}, {y})"
+            );
+        }
+    }
+}
+
+#[test]
+fn builds_reusing_fields_and_envelopes_equal_builds_from_scratch() {
+    let w = |at, h, r: f64| widget(at, h, [15.0, -20.0], [r, 0.7 * r]);
+    let a = CurveSpec {
+        points: (0..=8)
+            .map(|k| {
+                let t = k as f64 / 8.0;
+                DVec2::new(10.0 + 100.0 * t, 40.0 + 12.0 * (t * 6.0).sin())
+            })
+            .collect(),
+        widgets: vec![w(0.0, 100.0, 10.0), w(0.6, 160.0, 14.0), w(1.0, 90.0, 10.0)],
+        smoothing: 2,
+    };
+    let b = CurveSpec {
+        points: vec![
+            DVec2::new(60.0, 5.0),
+            DVec2::new(55.0, 45.0),
+            DVec2::new(70.0, 90.0),
+        ],
+        widgets: vec![w(0.5, 40.0, 8.0)],
+        smoothing: 1,
+    };
+    let c = CurveSpec {
+        points: vec![DVec2::new(5.0, 70.0), DVec2::new(115.0, 20.0)],
+        widgets: vec![w(0.3, 70.0, 6.0)],
+        smoothing: 0,
+    };
+    let mut higher = a.clone();
+    higher.widgets[1].height_m = 260.0;
+    let mut steeper = higher.clone();
+    steeper.widgets[0].slope_deg = [35.0, -5.0];
+    let mut moved = steeper.clone();
+    moved.points[3].y += 6.0;
+    let scenes = [
+        ("first", vec![a.clone(), b.clone()], false),
+        ("a widget's height", vec![higher.clone(), b.clone()], false),
+        ("a widget's slope", vec![steeper, b.clone()], false),
+        ("re-sketch", vec![moved.clone(), b.clone()], false),
+        (
+            "a crossing curve added",
+            vec![moved.clone(), b.clone(), c.clone()],
+            false,
+        ),
+        ("a curve deleted", vec![moved.clone(), c.clone()], false),
+        ("a junction's height", vec![moved, c], true),
+        ("back to the first", vec![a, b], false),
+    ];
+    let cache = FieldCache::new();
+    let mut before: Vec<Curve> = Vec::new();
+    for (what, specs, set) in scenes {
+        let fresh = build(&specs, &[], 2.0, &FieldCache::new()).unwrap();
+        let heights: Vec<JunctionHeight> = match set {
+            true => vec![JunctionHeight {
+                at: fresh.1[0].at,
+                height_m: 333.0,
+            }],
+            false => Vec::new(),
+        };
+        let (scratch, scratch_j) = build(&specs, &heights, 2.0, &FieldCache::new()).unwrap();
+        let (reused, reused_j) = build(&specs, &heights, 2.0, &cache).unwrap();
+        assert_eq!(scratch_j, reused_j, "{what}: junctions");
+        assert!(!reused_j.is_empty(), "{what}: the curves cross");
+        for (x, y) in scratch.iter().zip(&reused) {
+            assert_same_curve(x, y, what);
+        }
+        // The edits that keep a shape and its reach reused its envelope.
+        if what == "a widget's height" || what == "a widget's slope" {
+            assert!(Arc::ptr_eq(&before[0].env, &reused[0].env), "{what}");
+            assert!(Arc::ptr_eq(&before[1].env, &reused[1].env), "{what}");
+        }
+        before = reused;
+    }
+    // Fields: a, b, moved a, c (every later shape was seen before).
+    assert_eq!(cache.computed(), 4);
+}
