@@ -26,7 +26,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// No segment within the field's margin.
@@ -161,10 +161,28 @@ pub fn far_tile(segments: &Segments, corner: DVec2, w: usize, h: usize, dist: f6
 
 /// Distance fields by shape, shared by the curves of a scene and across the
 /// frames of an editing session.
-#[derive(Debug, Default)]
+///
+/// Bounded: an editor session re-sketches curves for hours, and every shape
+/// it ever drew stayed (a 1024² curve's field and envelopes are ~1–4 MB).
+/// Past [`FieldCache::budget`] bytes the least recently used shapes are
+/// dropped (a scene's own curves are used every edit, so they stay); a
+/// dropped shape is computed again if it comes back.
+#[derive(Debug)]
 pub struct FieldCache {
     fields: Mutex<HashMap<u64, Entry>>,
     computed: AtomicUsize,
+    /// Use counter: an entry's `used` is the count at its last use.
+    clock: AtomicU64,
+    budget: usize,
+}
+
+/// The default [`FieldCache`] budget.
+const FIELD_CACHE_BYTES: usize = 256 << 20;
+
+impl Default for FieldCache {
+    fn default() -> FieldCache {
+        FieldCache::with_budget(FIELD_CACHE_BYTES)
+    }
 }
 
 /// A field and the envelopes last built on it, most recent first, with
@@ -173,11 +191,62 @@ pub struct FieldCache {
 struct Entry {
     field: Arc<DistanceField>,
     envelopes: Vec<([Track; 2], Arc<Envelope>)>,
+    used: u64,
+}
+
+impl Entry {
+    /// Heap bytes held, about: the field's nodes and segments, the
+    /// envelopes' nodes and boundaries (not the segments' grid index).
+    fn bytes(&self) -> usize {
+        let points = |v: &Vec<Vec<DVec2>>| v.iter().map(Vec::len).sum::<usize>();
+        self.field.seg.len() * 4
+            + self.field.segments.len() * std::mem::size_of::<[DVec2; 2]>()
+            + (self.envelopes.iter())
+                .map(|(_, e)| {
+                    e.reach_eff.len() * 4
+                        + (points(&e.smoothed) + points(&e.raw)) * std::mem::size_of::<DVec2>()
+                })
+                .sum::<usize>()
+    }
 }
 
 impl FieldCache {
     pub fn new() -> FieldCache {
         FieldCache::default()
+    }
+
+    /// A cache that keeps at most `budget` bytes of fields and envelopes
+    /// (but always the shape last used).
+    pub fn with_budget(budget: usize) -> FieldCache {
+        FieldCache {
+            fields: Mutex::default(),
+            computed: AtomicUsize::new(0),
+            clock: AtomicU64::new(0),
+            budget,
+        }
+    }
+
+    /// Bytes held now.
+    pub fn bytes(&self) -> usize {
+        let fields = self.fields.lock().expect("not poisoned");
+        fields.values().map(Entry::bytes).sum()
+    }
+
+    fn tick(&self) -> u64 {
+        self.clock.fetch_add(1, Ordering::Relaxed) + 1
+    }
+
+    /// Drops the least recently used entries until the rest fit the
+    /// budget, keeping at least one.
+    fn evict(&self, fields: &mut HashMap<u64, Entry>) {
+        let mut total: usize = fields.values().map(Entry::bytes).sum();
+        while total > self.budget && fields.len() > 1 {
+            let (&oldest, e) = (fields.iter())
+                .min_by_key(|(_, e)| e.used)
+                .expect("more than one entry");
+            total -= e.bytes();
+            fields.remove(&oldest);
+        }
     }
 
     /// How many fields were computed (cache misses) so far.
@@ -189,10 +258,11 @@ impl FieldCache {
     /// shape was seen with a margin at least as large.
     pub fn get(&self, points: &[DVec2], margin: f64) -> Option<Arc<DistanceField>> {
         let key = shape_key(points);
-        if let Some(e) = self.fields.lock().expect("not poisoned").get(&key)
+        if let Some(e) = self.fields.lock().expect("not poisoned").get_mut(&key)
             && e.field.margin >= margin
             && same_shape(&e.field.segments, points)
         {
+            e.used = self.tick();
             return Some(e.field.clone());
         }
         let f = Arc::new(DistanceField::compute(points, margin)?);
@@ -200,8 +270,11 @@ impl FieldCache {
         let entry = Entry {
             field: f.clone(),
             envelopes: Vec::new(),
+            used: self.tick(),
         };
-        self.fields.lock().expect("not poisoned").insert(key, entry);
+        let mut fields = self.fields.lock().expect("not poisoned");
+        fields.insert(key, entry);
+        self.evict(&mut fields);
         Some(f)
     }
 
@@ -230,13 +303,17 @@ impl FieldCache {
         {
             let hit = e.envelopes.remove(k);
             e.envelopes.insert(0, hit.clone());
+            e.used = self.tick();
             return hit.1;
         }
         // Computed unlocked: other curves of the scene build meanwhile.
         let env = Arc::new(compute());
-        if let Some(e) = kept(&mut self.fields.lock().expect("not poisoned"), key, field) {
+        let mut fields = self.fields.lock().expect("not poisoned");
+        if let Some(e) = kept(&mut fields, key, field) {
             e.envelopes.insert(0, (reach.clone(), env.clone()));
             e.envelopes.truncate(ENVELOPES_PER_FIELD);
+            e.used = self.tick();
+            self.evict(&mut fields);
         }
         env
     }
@@ -350,5 +427,37 @@ mod tests {
         moved[3].x += 0.5;
         c.get(&moved, 10.0).unwrap();
         assert_eq!(c.computed(), 3);
+    }
+
+    #[test]
+    fn cache_drops_the_least_recently_used_shapes_past_its_budget() {
+        let shape = |k: usize| {
+            let mut p = wiggle();
+            p[3].x += k as f64;
+            p
+        };
+        let one = {
+            let c = FieldCache::new();
+            c.get(&shape(0), 10.0).unwrap();
+            c.bytes()
+        };
+        // Room for two shapes of about this size, not three.
+        let c = FieldCache::with_budget(2 * one + one / 2);
+        c.get(&shape(0), 10.0).unwrap();
+        c.get(&shape(1), 10.0).unwrap();
+        c.get(&shape(0), 10.0).unwrap(); // shape 1 is now the oldest
+        c.get(&shape(2), 10.0).unwrap();
+        assert_eq!(c.computed(), 3);
+        assert!(c.bytes() <= 2 * one + one / 2, "{} bytes", c.bytes());
+        c.get(&shape(0), 10.0).unwrap();
+        c.get(&shape(2), 10.0).unwrap();
+        assert_eq!(c.computed(), 3, "shapes 0 and 2 kept");
+        c.get(&shape(1), 10.0).unwrap();
+        assert_eq!(c.computed(), 4, "shape 1 dropped");
+        // A single shape larger than the budget is still kept.
+        let tiny = FieldCache::with_budget(1);
+        tiny.get(&shape(0), 10.0).unwrap();
+        tiny.get(&shape(0), 10.0).unwrap();
+        assert_eq!(tiny.computed(), 1);
     }
 }
