@@ -284,13 +284,18 @@ pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> V
 mod tests {
     use super::*;
 
+    /// The signed distance to a circle of radius `r` centred at (c, c), at
+    /// the nodes of an n² lattice.
+    fn disc(n: usize, c: f64, r: f64) -> Vec<f64> {
+        (0..n * n)
+            .map(|k| DVec2::new((k % n) as f64, (k / n) as f64).distance(DVec2::splat(c)) - r)
+            .collect()
+    }
+
     #[test]
     fn disc_isocurve_is_one_loop_near_the_circle() {
         let (w, h) = (41, 41);
-        let f: Vec<f64> = (0..w * h)
-            .map(|k| DVec2::new((k % w) as f64, (k / w) as f64).distance(DVec2::splat(20.0)) - 12.0)
-            .collect();
-        let loops = isocurves(&f, w, h);
+        let loops = isocurves(&disc(w, 20.0, 12.0), w, h);
         assert_eq!(loops.len(), 1);
         for p in &loops[0] {
             assert!((p.distance(DVec2::splat(20.0)) - 12.0).abs() < 0.1, "{p}");
@@ -310,10 +315,7 @@ mod tests {
         // A disc of radius 30 in an 81² lattice: nodes deep inside and
         // far outside (skipped tiles) and near the boundary.
         let (w, h) = (81, 81);
-        let f: Vec<f64> = (0..w * h)
-            .map(|k| DVec2::new((k % w) as f64, (k / w) as f64).distance(DVec2::splat(40.0)) - 30.0)
-            .collect();
-        let loops = isocurves(&f, w, h);
+        let loops = isocurves(&disc(w, 40.0, 30.0), w, h);
         let d: Vec<f64> = (0..w * h).map(|k| (k % 7) as f64).collect();
         let r = effective_reach(&loops, &d, w, h);
         let mut a = Vec::new();
