@@ -46,9 +46,9 @@
 //! exactly at its own altitude (offset 0), the sea kept its share but its
 //! shores froze where the start put them: straight, axis-aligned cliffs
 //! 100–150 px long. A twelfth keeps the shore mobile and the sea at sea
-//! level (seeds 11–13, exemplar size: median slope olympic 123 → 116 %,
-//! riviera 120 → 113 %, catalan 107 → 106 % with 9 → 7 % of its windows
-//! copied). Where a geometric constraint reaches ([`Prior::held`]) the fit
+//! level (seeds 11–13, exemplar size, with the coarse start's Voronoi
+//! pieces: median slope olympic 123 → 116 %, riviera 120 → 108 %, catalan
+//! 107 → 105 % with 9 → 5 % of its windows copied). Where a geometric constraint reaches ([`Prior::held`]) the fit
 //! keeps [`FLAT`]'s weight: at a twelfth, a point raised over the sea got
 //! a third of its height less and the slope around it flattened (the
 //! 576-px exemplars' point test: least slope 10.5°, 12° asked). (P = 0
@@ -481,9 +481,32 @@ pub fn keep_outside(st: &State, p: &CorrectParams, g: &Guide<'_>) {
 
 #[cfg(test)]
 mod tests {
-    use super::ParentRow;
+    use super::{FLAT, FLAT_FIT, ParentRow, Prior};
     use crate::level::fixed::Coord;
     use crate::level::state::State;
+
+    #[test]
+    fn a_flat_candidate_is_fitted_at_flat_fits_weight_unless_held() {
+        let free = Prior {
+            weight: 4,
+            v: 300,
+            held: false,
+        };
+        let held = Prior { held: true, ..free };
+        let sum1 = 12_000; // the neighbours 1000 units above the candidate
+        // Free: a twelfth of the free lift (1000 / 12 ≈ 83), priced as FLAT.
+        assert_eq!(free.fit(true, None, sum1), (FLAT, FLAT_FIT.optimal(sum1)));
+        assert_eq!(FLAT_FIT.optimal(sum1), 83);
+        // Held by a constraint: FLAT's fit, a third of the lift.
+        assert_eq!(held.fit(true, None, sum1), (FLAT, FLAT.optimal(sum1)));
+        assert_eq!(FLAT.optimal(sum1), 333);
+        // Not flat: the pixel's own prior; a fixed offset wins in both.
+        assert_eq!(free.fit(false, None, sum1), (free, free.optimal(sum1)));
+        assert_eq!(held.fit(true, Some(-7), sum1), (FLAT, -7));
+        assert_eq!(free.fit(false, Some(-7), sum1), (free, -7));
+        assert!(free.is_flat([5, 5, 5, 5]) && !free.is_flat([5, 5, 5, 6]));
+        assert!(!Prior { weight: 0, ..free }.is_flat([5, 5, 5, 5]));
+    }
 
     #[test]
     fn a_row_of_anchors_is_each_pixels_anchor() {

@@ -142,12 +142,14 @@ fn feature(seed: u32, side: i32, (i, j): (i32, i32)) -> (i32, i32) {
     (i * side + side / 2 + off(1), j * side + side / 2 + off(2))
 }
 
-/// The piece texel (x, y) belongs to, and its centre: the nearest
-/// [`feature`] (squared distance; ties to the first in row order) to the
-/// place displaced by a smooth field of up to a third of a side, so the
-/// cells' straight Voronoi edges come out wavy. The displaced place lies
-/// within a cell of (x, y)'s and the nearest centre within a cell of it:
-/// `pieces` takes the cells two around the region.
+/// The piece texel (x, y) belongs to, and its centre: of the features
+/// ([`feature`]) of the 3×3 cells around the place displaced by a smooth
+/// field of up to a third of a side, the nearest (squared distance; ties
+/// to the first in row order), so the cells' straight Voronoi edges come
+/// out wavy. (A feature two cells away can rarely be nearer; leaving it
+/// out keeps the piece a function of the 3×3 alone.) The displaced place
+/// lies within a cell of (x, y)'s and the chosen centre within a cell of
+/// it: `pieces` takes the cells two around the region.
 fn nearest(seed: u32, side: i32, (x, y): (i32, i32)) -> ((i32, i32), (i32, i32)) {
     let amp = side / 3;
     let (wx, wy) = (

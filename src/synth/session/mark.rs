@@ -15,13 +15,15 @@ use rayon::prelude::*;
 const TILE: usize = 8;
 
 /// Marks `W_FREE` in the `w × h` level-0 `weights` where `new`'s samples
-/// differ from `old`'s and either reaches (`old` None: wherever `new`
+/// differ from `old`'s and either reaches (`old` None, or a different
+/// [`Hold`] — a point's level cap goes with its slope — wherever either
 /// reaches). Reads the samples constraints keep ([`Constraint::centres`]);
 /// tile rows in parallel, skipping tiles no sample can reach
 /// ([`Hold::max_reach`], [`Constraint::distance_bound`]) as the blend does.
 /// Sampling old and new serially, tile by tile, this took ~28 ms of an edit
 /// of the editor bench's 820-px curve at 1024².
 ///
+/// [`Hold`]: crate::synth::control::Hold
 /// [`Hold::max_reach`]: crate::synth::control::Hold::max_reach
 pub(super) fn free_changed(
     new: &dyn Constraint,
@@ -31,6 +33,7 @@ pub(super) fn free_changed(
     h: usize,
 ) {
     let sides: Vec<&dyn Constraint> = std::iter::once(new).chain(old).collect();
+    let same_hold = old.is_some_and(|o| o.hold() == new.hold());
     let kept: Vec<_> = sides.iter().map(|c| c.centres()).collect();
     let clip = |v: f64, n: usize| (v.floor().max(0.0) as usize).min(n);
     let [x0, y0, x1, y1] = sides
@@ -79,7 +82,7 @@ pub(super) fn free_changed(
                             1 => within(a),
                             _ => {
                                 let b = sample(1, x, ty + j);
-                                (within(a) || within(b)) && bits(a) != bits(b)
+                                (within(a) || within(b)) && (!same_hold || bits(a) != bits(b))
                             }
                         };
                         if free {
@@ -140,7 +143,8 @@ mod tests {
                     None => within(a),
                     Some(o) => {
                         let b = o.sample(fx, fy);
-                        (within(a) || within(b)) && format!("{a:?}") != format!("{b:?}")
+                        (within(a) || within(b))
+                            && (o.hold() != new.hold() || format!("{a:?}") != format!("{b:?}"))
                     }
                 };
                 if free {
@@ -194,5 +198,18 @@ mod tests {
             *w = (*w).max(v);
         }
         assert!(want == both);
+    }
+
+    #[test]
+    fn a_changed_hold_frees_the_whole_reach() {
+        // A level point (level cap 4) made sloped (no cap): along the line
+        // through the site across the slope the samples are the same, but
+        // how the constraint holds them is not.
+        let p = |slope| PointConstraint::new((60.5, 50.5), 50.0, 0.0, slope, 18.0, 30.0).unwrap();
+        let (level, sloped) = (p(0.0), p(0.2));
+        assert_ne!(level.hold(), sloped.hold());
+        let want = brute(&sloped, Some(&level));
+        assert!(marked(&sloped, Some(&level)) == want);
+        assert!(want == brute(&sloped, None), "the whole reach");
     }
 }
