@@ -1,6 +1,9 @@
 //! A minimal blocking HTTP/1.1 client for the editor's tests: it sends
 //! exactly the bytes a test asks for (malformed requests included) to
 //! 127.0.0.1 and reads the whole answer (the server closes the connection).
+//! Also the load bench's client (`benches/editor_load.rs`), which uses a part
+//! of it.
+#![allow(dead_code)]
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpStream};
