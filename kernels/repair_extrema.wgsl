@@ -22,7 +22,7 @@ struct ReconstructParams {
 @group(0) @binding(6) var<storage, read_write> out: array<i32>;
 
 // repair_extrema::SUPPORT.
-const SUPPORT: u32 = 5u;
+const SUPPORT: u32 = 6u;
 
 fn height(i: i32) -> i32 {
     let u = u32(i);

@@ -15,7 +15,7 @@
 //! `t`'s eight neighbours that are higher than it (lower, for a peak), its
 //! *support*:
 //! - 8: the exemplar has the pit there too; it stays;
-//! - ≥ [`SUPPORT`] (more than half): `t` lies in a hollow, where a join's
+//! - ≥ [`SUPPORT`] (three in four): `t` lies in a hollow, where a join's
 //!   pit is plausible terrain (plains are full of them, and removing them
 //!   left the north German plain with 0.68× of its pits) — the pixel takes
 //!   the plain mean of the nine neighbours' whole predictions instead, the
@@ -34,11 +34,19 @@ use crate::level::fixed::div_floor;
 
 /// Support (of 8) from which a spurious extremum's texel counts as a hollow
 /// (a rise) and the pixel takes the mean of its neighbours' predictions
-/// rather than its neighbours' bound. Measured (seeds 11–13 and 14–29, all
-/// 8 shared DEMs): 4 kept too many join pits on steep ground (yosemite
-/// 1.61×), 6 too few on the plain (north German plain ratio 1.31); 5, the
-/// majority, keeps both within bounds.
-pub const SUPPORT: u32 = 5;
+/// rather than its neighbours' bound.
+///
+/// Measured (seeds 11–13, single-exemplar databases at the exemplar's
+/// size): at 5, yosemite kept 1.56× its DEM's pits — the dimples of joins
+/// on its flat valley floors, whose texels lie in hollows more than half
+/// the time — and failed the 1.5× target at 1× and 3×. At 6 it keeps
+/// 1.11×, and the realism ratio drops on yosemite (1.04 → 0.80) and the
+/// pyrenees (0.96 → 0.51, pits 1.20× → 1.03×); the north German plain,
+/// full of real pits, keeps 0.80× of them (0.82× at 5; its ratio 1.57 →
+/// 1.61), olympic 0.64× (0.71×). At 7 yosemite falls to 0.54× and the
+/// plain to 0.76×. (With the engine of the time, 4 kept 1.61× on
+/// yosemite and 6 left the plain's ratio at 1.31.)
+pub const SUPPORT: u32 = 6;
 
 /// The repaired height of an interior pixel whose blended height is `c`
 /// and whose eight neighbours' blended heights lie in `(lo, hi)` (least,
