@@ -154,29 +154,23 @@ mod tests {
 
     #[test]
     fn a_join_pit_in_a_hollow_takes_the_mean_of_the_predictions() {
-        // Higher than the centre: the five neighbours north and west.
-        let higher = |x: i32, y: i32| y == 1 || (x == 1 && y == 2) || (x == 1 && y == 3);
-        let e = exemplar(|x, y| {
-            if higher(x, y) {
-                9
-            } else if (x, y) == (2, 2) {
-                5
-            } else {
-                1
-            }
-        });
-        assert_eq!(repair(&e, -1, (0, 0), texel(), || 42), 42);
-        // Four higher neighbours are a slope, not a hollow.
-        let e = exemplar(|x, y| {
-            if y == 1 || (x, y) == (1, 2) {
-                9
-            } else if (x, y) == (2, 2) {
-                5
-            } else {
-                1
-            }
-        });
-        assert_eq!(repair(&e, -1, (0, 0), texel(), NO_MEAN), 0);
+        // The centre (5) with its first `n` neighbours (in `DELTAS` order)
+        // higher (9), the others lower (1).
+        let with_higher = |n: usize| {
+            exemplar(move |x, y| match (x - 2, y - 2) {
+                (0, 0) => 5,
+                d if DELTAS[1..=n].contains(&d) => 9,
+                _ => 1,
+            })
+        };
+        // Six higher neighbours (three in four): a hollow.
+        assert_eq!(SUPPORT, 6);
+        assert_eq!(repair(&with_higher(6), -1, (0, 0), texel(), || 42), 42);
+        assert_eq!(repair(&with_higher(7), -1, (0, 0), texel(), || 42), 42);
+        // Five are a slope, not a hollow (yosemite's flat valley floors
+        // kept 1.56× its pits when five were a hollow): raised.
+        assert_eq!(repair(&with_higher(5), -1, (0, 0), texel(), NO_MEAN), 0);
+        assert_eq!(repair(&with_higher(4), -1, (0, 0), texel(), NO_MEAN), 0);
     }
 
     #[test]
