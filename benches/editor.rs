@@ -67,6 +67,10 @@ const KINDS: &[(&str, &str)] = &[
         "await ed.api.idle(); ed.change(d => { const x = S*0.15 + k*S*0.1; d.pastes.push({source: 'terrain', lasso: [[x, S*0.7], [x + S*0.06, S*0.7], [x + S*0.03, S*0.76]], to: [x + S*0.05, S*0.85], delta_m: 30}); }, {kind: 'setup'}); await ed.api.idle(); await ed.undo(); await ed.api.idle(); await ed.redo();",
     ),
     (
+        "delete a paste (the earlier of two)",
+        "await ed.api.idle(); ed.change(d => { const x = S*0.1 + k*S*0.1; for (const y of [0.3, 0.45]) d.pastes.push({source: 'terrain', lasso: [[x, S*y], [x + S*0.06, S*y], [x + S*0.03, S*(y + 0.06)]], to: [x + S*0.05, S*(y + 0.1)], delta_m: 30}); }, {kind: 'setup'}); await ed.api.idle(); ed.change(d => { d.pastes.splice(d.pastes.length - 2, 1); }, {kind: 'paste'});",
+    ),
+    (
         "curve widget, last of 7 (height ±100 m)",
         "if (k == 0) { await ed.api.idle(); ed.change(d => { const r = ed.range(); d.curves.push({id: 'm', points: [[S*0.1, S*0.93], [S*0.5, S*0.96], [S*0.9, S*0.92]], smoothing: 2, widgets: [0, 1, 2, 3, 4, 5, 6].map(i => ({at: i / 6, height_m: r.lo + (0.3 + 0.05 * i) * (r.hi - r.lo), slope_deg: [-20, -20], reach_px: [S*0.03, S*0.03]}))}); }, {kind: 'setup'}); await ed.api.idle(); } ed.change(d => { d.curves.find(c => c.id == 'm').widgets[6].height_m += (k % 2 ? 100 : -100); }, {kind: 'curve-widget'});",
     ),

@@ -279,13 +279,17 @@ impl Editor {
 
     /// Swaps in a kept state that has `scene`'s pastes when the shown one
     /// has other pastes (undo, redo or delete of a paste): no synthesis,
-    /// where a new session or the paste would take one. The state left is
-    /// kept in its place (redo swaps it back). True when it swapped.
+    /// where a new session or the paste would take one. When none has
+    /// them and the shown state holds a paste `scene` lacks (a paste
+    /// deleted before the last one), the kept state with most of `scene`'s
+    /// first pastes: the edits then paste the rest again. The state left
+    /// is kept in its place (redo swaps it back). True when it swapped.
     fn restore(&mut self, scene: &Scene) -> bool {
         if self.stale || self.scene.pastes == scene.pastes {
             return false;
         }
-        match self.checkpoints.take(scene) {
+        let shown_fits = scene.pastes.starts_with(&self.scene.pastes);
+        match self.checkpoints.take(scene, !shown_fits) {
             Some(c) => self.swap_in(c),
             None => false,
         }
