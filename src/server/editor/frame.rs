@@ -210,7 +210,10 @@ impl Editor {
             self.heightfield = Arc::new(frame.heightfield);
             self.checkpoints.clear();
         } else {
-            if scene.pastes.len() > self.scene.pastes.len() {
+            // After a swap (a paste deleted before the last one, the later
+            // ones pasted again) the newest kept state must stay the one
+            // shown before, which an error below swaps back.
+            if !self.restored && scene.pastes.len() > self.scene.pastes.len() {
                 let t = Instant::now();
                 self.keep();
                 self.timing.keep += t.elapsed();
