@@ -1,6 +1,6 @@
 //! `terrasynth serve`, the editor (feature `serve`): its JSON API, limits
 //! and memory, undo of pastes, and the page itself in headless Chromium
-//! (browser, export, sculpt, tabs, autosave, 3D view;
+//! (browser, banners, export, sculpt, tabs, autosave, 3D view;
 //! `TERRASYNTH_REQUIRE_BROWSER` turns "no browser, skipped" into a
 //! failure). One target, so the editor's tests share one build.
 #![cfg(feature = "serve")]
@@ -10,6 +10,7 @@ mod common;
 
 mod api;
 mod autosave;
+mod banners;
 mod browser;
 mod export;
 mod limits;
