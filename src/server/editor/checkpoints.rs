@@ -110,19 +110,16 @@ impl Checkpoints {
     /// The caller asks for it only when the shown state cannot take the
     /// document's pastes itself (it has one the document lacks).
     pub fn take(&mut self, scene: &Scene, prefix: bool) -> Option<Checkpoint> {
+        // A state `scene` can be an edit of has a prefix of its pastes, so
+        // the most pastes are all of them where such a state is kept.
         let fits =
             |c: &Checkpoint| crate::server::document::rebuild_reason(&c.scene, scene).is_none();
-        let exact = self
-            .kept
-            .iter()
-            .rposition(|c| c.scene.pastes == scene.pastes && fits(c));
-        let k = match exact {
-            Some(k) => k,
-            None if prefix => (0..self.kept.len())
-                .filter(|&k| fits(&self.kept[k]))
-                .max_by_key(|&k| (self.kept[k].scene.pastes.len(), k))?,
-            None => return None,
-        };
+        let k = (0..self.kept.len())
+            .filter(|&k| fits(&self.kept[k]))
+            .max_by_key(|&k| (self.kept[k].scene.pastes.len(), k))?;
+        if !prefix && self.kept[k].scene.pastes != scene.pastes {
+            return None;
+        }
         let c = self.kept.remove(k)?;
         self.bytes -= c.bytes;
         Some(c)
