@@ -194,17 +194,14 @@ fn score_with(ns: Hood, qx: i32, qy: i32, kappa: u32, fixed: bool, fixed_h: i32)
     let d3 = ns.d - 3 * m3;
     let sum1 = d0.x + d1.x + d2.x + d3.x;
     // Prior::is_flat and Prior::fit: a flat candidate's offset is fitted
-    // with FLAT_FIT's weight (FLAT's where a constraint holds the pixel)
-    // and priced with FLAT's, towards 0.
+    // with FLAT_FIT's weight and priced with FLAT's, towards 0 — unless a
+    // constraint holds the pixel, where it is any candidate.
     var w = i32(p.prior);
     var fit_w = w;
     var anchor = prior_v;
-    if (w > 0 && m0.x == m1.x && m0.x == m2.x && m0.x == m3.x) {
+    if (w > 0 && !prior_held && m0.x == m1.x && m0.x == m2.x && m0.x == m3.x) {
         w = FLAT_WEIGHT;
         fit_w = FLAT_FIT_WEIGHT;
-        if (prior_held) {
-            fit_w = FLAT_WEIGHT;
-        }
         anchor = 0;
     }
     // Prior::optimal and Prior::cost.

@@ -48,11 +48,16 @@
 //! 100–150 px long. A twelfth keeps the shore mobile and the sea at sea
 //! level (seeds 11–13, exemplar size, with the coarse start's Voronoi
 //! pieces: median slope olympic 123 → 116 %, riviera 120 → 108 %, catalan
-//! 107 → 105 % with 9 → 5 % of its windows copied). Where a geometric constraint reaches ([`Prior::held`]) the fit
-//! keeps [`FLAT`]'s weight: at a twelfth, a point raised over the sea got
-//! a third of its height less and the slope around it flattened (the
-//! 576-px exemplars' point test: least slope 10.5°, 12° asked). (P = 0
-//! keeps the paper's rule for every candidate.)
+//! 107 → 105 % with 9 → 5 % of its windows copied). Where a geometric
+//! constraint reaches ([`Prior::held`]) a flat candidate is any candidate,
+//! fitted and priced by the pixel's own prior: the constraint's nudge is
+//! in the parent's offset, and both flat priors pull towards offset 0, so
+//! the sea under a raised point stayed down — at a twelfth, the 576-px
+//! exemplars' point test's least slope fell to 10.5° with 12° asked; with
+//! [`FLAT`]'s weight a point raised 633 m over the sea got 371 m (10.3 %
+//! of relief off; with the pixel's prior 604 m, 1.2 %, and that test's
+//! mean error 1.42 → 0.95 %, least slope 12.0 → 13.7°). (P = 0 keeps the
+//! paper's rule for every candidate.)
 //!
 //! Integer arithmetic (DESIGN §6), identical in the WGSL mirror:
 //! - N_S is kept as the *sum* of its three vectors (×3) so no division is
@@ -217,9 +222,9 @@ pub struct Prior {
     pub weight: u32,
     pub v: i32,
     /// Whether a geometric constraint reaches the pixel (its target's
-    /// tolerance ≥ 0): there a flat candidate is fitted with [`FLAT`]'s
-    /// weight, not [`FLAT_FIT`]'s, so the sea can still be lifted (or
-    /// lowered) to a constraint's target.
+    /// tolerance ≥ 0): there a flat candidate is any candidate (this
+    /// prior fits and prices it), so the sea can be lifted (or lowered) to
+    /// a constraint's target.
     pub held: bool,
 }
 
@@ -282,12 +287,12 @@ impl Prior {
 
     /// The prior that scores a candidate (`flat` from [`Prior::is_flat`])
     /// and its offset: the one `fixed` by a constraint, else the closed
-    /// form [`Prior::optimal`] — [`FLAT_FIT`]'s for a flat candidate.
+    /// form [`Prior::optimal`] — [`FLAT_FIT`]'s for a flat candidate where
+    /// no constraint holds the pixel.
     #[inline(always)]
     pub fn fit(self, flat: bool, fixed: Option<i32>, sum1: i32) -> (Prior, i32) {
-        if flat {
-            let fit = if self.held { FLAT } else { FLAT_FIT };
-            (FLAT, fixed.unwrap_or_else(|| fit.optimal(sum1)))
+        if flat && !self.held {
+            (FLAT, fixed.unwrap_or_else(|| FLAT_FIT.optimal(sum1)))
         } else {
             (self, fixed.unwrap_or_else(|| self.optimal(sum1)))
         }
@@ -497,12 +502,15 @@ mod tests {
         // Free: a twelfth of the free lift (1000 / 12 ≈ 83), priced as FLAT.
         assert_eq!(free.fit(true, None, sum1), (FLAT, FLAT_FIT.optimal(sum1)));
         assert_eq!(FLAT_FIT.optimal(sum1), 83);
-        // Held by a constraint: FLAT's fit, a third of the lift.
-        assert_eq!(held.fit(true, None, sum1), (FLAT, FLAT.optimal(sum1)));
-        assert_eq!(FLAT.optimal(sum1), 333);
-        // Not flat: the pixel's own prior; a fixed offset wins in both.
+        // Held by a constraint: any candidate, fitted and priced by the
+        // pixel's own prior towards the parent's offset (which carries the
+        // constraint's nudge): (12 000 + 12·300 + 12) / 24 = 650.
+        assert_eq!(held.fit(true, None, sum1), (held, held.optimal(sum1)));
+        assert_eq!(held.optimal(sum1), 650);
+        // Not flat: the pixel's own prior; a fixed offset wins in every case.
         assert_eq!(free.fit(false, None, sum1), (free, free.optimal(sum1)));
-        assert_eq!(held.fit(true, Some(-7), sum1), (FLAT, -7));
+        assert_eq!(held.fit(true, Some(-7), sum1), (held, -7));
+        assert_eq!(free.fit(true, Some(-7), sum1), (FLAT, -7));
         assert_eq!(free.fit(false, Some(-7), sum1), (free, -7));
         assert!(free.is_flat([5, 5, 5, 5]) && !free.is_flat([5, 5, 5, 6]));
         assert!(!Prior { weight: 0, ..free }.is_flat([5, 5, 5, 5]));
