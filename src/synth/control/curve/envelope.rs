@@ -22,7 +22,7 @@
 //!   and the clamp keeps the search local (envelope rebuild of a 1024-px
 //!   meander, reach 60 px: 578 → 304 ms on 2 cores, `benches/curve.rs`).
 
-use super::field::{DistanceField, NONE, TILE, far_tile, tiles};
+use super::field::{DistanceField, NONE, TILE, tiles};
 use super::segments::{Hit, Segments};
 use glam::DVec2;
 use rayon::prelude::*;
@@ -227,8 +227,9 @@ pub const BAND: f64 = 16.0;
 
 /// Effective reach per node: `d + s`, `s` the signed distance to `loops`
 /// (lattice coordinates; positive inside by the even-odd rule) clamped to
-/// ±[`BAND`]; tile rows in parallel, tiles all farther than [`BAND`] from
-/// the loops taking ±[`BAND`] without a query each ([`far_tile`]).
+/// ±[`BAND`]; tile rows in parallel, each node comparing its tile's
+/// candidate segments ([`Segments::tile_candidates`]; tiles all farther
+/// than [`BAND`] from the loops take ±[`BAND`] without a query).
 pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> Vec<f32> {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for lp in loops {
@@ -243,9 +244,15 @@ pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> V
         .enumerate()
         .for_each(|(t, rows)| {
             let (j0, n) = (t * TILE, rows.len() / w);
-            // Tiles all farther than BAND from the boundary: s = ±BAND.
-            let far: Vec<bool> = tiles(w)
-                .map(|(i0, i1)| far_tile(&segs, DVec2::new(i0 as f64, j0 as f64), i1 - i0, n, BAND))
+            // Each tile's candidate segments; none for tiles all farther
+            // than BAND from the boundary: s = ±BAND.
+            let near: Vec<Option<Vec<u32>>> = tiles(w)
+                .map(|(i0, i1)| {
+                    let mut c = Vec::new();
+                    let corner = DVec2::new(i0 as f64, j0 as f64);
+                    segs.tile_candidates(corner, (i1 - i0, n), BAND, &mut c)
+                        .then_some(c)
+                })
                 .collect();
             for (dj, row) in rows.chunks_mut(w).enumerate() {
                 let j = j0 + dj;
@@ -267,10 +274,10 @@ pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> V
                         continue;
                     }
                     let inside = xs.partition_point(|&c| c <= x) % 2 == 1;
-                    let s = match far[i / TILE] {
-                        true => BAND,
-                        false => segs
-                            .closest(DVec2::new(x, y), BAND)
+                    let s = match &near[i / TILE] {
+                        None => BAND,
+                        Some(c) => segs
+                            .closest_among(c, DVec2::new(x, y), BAND)
                             .map_or(BAND, |h| h.dist),
                     };
                     *slot = (di + if inside { s } else { -s }) as f32;

@@ -52,7 +52,8 @@ pub struct DistanceField {
 
 impl DistanceField {
     /// Computes the field around `points` (resampled) out to `margin` pixels,
-    /// tile rows in parallel, tiles beyond the margin skipped ([`far_tile`]).
+    /// tile rows in parallel, each node comparing its tile's candidates
+    /// ([`Segments::tile_candidates`]; none for tiles beyond the margin).
     /// `None` when the lattice would exceed [`MAX_NODES`].
     pub fn compute(points: &[DVec2], margin: f64) -> Option<DistanceField> {
         let segments = Segments::polyline(points, false);
@@ -75,13 +76,16 @@ impl DistanceField {
             .enumerate()
             .for_each(|(t, rows)| {
                 let j0 = t * TILE;
+                let mut near = Vec::new();
                 for (i0, i1) in tiles(width) {
-                    if far_tile(&segments, node(i0, j0), i1 - i0, rows.len() / width, margin) {
+                    let tile = (i1 - i0, rows.len() / width);
+                    if !segments.tile_candidates(node(i0, j0), tile, margin, &mut near) {
                         continue;
                     }
                     for (j, row) in rows.chunks_mut(width).enumerate() {
                         for (i, slot) in row.iter_mut().enumerate().take(i1).skip(i0) {
-                            if let Some(h) = segments.closest(node(i, j0 + j), margin) {
+                            if let Some(h) = segments.closest_among(&near, node(i, j0 + j), margin)
+                            {
                                 *slot = h.seg;
                             }
                         }
@@ -133,8 +137,8 @@ impl DistanceField {
 /// (undo, redo) while heights change freely.
 const ENVELOPES_PER_FIELD: usize = 4;
 
-/// Side of the tiles of lattice nodes tested at once for lying beyond a
-/// distance ([`far_tile`]).
+/// Side of the tiles of lattice nodes that share their candidate segments
+/// ([`Segments::tile_candidates`]).
 pub const TILE: usize = 8;
 
 /// Column ranges `[i0, i1)` of the tiles of a `width`-node row.
@@ -142,21 +146,6 @@ pub fn tiles(width: usize) -> impl Iterator<Item = (usize, usize)> {
     (0..width)
         .step_by(TILE)
         .map(move |i0| (i0, (i0 + TILE).min(width)))
-}
-
-/// Whether every node of the `w × h` tile of lattice nodes whose first
-/// node is at `corner` lies farther than `dist` from every segment (so
-/// [`Segments::closest`] within `dist` finds nothing for any of them): its
-/// centre does by more than the half-diagonal (and a pixel of slack for
-/// rounding). One query instead of `w·h` that each search out to `dist`:
-/// nodes far from the curve are the costliest to query, and at the
-/// corners of a curve's lattice most are.
-pub fn far_tile(segments: &Segments, corner: DVec2, w: usize, h: usize, dist: f64) -> bool {
-    let (a, b) = ((w - 1) as f64, (h - 1) as f64);
-    let centre = corner + DVec2::new(a, b) / 2.0;
-    segments
-        .closest(centre, dist + a.hypot(b) / 2.0 + 1.0)
-        .is_none()
 }
 
 /// Distance fields by shape, shared by the curves of a scene and across the
@@ -396,7 +385,7 @@ mod tests {
     }
 
     #[test]
-    fn skipping_far_tiles_changes_no_node() {
+    fn tile_candidates_change_no_node() {
         let pts = wiggle();
         for margin in [3.0, 12.0, 40.0] {
             let f = DistanceField::compute(&pts, margin).unwrap();

@@ -191,6 +191,54 @@ impl Segments {
         best.filter(|h| h.dist <= max_dist)
     }
 
+    /// The segments that can be the closest, within `dist`, to any node of
+    /// the `w × h` tile of lattice nodes whose first node is at `corner`,
+    /// into `out` (ascending); false (and `out` empty) when every node of
+    /// the tile lies farther than `dist` from every segment.
+    ///
+    /// Why: a node's own [`Segments::closest`] visits every bucket out to
+    /// its distance, so nodes far from the curve were the costliest (89 %
+    /// of building a 1024² curve's field). A node p within h (the tile's
+    /// half-diagonal) of the centre c has its closest segment at most
+    /// d(c) + h away, hence within d(c) + 2h of c: one query and one gather
+    /// per tile, and each node compares only those — the same segment as
+    /// its own query, ties included.
+    pub fn tile_candidates(
+        &self,
+        corner: DVec2,
+        (w, h): (usize, usize),
+        dist: f64,
+        out: &mut Vec<u32>,
+    ) -> bool {
+        out.clear();
+        let (a, b) = ((w - 1) as f64, (h - 1) as f64);
+        let half = a.hypot(b) / 2.0;
+        let centre = corner + DVec2::new(a, b) / 2.0;
+        // A pixel of slack for rounding, in both bounds.
+        let Some(near) = self.closest(centre, dist + half + 1.0) else {
+            return false;
+        };
+        let r = near.dist + 2.0 * half + 1.0;
+        self.near_box(centre - DVec2::splat(r), centre + DVec2::splat(r), out);
+        out.retain(|&s| self.project(s, centre).dist <= r);
+        true
+    }
+
+    /// The closest of `candidates` (ascending, from
+    /// [`Segments::tile_candidates`]) to `p` within `max_dist`: ties
+    /// toward the lowest index, as [`Segments::closest`].
+    #[inline]
+    pub fn closest_among(&self, candidates: &[u32], p: DVec2, max_dist: f64) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        for &s in candidates {
+            let h = self.project(s, p);
+            if best.is_none_or(|b| h.dist < b.dist) {
+                best = Some(h);
+            }
+        }
+        best.filter(|h| h.dist <= max_dist)
+    }
+
     /// Indices of segments whose bucket overlaps the box `[lo, hi]`.
     pub fn near_box(&self, lo: DVec2, hi: DVec2, out: &mut Vec<u32>) {
         out.clear();
@@ -241,6 +289,30 @@ mod tests {
             prop_assert_eq!(h, brute(&s, p));
             // A limit below the distance finds nothing.
             prop_assert!(s.closest(p, h.dist * 0.5 - 1e-9).is_none() || h.dist == 0.0);
+        }
+
+        /// Every node of a tile finds among its tile's candidates what its
+        /// own query finds (and nothing where the tile has none), for
+        /// tiles near, across and far from the polyline.
+        #[test]
+        fn tile_candidates_hold_every_nodes_closest_segment(
+            pts in proptest::collection::vec((-40.0f64..40.0, -40.0f64..40.0), 2..30),
+            corner in (-90i32..70, -90i32..70),
+            size in (1usize..12, 1usize..12),
+            dist in 0.5f64..60.0,
+        ) {
+            let pts: Vec<DVec2> = pts.into_iter().map(|(x, y)| DVec2::new(x, y)).collect();
+            let s = Segments::polyline(&pts, false);
+            let corner = DVec2::new(corner.0 as f64, corner.1 as f64);
+            let mut c = Vec::new();
+            let any = s.tile_candidates(corner, size, dist, &mut c);
+            prop_assert_eq!(any, !c.is_empty());
+            for j in 0..size.1 {
+                for i in 0..size.0 {
+                    let p = corner + DVec2::new(i as f64, j as f64);
+                    prop_assert_eq!(s.closest_among(&c, p, dist), s.closest(p, dist), "node {}", p);
+                }
+            }
         }
     }
 }
