@@ -9,10 +9,11 @@
 //! the function the tools call), one at a time (the page idle in between,
 //! so nothing is coalesced), and repeated; the table gives medians. It is
 //! printed and written to `target/editor-latency.md`. Without Chromium the
-//! bench says so and measures nothing. The last two kinds come last as
+//! bench says so and measures nothing. The last three kinds come last as
 //! they add curves: one with 7 widgets (changing its last widget's height
-//! moves only the end of its profile, so only that is re-synthesized) and
-//! short new ones (a new shape: its field and envelope are computed).
+//! moves only the end of its profile, so only that is re-synthesized),
+//! long new ones and short new ones (a new shape: its field and envelope
+//! are computed).
 
 #[path = "../tests/common/browser.rs"]
 mod browser;
@@ -73,6 +74,10 @@ const KINDS: &[(&str, &str)] = &[
     (
         "curve widget, last of 7 (height ±100 m)",
         "if (k == 0) { await ed.api.idle(); ed.change(d => { const r = ed.range(); d.curves.push({id: 'm', points: [[S*0.1, S*0.93], [S*0.5, S*0.96], [S*0.9, S*0.92]], smoothing: 2, widgets: [0, 1, 2, 3, 4, 5, 6].map(i => ({at: i / 6, height_m: r.lo + (0.3 + 0.05 * i) * (r.hi - r.lo), slope_deg: [-20, -20], reach_px: [S*0.03, S*0.03]}))}); }, {kind: 'setup'}); await ed.api.idle(); } ed.change(d => { d.curves.find(c => c.id == 'm').widgets[6].height_m += (k % 2 ? 100 : -100); }, {kind: 'curve-widget'});",
+    ),
+    (
+        "sketch a new long curve (~80 % of the side)",
+        "ed.change(d => { const r = ed.range(); const y = S*(0.12 + 0.05*k); d.curves.push({id: 'l' + k, points: [[S*0.1, y], [S*0.5, y + S*0.04], [S*0.9, y - S*0.02]], smoothing: 2, widgets: [{at: 0.5, height_m: (r.lo + r.hi) / 2, slope_deg: [-20, -20], reach_px: [S*0.03, S*0.03]}]}); }, {kind: 'curve-sketch'});",
     ),
     (
         "sketch a new curve (~100 px)",
