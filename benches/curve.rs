@@ -5,7 +5,10 @@
 //! reach and `curve/height/1024` with new heights — both reuse the cached
 //! distance field, as an edit does — and `curve/blend/1024` adds it to the
 //! overlap blend of every level and subtracts it again (what an edit of
-//! the curve does to the blend's running sums).
+//! the curve does to the blend's running sums). `curve/embed-long/1024`
+//! builds the editor bench's new long stroke from scratch (three points
+//! across 80 % of the side, reach 3 % of it): what sketching one costs
+//! before its synthesis.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec2;
@@ -43,6 +46,23 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("embed/1024", |b| {
         b.iter(|| build(&[spec(1000.0, 60.0)], &[], 30.0, &FieldCache::new()).unwrap())
+    });
+    let long = CurveSpec {
+        points: vec![
+            DVec2::new(102.4, 200.0),
+            DVec2::new(512.0, 241.0),
+            DVec2::new(921.6, 179.5),
+        ],
+        widgets: vec![Widget {
+            at: 0.5,
+            height_m: 1000.0,
+            slope_deg: [-20.0, -20.0],
+            reach_px: [30.72, 30.72],
+        }],
+        smoothing: 2,
+    };
+    g.bench_function("embed-long/1024", |b| {
+        b.iter(|| build(std::slice::from_ref(&long), &[], 30.0, &FieldCache::new()).unwrap())
     });
     let cache = FieldCache::new();
     build(&[spec(1000.0, 80.0)], &[], 30.0, &cache).unwrap();
