@@ -28,6 +28,11 @@ pub struct Centres {
 }
 
 impl Centres {
+    /// Heap bytes of the samples.
+    pub fn bytes(&self) -> usize {
+        self.samples.len() * size_of::<Option<Sample>>()
+    }
+
     /// Samples of `c` at the centres of the (non-negative) pixels within its
     /// bounds, rows in parallel; None past [`MAX_PIXELS`].
     pub fn new(c: &dyn Constraint) -> Option<Centres> {

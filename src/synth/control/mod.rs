@@ -67,6 +67,13 @@ pub trait Constraint: Send + Sync + std::fmt::Debug {
     fn centres(&self) -> Option<&Centres> {
         None
     }
+    /// Heap bytes it holds, about (its kept samples, a curve's distance
+    /// field and envelope): what a session state keeping it costs beyond
+    /// its rasters. Shared buffers count in full for every holder, so the
+    /// sum over states bounds what they hold.
+    fn bytes(&self) -> usize {
+        0
+    }
 }
 
 /// How tightly a geometric constraint holds the terrain (see [`blend`]).

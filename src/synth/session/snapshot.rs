@@ -13,7 +13,13 @@
 //! A snapshot is a copy of every per-pixel buffer the session keeps (~42 B
 //! per output pixel without constraints, ~84 B with them: 44–88 MB at
 //! 1024², measured); [`Snapshot::bytes`] says how much, so a keeper can
-//! bound it.
+//! bound it. It counts the constraints' own buffers too (a curve's kept
+//! samples, distance field and envelope, [`Constraint::bytes`]: ~1.3 MB for
+//! a 256-px curve, ~6 MB for an 820-px one at 1024²): a snapshot shares
+//! them with the session, but one kept across an edit of a curve is what
+//! keeps the old curve alive.
+//!
+//! [`Constraint::bytes`]: crate::synth::control::Constraint::bytes
 
 use super::Session;
 use crate::heightfield::Heightfield;
@@ -79,6 +85,11 @@ fn bytes_of(
     });
     let raster = |m: Option<usize>| m.unwrap_or(0);
     frames
+        + controls
+            .constraints
+            .values()
+            .map(|c| c.bytes())
+            .sum::<usize>()
         + guides.as_ref().map_or(0, guide_bytes)
         + pasted.iter().map(Vec::len).sum::<usize>()
         + raster(controls.types.as_ref().map(Vec::len))
@@ -147,5 +158,54 @@ impl Session<'_> {
         std::mem::swap(&mut self.pasted, &mut s.pasted);
         std::mem::swap(&mut self.last, &mut s.last);
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bytes_of;
+    use crate::database::Quantization;
+    use crate::synth::control::curve::{CurveSpec, FieldCache, Widget, build};
+    use crate::synth::control::{Blend, Constraint, ConstraintId, Controls};
+    use glam::DVec2;
+    use std::sync::Arc;
+
+    #[test]
+    fn a_states_bytes_count_its_constraints_samples_field_and_envelope() {
+        let spec = CurveSpec {
+            points: vec![
+                DVec2::new(20.0, 60.0),
+                DVec2::new(140.0, 130.0),
+                DVec2::new(240.0, 190.0),
+            ],
+            widgets: vec![Widget {
+                at: 0.5,
+                height_m: 900.0,
+                slope_deg: [10.0, 10.0],
+                reach_px: [24.0, 24.0],
+            }],
+            smoothing: 2,
+        };
+        let (mut curves, _) = build(&[spec], &[], 30.0, &FieldCache::new()).unwrap();
+        let curve = curves.remove(0);
+        let without = curve.bytes();
+        let samples = curve.centres().expect("kept").bytes();
+        assert_eq!(curve.bytes(), without + samples, "the samples, once taken");
+        assert!(samples > 256 * 100 * 32, "{samples}");
+        let blend = Blend::new(
+            256,
+            256,
+            3,
+            Quantization {
+                offset_m: 0.0,
+                scale_m: 0.05,
+            },
+        );
+        let mut controls = Controls::default();
+        let empty = bytes_of(&controls, &blend, &None, &None, &[], &None);
+        let curve: Arc<dyn Constraint> = Arc::new(curve);
+        controls.constraints.insert(ConstraintId(1), curve.clone());
+        let held = bytes_of(&controls, &blend, &None, &None, &[], &None);
+        assert_eq!(held - empty, curve.bytes());
     }
 }

@@ -43,6 +43,12 @@ pub struct Envelope {
 }
 
 impl Envelope {
+    /// Heap bytes held, about: the nodes' reach and the boundaries.
+    pub fn bytes(&self) -> usize {
+        let points = |v: &Vec<Vec<DVec2>>| v.iter().map(Vec::len).sum::<usize>();
+        self.reach_eff.len() * 4 + (points(&self.smoothed) + points(&self.raw)) * size_of::<DVec2>()
+    }
+
     /// Raw envelope `d − reach` per node of `f` (`reach` of a node's
     /// closest point), its isocurve, the isocurve smoothed with `sigma`,
     /// and the effective reach; rows in parallel.

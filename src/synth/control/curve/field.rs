@@ -51,6 +51,12 @@ pub struct DistanceField {
 }
 
 impl DistanceField {
+    /// Heap bytes held, about: the nodes and the segments (not the
+    /// segments' grid index).
+    pub fn bytes(&self) -> usize {
+        self.seg.len() * 4 + self.segments.len() * size_of::<[DVec2; 2]>()
+    }
+
     /// Computes the field around `points` (resampled) out to `margin` pixels,
     /// tile rows in parallel, each node comparing its tile's candidates
     /// ([`Segments::tile_candidates`]; none for tiles beyond the margin).
@@ -184,18 +190,9 @@ struct Entry {
 }
 
 impl Entry {
-    /// Heap bytes held, about: the field's nodes and segments, the
-    /// envelopes' nodes and boundaries (not the segments' grid index).
+    /// Heap bytes held, about: the field's and the envelopes'.
     fn bytes(&self) -> usize {
-        let points = |v: &Vec<Vec<DVec2>>| v.iter().map(Vec::len).sum::<usize>();
-        self.field.seg.len() * 4
-            + self.field.segments.len() * std::mem::size_of::<[DVec2; 2]>()
-            + (self.envelopes.iter())
-                .map(|(_, e)| {
-                    e.reach_eff.len() * 4
-                        + (points(&e.smoothed) + points(&e.raw)) * std::mem::size_of::<DVec2>()
-                })
-                .sum::<usize>()
+        self.field.bytes() + self.envelopes.iter().map(|(_, e)| e.bytes()).sum::<usize>()
     }
 }
 

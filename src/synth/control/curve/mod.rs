@@ -409,6 +409,11 @@ impl Constraint for Curve {
         self.centres.get_or_init(|| Centres::new(self)).as_ref()
     }
 
+    fn bytes(&self) -> usize {
+        let centres = self.centres.get().and_then(Option::as_ref);
+        centres.map_or(0, Centres::bytes) + self.field.bytes() + self.env.bytes()
+    }
+
     fn sample(&self, x: f64, y: f64) -> Option<Sample> {
         let p = DVec2::new(x, y);
         let hit = self.field.closest(p)?;
