@@ -14,7 +14,7 @@
 //! per output pixel without constraints, ~84 B with them: 44–88 MB at
 //! 1024², measured); [`Snapshot::bytes`] says how much, so a keeper can
 //! bound it. It counts the constraints' own buffers too (a curve's kept
-//! samples, distance field and envelope, [`Constraint::bytes`]: ~1.3 MB for
+//! samples, distance field and envelope, [`Constraint::bytes`]: 2.3 MB for
 //! a 256-px curve, ~7 MB for an 820-px one at 1024²): a snapshot shares
 //! them with the session, but one kept across an edit of a curve is what
 //! keeps the old curve alive.
