@@ -27,6 +27,7 @@ mod registry;
 pub use api::error::ApiError;
 pub use editor::view::View;
 
+use crate::backend::engine::Engine;
 use crate::database::{Database, DbError};
 use crate::progress::Progress;
 use crate::scene::{Freeze, Scene, SceneEdits, SceneError, TypePaint};
@@ -70,6 +71,9 @@ pub struct Config {
     /// Where a server without `--scene` autosaves (the CLI: the user cache
     /// dir); with `--scene`, the side file beside it. None: no autosave.
     pub unsaved_autosave: Option<PathBuf>,
+    /// Where sessions synthesize and previews are shaded (`--backend`):
+    /// the same bytes on every engine, so a GPU only makes edits faster.
+    pub engine: Engine,
 }
 
 impl Default for Config {
@@ -85,6 +89,7 @@ impl Default for Config {
             idle: Duration::from_secs(8),
             autosave_delay: Duration::from_secs(2),
             unsaved_autosave: None,
+            engine: Engine::default(),
         }
     }
 }
@@ -170,6 +175,8 @@ pub(crate) struct App {
     instance: String,
     /// None without `--scene` and [`Config::unsaved_autosave`].
     autosave: Option<autosave::Autosave>,
+    /// Where every session synthesizes and shades ([`Config::engine`]).
+    engine: Engine,
 }
 
 /// The scene file's document as last saved, and how many saves it took.
@@ -428,6 +435,7 @@ fn prepare(config: &Config) -> Result<(App, DbSource), ServeError> {
         exemplar_previews: Mutex::new(Vec::new()),
         instance: registry::new_id(),
         autosave,
+        engine: config.engine.clone(),
     };
     Ok((app, source))
 }

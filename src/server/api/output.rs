@@ -4,6 +4,7 @@
 
 use super::error::ApiError;
 use super::request::{self, PathParam};
+use crate::backend::engine::Engine;
 use crate::database::Database;
 use crate::io::{self, Format, WriteOptions};
 use crate::server::App;
@@ -38,7 +39,8 @@ pub async fn exemplar(State(app): State<Arc<App>>, PathParam(index): PathParam) 
     let png = match cached {
         Some(p) => p,
         None => {
-            let png = tokio::task::spawn_blocking(move || exemplar_png(db, i))
+            let engine = app.engine.clone();
+            let png = tokio::task::spawn_blocking(move || exemplar_png(db, &engine, i))
                 .await
                 .map_err(|e| ApiError::Internal(e.to_string()))??;
             let png = Arc::new(png);
@@ -51,15 +53,17 @@ pub async fn exemplar(State(app): State<Arc<App>>, PathParam(index): PathParam) 
     Ok(png_response(png.to_vec(), None))
 }
 
-/// An exemplar's level-0 heights, rendered like the terrain.
-fn exemplar_png(db: &Database, i: usize) -> Api<Vec<u8>> {
+/// An exemplar's level-0 heights, rendered like the terrain (on `engine`).
+fn exemplar_png(db: &Database, engine: &Engine, i: usize) -> Api<Vec<u8>> {
     let hf = db.exemplar(i);
     let style = crate::server::editor::view::Style::new(db);
     let view = View {
         range: false,
         ..View::default()
     };
-    let image = style.render(&hf, None, view).map_err(ApiError::Internal)?;
+    let image = style
+        .render(engine, &hf, None, view)
+        .map_err(ApiError::Internal)?;
     crate::render::encode_png(&image).map_err(|e| ApiError::Internal(e.to_string()))
 }
 

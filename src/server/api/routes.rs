@@ -22,7 +22,8 @@
 //! | `POST /api/sessions/{id}/ping` | the page's heartbeat (`info.sessions.heartbeat_ms`) → `{"stale"}`: true when another tab saved the scene file after this session's document was loaded (the page offers reload/merge before a save is refused) |
 //! | `POST /api/sessions/{id}/close` | free the slot (on page hide, by beacon) |
 //!
-//! A frame: `revision`, `size`, `seed`, `history {undo, redo}`,
+//! A frame: `revision`, `size`, `seed`, `backend` (`cpu` or `gpu`:
+//! where it was synthesized and shaded, `serve --backend`), `history {undo, redo}`,
 //! `timing_ms {queued, edits, synth, render, total}`, `changed {pixels,
 //! bounds}`, `rebuilt`, `heights_m {min, max}`, `overlay {curves,
 //! junctions}`, `view` (and `scene` after undo/redo/create; `baked`,
@@ -266,9 +267,9 @@ async fn create(
         .ok_or_else(|| ApiError::NotReady("the database is not ready".into()))?;
     let policy = app.policy.clone();
     let (w, h) = (scene.width, scene.height);
-    let (id, rx) = app
-        .registry
-        .admit(w, h, || Handle::spawn(db, policy, style, doc, scene, base))?;
+    let (id, rx) = app.registry.admit(w, h, || {
+        Handle::spawn(db, policy, style, app.engine.clone(), doc, scene, base)
+    })?;
     let mut pending = app.registry.until_answered(&id);
     let mut frame = reply(rx).await?;
     pending.done = true;

@@ -6,6 +6,7 @@
 use super::checkpoints::{Checkpoint, Checkpoints, MAX_BYTES};
 use super::view::{Style, View, encode_rect, overlay};
 use super::{Reply, Task};
+use crate::backend::engine::Engine;
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::scene::{Scene, SceneEdits};
@@ -39,6 +40,8 @@ pub struct Editor {
     db: &'static Database,
     policy: Arc<Policy>,
     style: Arc<Style>,
+    /// Where the sessions synthesize and the previews are shaded.
+    engine: Engine,
     session: Session<'static>,
     edits: SceneEdits,
     scene: Scene,
@@ -73,14 +76,16 @@ impl Editor {
         db: &'static Database,
         policy: Arc<Policy>,
         style: Arc<Style>,
+        engine: Engine,
         doc: Value,
         scene: Scene,
     ) -> Result<Editor, ApiError> {
-        let (session, edits, frame, timing) = start(db, &scene)?;
+        let (session, edits, frame, timing) = start(db, &engine, &scene)?;
         let mut ed = Editor {
             db,
             policy,
             style,
+            engine,
             session,
             edits,
             history: History::new(doc.clone()),
@@ -201,7 +206,7 @@ impl Editor {
             // The new session is built beside the old one (a new size is
             // checked as a new tab's is).
             crate::server::registry::check_memory(scene.width, scene.height)?;
-            let (session, edits, frame, timing) = start(self.db, &scene)?;
+            let (session, edits, frame, timing) = start(self.db, &self.engine, &scene)?;
             self.session = session;
             self.edits = edits;
             self.stale = false;
@@ -352,7 +357,7 @@ impl Editor {
             _ if whole || self.image.width() == 0 => {
                 self.image = self
                     .style
-                    .render(&self.heightfield, types.as_deref(), self.view)
+                    .render(&self.engine, &self.heightfield, types.as_deref(), self.view)
                     .map_err(fail)?;
                 Some([
                     0,
@@ -366,6 +371,7 @@ impl Editor {
                 let done = self
                     .style
                     .render_window(
+                        &self.engine,
                         &self.heightfield,
                         types.as_deref(),
                         self.view,
@@ -378,7 +384,7 @@ impl Editor {
                 } else {
                     self.image = self
                         .style
-                        .render(&self.heightfield, types.as_deref(), self.view)
+                        .render(&self.engine, &self.heightfield, types.as_deref(), self.view)
                         .map_err(fail)?;
                     Some(full)
                 }
@@ -400,6 +406,7 @@ impl Editor {
             "revision": self.revision,
             "size": [self.scene.width, self.scene.height],
             "seed": self.scene.seed,
+            "backend": self.session.synthesizer().backend_name(),
             "history": {"undo": undo, "redo": redo},
             "timing_ms": {
                 "queued": waited.map(ms).unwrap_or(0.0),
@@ -427,9 +434,10 @@ impl Editor {
     }
 }
 
-/// A new session on `scene`, with its first frame.
+/// A new session on `scene` running on `engine`, with its first frame.
 fn start(
     db: &'static Database,
+    engine: &Engine,
     scene: &Scene,
 ) -> Result<(Session<'static>, SceneEdits, Frame, Timing), ApiError> {
     let mut edits = SceneEdits::new();
@@ -438,6 +446,10 @@ fn start(
     let edits_time = t.elapsed();
     let mut session =
         SceneEdits::session(db, scene).map_err(|e| ApiError::invalid("$", e.to_string()))?;
+    session
+        .synthesizer_mut()
+        .use_engine(engine.clone())
+        .map_err(|e| ApiError::Internal(e.to_string()))?;
     let frame = session
         .apply(list)
         .map_err(|e| ApiError::invalid("$", e.to_string()))?;

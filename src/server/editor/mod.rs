@@ -21,6 +21,7 @@ mod checkpoints;
 mod frame;
 pub(super) mod view;
 
+use crate::backend::engine::Engine;
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::scene::Scene;
@@ -135,6 +136,7 @@ impl Handle {
         db: &'static Database,
         policy: Arc<Policy>,
         style: Arc<Style>,
+        engine: Engine,
         doc: Value,
         scene: Scene,
         base: (u64, Arc<Value>),
@@ -155,7 +157,7 @@ impl Handle {
             .name("terrasynth-editor".into())
             .spawn(move || {
                 let t = Instant::now();
-                let first = guarded(|| Editor::new(db, policy, style, doc, scene));
+                let first = guarded(|| Editor::new(db, policy, style, engine, doc, scene));
                 match first {
                     Ok(mut ed) => {
                         let reply = ed.frame_reply(None, t.elapsed(), true);

@@ -8,6 +8,7 @@
 //! height range, not taken from each frame, so an edit that raises one peak
 //! does not recolour the whole map (a designer reads changes by colour).
 
+use crate::backend::engine::Engine;
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::io::maps::type_mask::TypeMask;
@@ -114,10 +115,11 @@ impl Style {
         Ok(o)
     }
 
-    /// Renders a whole preview. `types` is the scene's painted type raster
-    /// (database indices, 255 = none).
+    /// Renders a whole preview, shaded on `engine`. `types` is the scene's
+    /// painted type raster (database indices, 255 = none).
     pub fn render(
         &self,
+        engine: &Engine,
         hf: &Heightfield,
         types: Option<&[u8]>,
         view: View,
@@ -126,7 +128,9 @@ impl Style {
         if let (true, Some(t)) = (view.types, types) {
             opts.types = Some(self.overlay(hf.width(), hf.height(), t.to_vec())?);
         }
-        Ok(render::render(hf, &opts).map_err(|e| e.to_string())?.image)
+        Ok(render::render_on(engine, hf, &opts)
+            .map_err(|e| e.to_string())?
+            .image)
     }
 
     /// Re-renders `rect` (`[x0, y0, x1, y1)`, terrain pixels) of `image`, a
@@ -134,6 +138,7 @@ impl Style {
     /// preview is scaled; then only [`Style::render`] is exact.
     pub fn render_window(
         &self,
+        engine: &Engine,
         hf: &Heightfield,
         types: Option<&[u8]>,
         view: View,
@@ -160,7 +165,7 @@ impl Style {
                 .collect();
             opts.types = Some(self.overlay(cw, ch, sub)?);
         }
-        let part = render::render(&crop, &opts)
+        let part = render::render_on(engine, &crop, &opts)
             .map_err(|e| e.to_string())?
             .image;
         for y in y0..y1 {
@@ -288,18 +293,33 @@ mod tests {
                 bumped.set(x, y, bumped.get(x, y) + 40.0 + x as f32);
             }
         }
-        let whole = style.render(&bumped, Some(&types), view).unwrap();
-        let mut patched = style.render(&hf, Some(&types), view).unwrap();
+        let cpu = Engine::default();
+        let whole = style.render(&cpu, &bumped, Some(&types), view).unwrap();
+        let mut patched = style.render(&cpu, &hf, Some(&types), view).unwrap();
         assert_ne!(whole, patched);
         // The changed heights grown by the shade stage's one-pixel reach.
         let ok = style
-            .render_window(&bumped, Some(&types), view, &mut patched, [19, 9, 51, 31])
+            .render_window(
+                &cpu,
+                &bumped,
+                Some(&types),
+                view,
+                &mut patched,
+                [19, 9, 51, 31],
+            )
             .unwrap();
         assert!(ok);
         assert!(whole == patched, "the window differs from a full render");
         // A window at the edge too.
         let ok = style
-            .render_window(&bumped, Some(&types), view, &mut patched, [0, 0, w, 5])
+            .render_window(
+                &cpu,
+                &bumped,
+                Some(&types),
+                view,
+                &mut patched,
+                [0, 0, w, 5],
+            )
             .unwrap();
         assert!(ok && whole == patched);
     }

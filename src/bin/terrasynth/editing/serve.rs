@@ -2,9 +2,10 @@
 //! `terrasynth::server`).
 
 use crate::CliResult;
-use crate::args::parse_size;
+use crate::args::{BackendArg, parse_size};
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use terrasynth::backend::engine::Engine;
 use terrasynth::server::{self, Config, DbSource};
 
 #[derive(clap::Args)]
@@ -35,6 +36,11 @@ pub struct Args {
     /// Largest request body, MiB (scene documents).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=1024))]
     max_request_mib: u16,
+    /// Where sessions synthesize and previews are shaded: cpu, gpu
+    /// (`--features gpu` builds) or auto. The same terrain and pictures,
+    /// byte for byte, on each.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    backend: BackendArg,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -46,6 +52,10 @@ pub fn run(a: Args) -> CliResult {
         }
         Some(_) => None,
     };
+    let (engine, notice) = Engine::choose(a.backend.into())?;
+    if let Some(n) = notice {
+        eprintln!("note: {n}");
+    }
     let config = Config {
         bind: a.bind,
         database: a.db.map(DbSource::File),
@@ -55,6 +65,7 @@ pub fn run(a: Args) -> CliResult {
         seed: a.seed,
         max_sessions: a.max_sessions as usize,
         max_request_bytes: (a.max_request_mib as usize) << 20,
+        engine,
         ..Config::default()
     };
     server::run(config, |s| {
