@@ -252,7 +252,7 @@ pub fn effective_reach(loops: &[Vec<DVec2>], d: &[f64], w: usize, h: usize) -> V
             let (j0, n) = (t * TILE, rows.len() / w);
             // Each tile's candidate segments; none for tiles all farther
             // than BAND from the boundary: s = ±BAND.
-            let near: Vec<Option<Vec<u32>>> = tiles(w)
+            let near: Vec<Option<Vec<(f64, u32)>>> = tiles(w)
                 .map(|(i0, i1)| {
                     let mut c = Vec::new();
                     let corner = DVec2::new(i0 as f64, j0 as f64);

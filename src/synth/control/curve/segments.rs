@@ -12,6 +12,11 @@ use glam::DVec2;
 /// Bucket side, output pixels.
 pub const BUCKET: f64 = 8.0;
 
+/// Slack taken off a candidate's distance bound
+/// ([`Segments::tile_candidates`]) for the rounding of the two distances
+/// it is made of (each exact to ~1e-13 pixels here).
+const BOUND_SLACK: f64 = 1e-6;
+
 /// The closest point of a segment list to a query.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
@@ -193,8 +198,11 @@ impl Segments {
 
     /// The segments that can be the closest, within `dist`, to any node of
     /// the `w × h` tile of lattice nodes whose first node is at `corner`,
-    /// into `out` (ascending); false (and `out` empty) when every node of
-    /// the tile lies farther than `dist` from every segment.
+    /// into `out`, each with a lower bound of its distance to every node of
+    /// the tile (its distance to the tile's centre less the tile's
+    /// half-diagonal), by ascending bound then index; false (and `out`
+    /// empty) when every node of the tile lies farther than `dist` from
+    /// every segment.
     ///
     /// Why: a node's own [`Segments::closest`] visits every bucket out to
     /// its distance, so nodes far from the curve were the costliest (89 %
@@ -208,7 +216,7 @@ impl Segments {
         corner: DVec2,
         (w, h): (usize, usize),
         dist: f64,
-        out: &mut Vec<u32>,
+        out: &mut Vec<(f64, u32)>,
     ) -> bool {
         out.clear();
         let (a, b) = ((w - 1) as f64, (h - 1) as f64);
@@ -219,20 +227,35 @@ impl Segments {
             return false;
         };
         let r = near.dist + 2.0 * half + 1.0;
-        self.near_box(centre - DVec2::splat(r), centre + DVec2::splat(r), out);
-        out.retain(|&s| self.project(s, centre).dist <= r);
+        let mut boxed = Vec::new();
+        self.near_box(
+            centre - DVec2::splat(r),
+            centre + DVec2::splat(r),
+            &mut boxed,
+        );
+        out.extend(boxed.into_iter().filter_map(|s| {
+            let d = self.project(s, centre).dist;
+            (d <= r).then_some((d - half - BOUND_SLACK, s))
+        }));
+        out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
         true
     }
 
-    /// The closest of `candidates` (ascending, from
-    /// [`Segments::tile_candidates`]) to `p` within `max_dist`: ties
-    /// toward the lowest index, as [`Segments::closest`].
+    /// The closest of `candidates` (from [`Segments::tile_candidates`]) to
+    /// `p` within `max_dist`: ties toward the lowest index, as
+    /// [`Segments::closest`].
+    ///
+    /// Why in order of the bound: a node near the curve has its closest
+    /// segment among the first few, and the bound ends the scan there.
     #[inline]
-    pub fn closest_among(&self, candidates: &[u32], p: DVec2, max_dist: f64) -> Option<Hit> {
+    pub fn closest_among(&self, candidates: &[(f64, u32)], p: DVec2, max_dist: f64) -> Option<Hit> {
         let mut best: Option<Hit> = None;
-        for &s in candidates {
+        for &(bound, s) in candidates {
+            if bound > best.map_or(max_dist, |b| b.dist) {
+                break;
+            }
             let h = self.project(s, p);
-            if best.is_none_or(|b| h.dist < b.dist) {
+            if best.is_none_or(|b| h.dist < b.dist || (h.dist == b.dist && s < b.seg)) {
                 best = Some(h);
             }
         }
