@@ -227,17 +227,16 @@ impl Segments {
             return false;
         };
         let r = near.dist + 2.0 * half + 1.0;
-        let mut boxed = Vec::new();
-        self.near_box(
-            centre - DVec2::splat(r),
-            centre + DVec2::splat(r),
-            &mut boxed,
-        );
-        out.extend(boxed.into_iter().filter_map(|s| {
+        // The buckets' segments, filtered before they are sorted: a segment
+        // spans several buckets, and most of a box lies beyond r.
+        self.for_box(centre - DVec2::splat(r), centre + DVec2::splat(r), |s| {
             let d = self.project(s, centre).dist;
-            (d <= r).then_some((d - half - BOUND_SLACK, s))
-        }));
+            if d <= r {
+                out.push((d - half - BOUND_SLACK, s));
+            }
+        });
         out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        out.dedup_by_key(|c| c.1);
         true
     }
 
@@ -265,6 +264,14 @@ impl Segments {
     /// Indices of segments whose bucket overlaps the box `[lo, hi]`.
     pub fn near_box(&self, lo: DVec2, hi: DVec2, out: &mut Vec<u32>) {
         out.clear();
+        self.for_box(lo, hi, |s| out.push(s));
+        out.sort_unstable();
+        out.dedup();
+    }
+
+    /// Calls `f` on the segments of every bucket that overlaps the box
+    /// `[lo, hi]` (a segment once per bucket it spans).
+    fn for_box(&self, lo: DVec2, hi: DVec2, mut f: impl FnMut(u32)) {
         let c0 = ((lo - self.origin) / BUCKET).floor();
         let c1 = ((hi - self.origin) / BUCKET).floor();
         let x0 = (c0.x.max(0.0) as usize).min(self.nx);
@@ -277,13 +284,11 @@ impl Segments {
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let k = y * self.nx + x;
-                out.extend_from_slice(
-                    &self.items[self.start[k] as usize..self.start[k + 1] as usize],
-                );
+                for &s in &self.items[self.start[k] as usize..self.start[k + 1] as usize] {
+                    f(s);
+                }
             }
         }
-        out.sort_unstable();
-        out.dedup();
     }
 }
 
