@@ -37,7 +37,7 @@ use super::request::{self, PathParam, json_body};
 use super::{assets, output};
 use crate::database::Database;
 use crate::io::Format;
-use crate::server::editor::{Handle, Reply, Task};
+use crate::server::editor::{Handle, Reply, Shared, Task};
 use crate::server::{App, DbState};
 use axum::Router;
 use axum::body::Bytes;
@@ -265,11 +265,16 @@ async fn create(
         .unwrap_or_else(|e| e.into_inner())
         .clone()
         .ok_or_else(|| ApiError::NotReady("the database is not ready".into()))?;
-    let policy = app.policy.clone();
+    let shared = Shared {
+        db,
+        policy: app.policy.clone(),
+        style,
+        engine: app.engine.clone(),
+    };
     let (w, h) = (scene.width, scene.height);
-    let (id, rx) = app.registry.admit(w, h, || {
-        Handle::spawn(db, policy, style, app.engine.clone(), doc, scene, base)
-    })?;
+    let (id, rx) = app
+        .registry
+        .admit(w, h, || Handle::spawn(shared, doc, scene, base))?;
     let mut pending = app.registry.until_answered(&id);
     let mut frame = reply(rx).await?;
     pending.done = true;

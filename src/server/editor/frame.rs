@@ -4,15 +4,15 @@
 //! when a document cannot be an edit of it).
 
 use super::checkpoints::{Checkpoint, Checkpoints, MAX_BYTES};
-use super::view::{Style, View, encode_rect, overlay};
-use super::{Reply, Task};
+use super::view::{View, encode_rect, overlay};
+use super::{Reply, Shared, Task};
 use crate::backend::engine::Engine;
 use crate::database::Database;
 use crate::heightfield::Heightfield;
 use crate::scene::{Scene, SceneEdits};
 use crate::server::api::error::ApiError;
 use crate::server::document::history::History;
-use crate::server::document::{Policy, rebuild_reason};
+use crate::server::document::rebuild_reason;
 use crate::synth::session::{Frame, Session, change};
 use crate::synth::union;
 use image::RgbaImage;
@@ -37,11 +37,7 @@ struct Timing {
 
 /// The session and everything around it, owned by the thread.
 pub struct Editor {
-    db: &'static Database,
-    policy: Arc<Policy>,
-    style: Arc<Style>,
-    /// Where the sessions synthesize and the previews are shaded.
-    engine: Engine,
+    shared: Shared,
     session: Session<'static>,
     edits: SceneEdits,
     scene: Scene,
@@ -72,20 +68,10 @@ pub struct Editor {
 }
 
 impl Editor {
-    pub fn new(
-        db: &'static Database,
-        policy: Arc<Policy>,
-        style: Arc<Style>,
-        engine: Engine,
-        doc: Value,
-        scene: Scene,
-    ) -> Result<Editor, ApiError> {
-        let (session, edits, frame, timing) = start(db, &engine, &scene)?;
+    pub fn new(shared: Shared, doc: Value, scene: Scene) -> Result<Editor, ApiError> {
+        let (session, edits, frame, timing) = start(shared.db, &shared.engine, &scene)?;
         let mut ed = Editor {
-            db,
-            policy,
-            style,
-            engine,
+            shared,
             session,
             edits,
             history: History::new(doc.clone()),
@@ -138,6 +124,7 @@ impl Editor {
                     ));
                 };
                 let applied = self
+                    .shared
                     .policy
                     .check_value(&doc)
                     .and_then(|scene| self.show(doc, scene));
@@ -206,7 +193,8 @@ impl Editor {
             // The new session is built beside the old one (a new size is
             // checked as a new tab's is).
             crate::server::registry::check_memory(scene.width, scene.height)?;
-            let (session, edits, frame, timing) = start(self.db, &self.engine, &scene)?;
+            let (session, edits, frame, timing) =
+                start(self.shared.db, &self.shared.engine, &scene)?;
             self.session = session;
             self.edits = edits;
             self.stale = false;
@@ -224,7 +212,7 @@ impl Editor {
                 self.timing.keep += t.elapsed();
             }
             let t = Instant::now();
-            let list = match self.edits.edits(&scene, self.db) {
+            let list = match self.edits.edits(&scene, self.shared.db) {
                 Ok(list) => list,
                 Err(e) => {
                     if self.restored {
@@ -346,50 +334,31 @@ impl Editor {
         } else {
             None
         };
-        let rect = union(heights, painted);
-        let full = [
-            0,
-            0,
-            self.image.width() as usize,
-            self.image.height() as usize,
-        ];
-        let rect = match rect {
-            _ if whole || self.image.width() == 0 => {
-                self.image = self
-                    .style
-                    .render(&self.engine, &self.heightfield, types.as_deref(), self.view)
-                    .map_err(fail)?;
-                Some([
-                    0,
-                    0,
-                    self.image.width() as usize,
-                    self.image.height() as usize,
-                ])
-            }
-            None => None,
-            Some(r) => {
-                let done = self
-                    .style
-                    .render_window(
-                        &self.engine,
-                        &self.heightfield,
-                        types.as_deref(),
-                        self.view,
-                        &mut self.image,
-                        r,
-                    )
-                    .map_err(fail)?;
-                if done {
-                    Some(r)
-                } else {
-                    self.image = self
-                        .style
-                        .render(&self.engine, &self.heightfield, types.as_deref(), self.view)
-                        .map_err(fail)?;
-                    Some(full)
-                }
-            }
-        };
+        let mut rect = union(heights, painted);
+        // A whole render when asked, for the first frame, or when the
+        // window cannot be patched in place.
+        let (shared, hf, view) = (&self.shared, &self.heightfield, self.view);
+        let mut whole = whole || self.image.width() == 0;
+        if let (false, Some(r)) = (whole, rect) {
+            let done = (shared.style)
+                .render_window(
+                    &shared.engine,
+                    hf,
+                    types.as_deref(),
+                    view,
+                    &mut self.image,
+                    r,
+                )
+                .map_err(fail)?;
+            whole = !done;
+        }
+        if whole {
+            self.image = (shared.style)
+                .render(&shared.engine, hf, types.as_deref(), view)
+                .map_err(fail)?;
+            let (w, h) = (self.image.width() as usize, self.image.height() as usize);
+            rect = Some([0, 0, w, h]);
+        }
         self.tile = match rect {
             Some(r) => Some((r, Arc::new(encode_rect(&self.image, r).map_err(fail)?))),
             None => None,

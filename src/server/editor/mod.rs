@@ -97,6 +97,17 @@ pub type Png = (u64, Arc<Vec<u8>>);
 /// Tiles kept for pages that fetch them a little late.
 const TILES_KEPT: usize = 16;
 
+/// What every editor of a server shares: the database, the policy that
+/// checks documents, the preview style, and the engine that synthesizes
+/// and shades. Cloned into each session's thread.
+#[derive(Clone)]
+pub struct Shared {
+    pub db: &'static Database,
+    pub policy: Arc<Policy>,
+    pub style: Arc<Style>,
+    pub engine: Engine,
+}
+
 /// The part of a session that request handlers hold.
 pub struct Handle {
     queue: Mutex<Queue>,
@@ -133,10 +144,7 @@ impl Handle {
     /// the receiver gets the first frame, or why there is none (then the
     /// session is closed).
     pub fn spawn(
-        db: &'static Database,
-        policy: Arc<Policy>,
-        style: Arc<Style>,
-        engine: Engine,
+        shared: Shared,
         doc: Value,
         scene: Scene,
         base: (u64, Arc<Value>),
@@ -157,7 +165,7 @@ impl Handle {
             .name("terrasynth-editor".into())
             .spawn(move || {
                 let t = Instant::now();
-                let first = guarded(|| Editor::new(db, policy, style, engine, doc, scene));
+                let first = guarded(|| Editor::new(shared, doc, scene));
                 match first {
                     Ok(mut ed) => {
                         let reply = ed.frame_reply(None, t.elapsed(), true);
