@@ -188,8 +188,9 @@ fn rect((x, y, w, h): (usize, usize, usize, usize)) -> PyResult<Rect> {
 /// one seamless terrain. None synthesizes the whole world.
 ///
 /// ``seed``, ``jitter`` (texels; 0 reproduces the exemplar), ``passes``
-/// (correction passes per level), ``start_exemplar`` and ``height_prior``
-/// are those of ``terrasynth synth``. Returns an array of shape (h, w)
+/// (correction passes per level; the start level takes more for exemplars
+/// smooth at the pixel scale), ``start_exemplar`` and ``height_prior`` are
+/// those of ``terrasynth synth``. Returns an array of shape (h, w)
 /// (rows north to south) of heights in metres; the cell size is
 /// ``db.cell_size(start_exemplar)``.
 #[pyfunction]

@@ -13,7 +13,8 @@
 //! - **correction** (levels ≤ L): a subpass reads up to
 //!   [`REACH_PER_SUBPASS`] = 2 pixels away, so what must be right after the
 //!   level's `4 · passes` subpasses is computed over a region widened by
-//!   `2 · 4 · passes` (16 with the default 2 passes). Pixels that near the
+//!   `2 · 4 · passes` (16 with the default 2 passes; the start level of
+//!   smooth exemplars takes more, `coarse::seams`). Pixels that near the
 //!   region's edge read reflected neighbours where the real ones are
 //!   missing, and are wrong — but only they, and nothing right depends on
 //!   them. Where the region meets the world's edge, reflection *is* the
@@ -156,16 +157,15 @@ pub struct Cone {
 impl Cone {
     /// The cone of `window` (output pixels inside the `world`) for a
     /// synthesis whose coarsest level is `top` and whose levels ≤ `l` are
-    /// corrected by `passes` passes. `needs[i]`, when given, is one more
+    /// corrected by `passes[level]` passes. `needs[i]`, when given, is one more
     /// rectangle of level i that must come out right (e.g. a paste's
     /// source): the cone covers it and what it depends on.
     pub fn plan(
         world: (usize, usize),
         window: Rect,
-        (top, l, passes): (usize, usize, u32),
+        (top, l, passes): (usize, usize, &[u32]),
         needs: &[Option<Rect>],
     ) -> Cone {
-        let grow = REACH_PER_SUBPASS * SUBPASSES.len() * passes as usize;
         let mut regions = Vec::with_capacity(top + 1);
         let mut from_below: Option<Rect> = None;
         for i in 0..=top {
@@ -174,9 +174,9 @@ impl Cone {
             if let Some(r) = needs.get(i).copied().flatten() {
                 need = need.union(r.widen(0, size));
             }
-            let corrected = i <= l && passes > 0;
-            let r = if corrected {
-                need.widen(grow, size)
+            let passes = passes.get(i).copied().unwrap_or(0) as usize;
+            let r = if i <= l && passes > 0 {
+                need.widen(REACH_PER_SUBPASS * SUBPASSES.len() * passes, size)
             } else {
                 need
             }
@@ -250,7 +250,7 @@ mod tests {
     #[test]
     fn the_whole_world_is_its_own_cone() {
         let world = (777, 333);
-        let c = Cone::plan(world, Rect::new(0, 0, 777, 333), (9, 5, 2), &[]);
+        let c = Cone::plan(world, Rect::new(0, 0, 777, 333), (9, 5, &[2; 10]), &[]);
         for i in 0..=9 {
             let (w, h) = level_size(777, 333, i);
             assert_eq!(c.region(i), Rect::new(0, 0, w, h));
@@ -261,7 +261,12 @@ mod tests {
     #[test]
     fn a_window_widens_by_its_reach_and_halves_per_level() {
         let world = (65536, 65536);
-        let c = Cone::plan(world, Rect::new(30001, 40000, 1024, 1024), (5, 5, 2), &[]);
+        let c = Cone::plan(
+            world,
+            Rect::new(30001, 40000, 1024, 1024),
+            (5, 5, &[2; 6]),
+            &[],
+        );
         // Level 0: the window ± 2 (reconstruct's reach), then ± 16, corner
         // made even.
         let r = c.region(0);
@@ -280,7 +285,7 @@ mod tests {
     #[test]
     fn regions_at_the_world_edge_reach_the_level_edge() {
         let world = (300, 200);
-        let c = Cone::plan(world, Rect::new(290, 0, 10, 7), (7, 5, 2), &[]);
+        let c = Cone::plan(world, Rect::new(290, 0, 10, 7), (7, 5, &[2; 8]), &[]);
         for i in 0..=7 {
             let (w, _) = level_size(300, 200, i);
             assert_eq!(c.region(i).x1, w, "level {i}");

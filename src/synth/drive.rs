@@ -33,6 +33,7 @@ impl Synthesizer<'_> {
         let t0 = Instant::now();
         let (width, height) = cone.world();
         let (start, top, l) = self.levels(width, height);
+        let passes = self.level_passes(width, height);
         let mut timings = Timings {
             levels: vec![LevelTiming::default(); top_level(width, height) + 1],
             ..Default::default()
@@ -70,7 +71,9 @@ impl Synthesizer<'_> {
             let region = cone.region(level);
             let (w, h) = (region.width(), region.height());
             let window = match control {
-                Some(c) if level <= l => self.window(c, level, (w, h), changed_parent),
+                Some(c) if level <= l => {
+                    self.window(c, (level, passes[level]), (w, h), changed_parent)
+                }
                 _ => None,
             };
             if level < top {
@@ -118,7 +121,7 @@ impl Synthesizer<'_> {
                 let t = Instant::now();
                 match control {
                     None => {
-                        for _pass in 0..self.params.passes {
+                        for _pass in 0..passes[level] {
                             for &sub in &SUBPASSES {
                                 let p = self.correct_params(level, sub);
                                 b.correct(&state, parent.as_ref(), level, &p);
@@ -126,12 +129,14 @@ impl Synthesizer<'_> {
                         }
                     }
                     Some(c) => {
-                        changed_parent = match window.filter(|_| self.can_crop(c, level)) {
+                        let crop = |_: &_| self.can_crop(c, level, passes[level]);
+                        changed_parent = match window.filter(crop) {
                             Some(win) => {
                                 let buf = LevelBuffers {
                                     state: &state,
                                     parent: parent.as_ref().map(|p| (p, parent_size)),
                                     level,
+                                    passes: passes[level],
                                     region,
                                 };
                                 let (changed, corrected) =
@@ -142,7 +147,7 @@ impl Synthesizer<'_> {
                             None => self.correct_level(
                                 b,
                                 (&state, parent.as_ref()),
-                                (level, region),
+                                (level, passes[level], region),
                                 c,
                                 window,
                                 frames.as_mut(),

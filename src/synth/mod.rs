@@ -68,6 +68,9 @@ pub struct Synthesizer<'db> {
     /// The coarse start's pool, built by the first synthesis that starts
     /// from pieces (it ranks every interior texel of level L).
     pool: OnceLock<coarse::Pool>,
+    /// The start level's factor of passes (`coarse::seams`), measured by
+    /// the first synthesis that starts from pieces.
+    start_factor: OnceLock<u32>,
     /// The CPU stages' instruction-set level (when no GPU runs them).
     isa: Isa,
     #[cfg(feature = "gpu")]
@@ -102,6 +105,7 @@ impl<'db> Synthesizer<'db> {
             atlas,
             jitter,
             pool: OnceLock::new(),
+            start_factor: OnceLock::new(),
             isa: Isa::default(),
             #[cfg(feature = "gpu")]
             gpu: None,
@@ -284,7 +288,31 @@ impl<'db> Synthesizer<'db> {
     /// rectangles per level that must come out right).
     pub(crate) fn cone(&self, world: (usize, usize), window: Rect, needs: &[Option<Rect>]) -> Cone {
         let (_, top, l) = self.levels(world.0, world.1);
-        Cone::plan(world, window, (top, l, self.params.passes), needs)
+        let passes = self.level_passes(world.0, world.1);
+        Cone::plan(world, window, (top, l, &passes), needs)
+    }
+
+    /// The correction passes of each level of a `width × height` synthesis
+    /// (index = level, up to its coarsest): [`Params::passes`], times a
+    /// factor of 1–4 at the level a jittered start's pieces are laid at,
+    /// more for exemplars smooth at the pixel scale (`synth/coarse/seams.rs`:
+    /// the pieces' seams are healed there).
+    pub fn level_passes(&self, width: usize, height: usize) -> Vec<u32> {
+        let (start, top, l) = self.levels(width, height);
+        (0..=top)
+            .map(|i| match start {
+                Start::Pieces { .. } if i == l => self.params.passes * self.start_factor(),
+                _ => self.params.passes,
+            })
+            .collect()
+    }
+
+    /// The start level's factor of passes for this synthesizer's
+    /// exemplars, measured once.
+    fn start_factor(&self) -> u32 {
+        *self
+            .start_factor
+            .get_or_init(|| coarse::seams::factor(self.db, self.params.start_exemplar))
     }
 
     /// Parameters of the upsampling into level `level` over `region`. Above

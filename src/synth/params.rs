@@ -13,7 +13,10 @@ use thiserror::Error;
 pub struct Params {
     /// Jitter amplitude r of eq. 1, in texels (0 = none; paper: 0.4).
     pub jitter: f64,
-    /// Correction passes per level (paper: 2), each of four subpasses.
+    /// Correction passes per level (paper: 2), each of four subpasses; the
+    /// level a jittered start is laid at takes up to four times as many for
+    /// exemplars smooth at the pixel scale
+    /// ([`Synthesizer::level_passes`](super::Synthesizer::level_passes)).
     pub passes: u32,
     /// The exemplar synthesis starts from: its pieces make the coarse start
     /// (see [`super::coarse`]), or without jitter its centre; the output

@@ -38,11 +38,12 @@ use crate::level::state::State;
 use crate::stages::correct::{Coherence, Guide, SUBPASSES};
 
 /// One level's buffers for [`Synthesizer::correct_cropped`]: the state,
-/// the level above and its size, and where the level lies.
+/// the level above and its size, the level's passes and where it lies.
 pub(super) struct LevelBuffers<'s, S> {
     pub state: &'s S,
     pub parent: Option<(&'s S, (usize, usize))>,
     pub level: usize,
+    pub passes: u32,
     pub region: Rect,
 }
 
@@ -50,12 +51,12 @@ impl Synthesizer<'_> {
     /// The window of a `w × h` level that restricted re-synthesis corrects
     /// ([`super::Guides::restrict`], with a previous frame of the level): the
     /// pixels whose own inputs changed and the children of the parent's
-    /// changed pixels, widened by how far the level's subpasses carry a
+    /// changed pixels, widened by how far the level's `passes` carry a
     /// change. None: the whole level.
     pub(super) fn window(
         &self,
         c: &Control<'_>,
-        level: usize,
+        (level, passes): (usize, u32),
         (w, h): (usize, usize),
         changed_parent: Option<[usize; 4]>,
     ) -> Option<[usize; 4]> {
@@ -65,15 +66,15 @@ impl Synthesizer<'_> {
         }
         let dirty = c.guides.levels.get(level).and_then(|g| g.dirty);
         let seeds = union(dirty, changed_parent.map(double));
-        let grow = REACH_PER_SUBPASS * SUBPASSES.len() * self.params.passes as usize;
+        let grow = REACH_PER_SUBPASS * SUBPASSES.len() * passes as usize;
         Some(seeds.map_or([0; 4], |b| widen(b, grow, w, h)))
     }
 
-    /// Whether the level's `window` can be corrected on a crop: every pass
-    /// has the previous frame's result and weights (the coherence that
-    /// decides the pixels outside the window).
-    pub(super) fn can_crop(&self, c: &Control<'_>, level: usize) -> bool {
-        let passes = self.params.passes as usize;
+    /// Whether the level's `window` can be corrected on a crop: each of its
+    /// `passes` has the previous frame's result and weights (the coherence
+    /// that decides the pixels outside the window).
+    pub(super) fn can_crop(&self, c: &Control<'_>, level: usize, passes: u32) -> bool {
+        let passes = passes as usize;
         passes > 0
             && c.prev
                 .as_ref()
@@ -85,7 +86,7 @@ impl Synthesizer<'_> {
                 .is_some_and(|g| g.weights.is_some())
     }
 
-    /// The correction passes of one `w × h` level under control: each
+    /// The `passes` correction passes of one `w × h` level under control: each
     /// pass's guide uploaded to the backend, its result recorded into
     /// `frames`. With [`Guides::restrict`] and a previous frame, only the
     /// window that can differ is corrected (the stage gives the rest the
@@ -95,7 +96,7 @@ impl Synthesizer<'_> {
         &self,
         b: &B,
         (state, parent): (&B::State, Option<&B::State>),
-        (level, region): (usize, Rect),
+        (level, passes, region): (usize, u32, Rect),
         c: &Control<'_>,
         window: Option<[usize; 4]>,
         mut frames: Option<&mut Frames>,
@@ -105,7 +106,7 @@ impl Synthesizer<'_> {
         let prev = c.prev.as_ref().map(|f| f.borrow());
         let before = prev.as_ref().and_then(|f| f.levels.get(level));
         let mut last_result = None;
-        for pass in 0..self.params.passes as usize {
+        for pass in 0..passes as usize {
             let last = before.and_then(|b| b.get(pass));
             let coherence = match (last, lg.and_then(|g| g.weights.as_deref())) {
                 (Some(r), Some(weights)) => Some(Coherence {
@@ -125,7 +126,7 @@ impl Synthesizer<'_> {
             };
             let g = b.upload_guide(&guide, w, h)?;
             self.subpasses(b, (state, parent), level, &g);
-            let is_last = pass + 1 == self.params.passes as usize;
+            let is_last = pass + 1 == passes as usize;
             if frames.is_some() || (is_last && window.is_some()) {
                 let (coords, offsets) = b.download(state)?;
                 let r = PassResult { coords, offsets };
@@ -160,6 +161,7 @@ impl Synthesizer<'_> {
             state,
             parent,
             level,
+            passes,
             region,
         } = buf;
         let (w, h) = (region.width(), region.height());
@@ -195,7 +197,7 @@ impl Synthesizer<'_> {
         let (a, z) = (window[0] - cr.x0, window[2] - cr.x0);
         let local = [a, window[1] - cr.y0, z, window[3] - cr.y0];
         let (mut last, mut changed) = (None, None);
-        let passes = self.params.passes as usize;
+        let passes = passes as usize;
         for (pass, mut prev) in before.into_iter().enumerate().take(passes) {
             let (coords, offsets) = (
                 crop(&prev.coords, level_rect, cr),

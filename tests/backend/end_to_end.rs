@@ -34,10 +34,18 @@ fn assert_states_eq(gpu: &(Vec<Coord>, Vec<i32>), cpu: &(Vec<Coord>, Vec<i32>), 
     assert_eq!(gpu, cpu, "{what}");
 }
 
-/// A whole synthesis: same heights (bit patterns), same kept levels.
-fn check_end_to_end(db: &Database, ctx: Arc<Context>, (w, h): (usize, usize), seed: u32) {
+/// A whole synthesis (pieces of `start`, or of every exemplar): same
+/// heights (bit patterns), same kept levels.
+fn check_end_to_end(
+    db: &Database,
+    ctx: Arc<Context>,
+    (w, h): (usize, usize),
+    seed: u32,
+    start: Option<usize>,
+) {
     let params = Params {
         keep_levels: true,
+        start_exemplar: start,
         ..Params::default()
     };
     let cpu = Synthesizer::new(db, params.clone()).unwrap();
@@ -61,8 +69,18 @@ fn check_end_to_end(db: &Database, ctx: Arc<Context>, (w, h): (usize, usize), se
 #[test]
 fn end_to_end_synthesis_is_identical() {
     let Some(ctx) = ctx() else { return };
-    check_end_to_end(default_db(), ctx.clone(), (256, 256), 1);
-    check_end_to_end(default_db(), ctx, (173, 61), 77);
+    check_end_to_end(default_db(), ctx.clone(), (256, 256), 1, None);
+    check_end_to_end(default_db(), ctx.clone(), (173, 61), 77, None);
+    // The Pyrenees alone: its start level takes twice the passes.
+    let s = Synthesizer::new(
+        default_db(),
+        Params {
+            start_exemplar: Some(2),
+            ..Params::default()
+        },
+    );
+    assert_eq!(s.unwrap().level_passes(200, 144), [2, 2, 4]);
+    check_end_to_end(default_db(), ctx, (200, 144), 4, Some(2));
 }
 
 #[test]
@@ -71,7 +89,7 @@ fn end_to_end_synthesis_of_shared_dems_is_identical() {
     let Some(db) = two_dems(PYRENEES_JURA, "real-DEM end-to-end cross-check") else {
         return;
     };
-    check_end_to_end(db, ctx, (256, 200), 5);
+    check_end_to_end(db, ctx, (256, 200), 5, None);
 }
 
 /// End to end: the Fig. 11-style design of `data/scenes/` (curves with

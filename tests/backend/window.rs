@@ -21,7 +21,9 @@ fn db() -> &'static Database {
 
 /// Parameter sets the windows are checked under: the default (block
 /// start), no jitter (the exemplar centre, levels above L), one pass, and
-/// blocks from one exemplar with the paper's relative heights.
+/// blocks from one exemplar with the paper's relative heights — the
+/// Pyrenees, whose start level takes twice the passes (checked by
+/// `every_start_and_pass_count`), so its cone widens more there.
 fn params(kind: usize) -> Params {
     let d = Params::default();
     match kind {
@@ -29,7 +31,7 @@ fn params(kind: usize) -> Params {
         1 => Params { jitter: 0.0, ..d },
         2 => Params { passes: 1, ..d },
         _ => Params {
-            start_exemplar: Some(1),
+            start_exemplar: Some(2),
             prior: 0,
             ..d
         },
@@ -88,6 +90,8 @@ fn corners_edges_and_the_whole_world() {
 
 #[test]
 fn every_start_and_pass_count() {
+    let pyrenees = Synthesizer::new(db(), params(3)).unwrap();
+    assert_eq!(pyrenees.level_passes(256, 256), [2, 2, 4]);
     for kind in 1..4 {
         for (world, win) in [
             ((256, 256), Rect::new(100, 37, 61, 90)),

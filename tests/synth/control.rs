@@ -8,11 +8,11 @@ use std::sync::{Arc, OnceLock};
 use terrasynth::database::{self, BuildOptions, Database};
 use terrasynth::heightfield::Heightfield;
 use terrasynth::progress::Silent;
-use terrasynth::synth::Params;
 use terrasynth::synth::control::{
     Constraint, ConstraintId, Lift, Paste, PasteSource, PointConstraint, UNCONSTRAINED,
 };
 use terrasynth::synth::session::{Edit, Session};
+use terrasynth::synth::{Params, Synthesizer};
 
 use crate::common::db::{PYRENEES_CATALAN, TwoDems, start_relief, two_dems};
 use crate::common::dem;
@@ -353,7 +353,6 @@ fn coherence_keeps_a_new_point_local() {
 #[test]
 fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
     let Some(db) = db() else { return };
-    let cell = db.meta().exemplars[0].cell_size_m;
     let hills = db.type_names().iter().position(|n| n == "hills").unwrap() as u8;
     let paint: Vec<u8> = (0..N * N)
         .map(|k| {
@@ -364,18 +363,38 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
             }
         })
         .collect();
+    let passes = |db| {
+        Synthesizer::new(db, Params::default())
+            .unwrap()
+            .level_passes(N, N)
+    };
+    assert_eq!(passes(db), [2, 2, 2]);
+    restricted_matches_full(db, restricted_edits(db, Some(paint)));
+    // Yosemite, smooth at the pixel scale: its start level takes four
+    // times the passes (`Synthesizer::level_passes`), so a change there
+    // spreads farther.
+    let Some(yosemite) = yosemite() else { return };
+    assert_eq!(passes(yosemite), [2, 2, 8]);
+    restricted_matches_full(yosemite, restricted_edits(yosemite, None));
+}
+
+/// The edits of the restricted re-synthesis test: points set, moved and
+/// removed, types painted (`paint`, where the database has types), a
+/// paste and a freeze.
+fn restricted_edits(db: &Database, paint: Option<Vec<u8>>) -> Vec<Vec<Edit>> {
+    let cell = db.meta().exemplars[0].cell_size_m;
     let p1: Arc<dyn Constraint> =
         Arc::new(PointConstraint::new((60.0, 60.0), 1800.0, 0.0, 0.2, 30.0, cell).unwrap());
     let p2: Arc<dyn Constraint> =
         Arc::new(PointConstraint::new((70.0, 190.0), 900.0, 2.0, 0.4, 40.0, cell).unwrap());
     let p1b: Arc<dyn Constraint> =
         Arc::new(PointConstraint::new((90.0, 70.0), 1700.0, 0.0, 0.2, 30.0, cell).unwrap());
-    let edits = vec![
+    vec![
         vec![],
         vec![Edit::SetConstraint(ConstraintId(1), p1)],
         vec![
             Edit::SetConstraint(ConstraintId(2), p2),
-            Edit::PaintTypes(Some(paint)),
+            Edit::PaintTypes(paint),
         ],
         vec![Edit::SetConstraint(ConstraintId(1), p1b)],
         vec![Edit::RemoveConstraint(ConstraintId(2))],
@@ -392,7 +411,12 @@ fn restricted_resynthesis_is_exact_and_unchanged_inputs_repeat() {
         vec![Edit::Freeze(Some(
             (0..N * N).map(|k| (k % N) < 40 && (k / N) < 40).collect(),
         ))],
-    ];
+    ]
+}
+
+/// Applies `edits` to a restricted and to a full re-synthesizing session:
+/// every frame and every pass's results are the same.
+fn restricted_matches_full(db: &Database, edits: Vec<Vec<Edit>>) {
     let mut fast = session(db);
     let mut full = session(db);
     full.restrict = false;

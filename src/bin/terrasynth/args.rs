@@ -132,7 +132,8 @@ pub struct SynthesisArgs {
     /// Jitter amplitude r in texels (paper default 0.4; 0 reproduces the exemplar).
     #[arg(long, default_value_t = 0.4)]
     pub jitter: f64,
-    /// Correction passes per level.
+    /// Correction passes per level (the start level takes up to 4× as many
+    /// for exemplars smooth at the pixel scale).
     #[arg(long, default_value_t = 2)]
     pub passes: u32,
     /// Exemplar (index) the synthesis starts from: its pieces make the

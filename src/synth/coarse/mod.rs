@@ -35,6 +35,10 @@
 //! joins of pieces from unrelated places, and the layout of highs and lows
 //! is the guide's, new for every seed and every place of a world.
 //!
+//! The start level is corrected with more passes than the others where
+//! the exemplars are smooth at the pixel scale, so the pieces' seams heal
+//! there before the finer levels add detail to them (`seams.rs`).
+//!
 //! Computed on the host for every backend and uploaded: it is small
 //! (level L, ⌈W/2^L⌉ × ⌈H/2^L⌉ pixels), so it has no kernel mirror. Every
 //! choice is a hash of the seed and the piece's absolute position
@@ -43,6 +47,7 @@
 mod guide;
 mod pieces;
 mod pool;
+pub(super) mod seams;
 
 pub use pieces::pieces;
 pub use pool::Pool;
