@@ -186,6 +186,14 @@ fn cli_synth_coords_eval_and_suite() {
     assert_eq!(dem["seeds"].as_array().unwrap().len(), 2);
     assert!(dem["median"]["ratio"].as_f64().unwrap() > 0.0);
     assert!(dem["baseline"].as_f64().unwrap() > 0.0);
+    // Passes per level, finest first, down to the start level; `--passes`
+    // (2) at least on every one.
+    let passes = dem["level_passes"].as_array().unwrap();
+    assert!(passes.len() >= 2, "{passes:?}");
+    assert!(
+        passes.iter().all(|p| p.as_u64().unwrap() >= 2),
+        "{passes:?}"
+    );
     assert!(dem["copy_baseline"].as_f64().is_some());
     assert!(dem["median"]["copy_share"].as_f64().is_some());
     assert!(dem["targets"]["copies"].as_bool().is_some());

@@ -80,6 +80,10 @@ pub(super) struct DemResult {
     pub(super) height: usize,
     pub(super) cell_size_m: f64,
     pub(super) synth_size: [usize; 2],
+    /// Correction passes per level of the synthesis, finest first: the
+    /// start level takes more for an exemplar smooth at the pixel scale
+    /// (`Synthesizer::level_passes`).
+    pub(super) level_passes: Vec<u32>,
     /// Real against real: the DEM's top half against its bottom half, in
     /// units of its left half against its right (about 1; what an equally
     /// real synthesis could score).
@@ -173,6 +177,8 @@ pub(super) fn run_dem(
         ..Params::default()
     };
     let synth = Synthesizer::new(&db, params).map_err(|e| format!("{name}: {e}"))?;
+    let level_passes = synth.level_passes(w, h);
+    eprintln!("{name}: correction passes per level, finest first: {level_passes:?}");
     let mut seeds = Vec::new();
     for (k, &seed) in a.seeds.iter().enumerate() {
         let ts = Instant::now();
@@ -268,6 +274,7 @@ pub(super) fn run_dem(
         height: dem.hf.height(),
         cell_size_m: dem.hf.cell_size(),
         synth_size: [w, h],
+        level_passes,
         baseline,
         copy_baseline,
         seeds,
