@@ -172,6 +172,17 @@ fn the_cli_writes_a_mosaic_gdal_reads_as_the_world() {
     assert!(ok && err.contains("12 kept"), "{err}");
     let (ok, err) = run(&["--jitter", "0.3"]);
     assert!(!ok && err.contains("another world"), "{err}");
+    // The manifest names the passes per level the engine ran; a directory
+    // written before the start level's passes followed the exemplars (no
+    // such entry) is another world.
+    let manifest = out.join("manifest.json");
+    let mut m: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    assert_eq!(m["source"]["level_passes"], serde_json::json!([2, 2, 2]));
+    m["source"].as_object_mut().unwrap().remove("level_passes");
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    let (ok, err) = run(&[]);
+    assert!(!ok && err.contains("another world"), "{err}");
     if !have_gdal() {
         return;
     }

@@ -210,6 +210,10 @@ pub fn run(a: Args) -> CliResult {
         },
         "jitter": params.jitter,
         "passes": params.passes,
+        // What the engine made of them (the start level's passes follow
+        // the exemplars): tiles of a directory written before that rule
+        // are not kept beside tiles written after it.
+        "level_passes": synth.level_passes(w, h),
         "start_exemplar": params.start_exemplar,
         "piece_size": params.piece_size,
         "height_prior": params.prior,
