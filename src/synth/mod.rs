@@ -393,7 +393,15 @@ impl<'db> Synthesizer<'db> {
                 let allowed = control
                     .and_then(|c| c.guides.levels.get(l))
                     .and_then(|g| g.allowed.as_deref());
-                coarse::pieces(src, region, (l, side), seed, self.jitter, allowed)
+                coarse::pieces(
+                    src,
+                    region,
+                    (width, height),
+                    (l, side),
+                    seed,
+                    self.jitter,
+                    allowed,
+                )
             }
             Start::Centre => {
                 let top = start.top(m, l);

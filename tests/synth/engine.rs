@@ -28,13 +28,13 @@ fn bits(hf: &terrasynth::Heightfield) -> Vec<u32> {
 fn start(
     atlas: &AtlasLevel<'_>,
     from: Option<usize>,
-    region: Rect,
+    (region, world): (Rect, (usize, usize)),
     (l, side): (usize, i32),
     (seed, jitter): (u32, i32),
 ) -> State {
     let pool = coarse::Pool::new(atlas, from);
     let src = coarse::Source { atlas, pool: &pool };
-    coarse::pieces(src, region, (l, side), seed, jitter, None)
+    coarse::pieces(src, region, world, (l, side), seed, jitter, None)
 }
 
 /// The level synthesis starts at, and the database's atlas there.
@@ -239,7 +239,7 @@ fn without_a_start_exemplar_pieces_come_from_every_exemplar_by_area() {
     let st = start(
         &atlas,
         None,
-        Rect::new(0, 0, world, world),
+        (Rect::new(0, 0, world, world), (world << l, world << l)),
         (l, side),
         (5, 0),
     );
@@ -287,7 +287,7 @@ fn pieces_cover_every_interior_texel_alike_and_stay_inside() {
     let st = start(
         &atlas,
         Some(0),
-        Rect::new(0, 0, world, world),
+        (Rect::new(0, 0, world, world), (world << l, world << l)),
         (l, 8),
         (9, 100),
     );
@@ -330,7 +330,7 @@ fn pieces_stand_where_the_guide_says_and_keep_the_exemplars_relief() {
         let st = start(
             &atlas,
             Some(0),
-            Rect::new(0, 0, world, world),
+            (Rect::new(0, 0, world, world), (world << l, world << l)),
             (l, side),
             (seed, 0),
         );
@@ -371,21 +371,31 @@ fn a_window_of_the_start_is_the_crop_of_the_whole() {
     // Every piece is a hash of the seed and its position, and the guide a
     // field of absolute positions: any region starts as the crop of the
     // whole (what windows and tiles rely on).
+    // A world of 1200 px and one of 4800: the guide's rank window is
+    // ±7 nodes in the first, ±12 in the second (`coarse::guide::rank_steps`).
     let (l, atlas) = start_level();
-    let whole = start(&atlas, None, Rect::new(0, 0, 300, 200), (l, 8), (4, 100));
-    for r in [
-        Rect::new(37, 21, 50, 40),
-        Rect::new(0, 0, 7, 9),
-        Rect::new(250, 150, 50, 50),
-    ] {
-        let part = start(&atlas, None, r, (l, 8), (4, 100));
-        for y in 0..r.height() {
-            for x in 0..r.width() {
-                let (a, b) = (
-                    part.s(y * r.width() + x),
-                    whole.s((r.y0 + y) * 300 + r.x0 + x),
-                );
-                assert_eq!((a.x, a.y), (b.x, b.y), "{r:?} pixel ({x}, {y})");
+    for world in [(1200, 800), (4800, 3200)] {
+        let whole = start(
+            &atlas,
+            None,
+            (Rect::new(0, 0, 300, 200), world),
+            (l, 8),
+            (4, 100),
+        );
+        for r in [
+            Rect::new(37, 21, 50, 40),
+            Rect::new(0, 0, 7, 9),
+            Rect::new(250, 150, 50, 50),
+        ] {
+            let part = start(&atlas, None, (r, world), (l, 8), (4, 100));
+            for y in 0..r.height() {
+                for x in 0..r.width() {
+                    let (a, b) = (
+                        part.s(y * r.width() + x),
+                        whole.s((r.y0 + y) * 300 + r.x0 + x),
+                    );
+                    assert_eq!((a.x, a.y), (b.x, b.y), "{world:?} {r:?} pixel ({x}, {y})");
+                }
             }
         }
     }

@@ -51,6 +51,7 @@ const BAND_PER_MILLE: u32 = 20;
 pub fn pieces(
     src: Source<'_>,
     region: Rect,
+    world: (usize, usize),
     (l, side): (usize, i32),
     seed: u32,
     jitter: i32,
@@ -76,7 +77,8 @@ pub fn pieces(
             ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1)
         })
         .collect();
-    let quantiles = guide::quantiles(seed, src.pool.scale(), &places);
+    let steps = guide::rank_steps(world);
+    let quantiles = guide::quantiles(seed, src.pool.scale(), steps, &places);
     // The pool of every type set painted in the region (the whole pool
     // where a set has no texel at this level: type seeding then does what
     // it can, as it did before).
