@@ -10,8 +10,9 @@
 //! of highs and lows, the exemplars set everything else, and the output's
 //! altitudes follow the exemplars' distribution whatever the layout: the
 //! rank is local ([`RANK_STEPS`]), so every region of a few hundred
-//! pixels holds the exemplars' whole range of altitudes. The field's scale
-//! follows the exemplars' ([`Scale::of_exemplars`]).
+//! pixels holds the exemplars' whole range of altitudes — wider regions in
+//! larger worlds ([`rank_steps`]). The field's scale follows the
+//! exemplars' ([`Scale::of_exemplars`]).
 //!
 //! Why a field and not the exemplars' own layout: the start laid verbatim
 //! exemplar blocks, so every output was the exemplar's own massifs
