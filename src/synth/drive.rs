@@ -129,8 +129,8 @@ impl Synthesizer<'_> {
                         }
                     }
                     Some(c) => {
-                        let crop = |_: &_| self.can_crop(c, level, passes[level]);
-                        changed_parent = match window.filter(crop) {
+                        let can_crop = self.can_crop(c, level, passes[level]);
+                        changed_parent = match window.filter(|_| can_crop) {
                             Some(win) => {
                                 let buf = LevelBuffers {
                                     state: &state,

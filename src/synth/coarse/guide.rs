@@ -156,6 +156,7 @@ const CDF_SIDE: i32 = 4;
 /// the share of the middle ones, and coasts came out with two thirds of
 /// their sea (catalan 14.6 % at the start, exemplar 21.7 %).
 pub fn quantiles(seed: u32, scale: Scale, steps: i32, points: &[(i32, i32)]) -> Vec<u32> {
+    let steps = steps.clamp(RANK_STEPS, MAX_RANK_STEPS);
     let sorted = distribution(scale, steps);
     let n = sorted.len() as u64;
     local_ranks(seed, scale, steps, points)
@@ -170,8 +171,8 @@ pub fn quantiles(seed: u32, scale: Scale, steps: i32, points: &[(i32, i32)]) -> 
 }
 
 /// The local ranks of [`CDF_REGIONS`] × [`CDF_SIDE`]² places of seed 0 at
-/// `scale` in windows of ±`steps` nodes, sorted: computed once per process,
-/// scale and window.
+/// `scale` in windows of ±`steps` nodes (`RANK_STEPS ..= MAX_RANK_STEPS`),
+/// sorted: computed once per process, scale and window.
 ///
 /// Why [`local_ranks`] runs on one thread: this is a lazy static's
 /// initializer, and work handed to rayon's pool from inside it deadlocks
@@ -182,7 +183,6 @@ fn distribution(scale: Scale, steps: i32) -> &'static [u32] {
     const WINDOWS: usize = (MAX_RANK_STEPS - RANK_STEPS + 1) as usize;
     static SORTED: [[OnceLock<Vec<u32>>; WINDOWS]; 2] =
         [const { [const { OnceLock::new() }; WINDOWS] }; 2];
-    let steps = steps.clamp(RANK_STEPS, MAX_RANK_STEPS);
     SORTED[(scale.bits - 8) as usize][(steps - RANK_STEPS) as usize]
         .get_or_init(|| sample(scale, steps))
 }

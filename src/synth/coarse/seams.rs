@@ -67,7 +67,8 @@ fn factor_of(share: f64) -> u32 {
     if steps.is_nan() || steps < 0.0 {
         1
     } else {
-        (2 + steps.min(MAX_FACTOR as f64) as u32).min(MAX_FACTOR)
+        // `as` saturates, so a huge share cannot overflow.
+        (steps as u32).saturating_add(2).min(MAX_FACTOR)
     }
 }
 
@@ -84,13 +85,14 @@ type Grid<'a> = (&'a [u16], usize, usize);
 pub fn coarse_share(grids: &[Grid<'_>]) -> f64 {
     let (mut fine, mut coarse) = (Vec::new(), Vec::new());
     for &(heights, w, h) in grids {
-        let level0: Vec<u32> = heights.iter().map(|&v| v as u32).collect();
-        squared_differences(&level0, w, h, &mut fine);
+        squared_differences(heights, w, h, &mut fine);
         let (w2, h2) = (w / 4, h / 4);
         let sums: Vec<u32> = (0..w2 * h2)
             .map(|k| {
                 let (x, y) = (4 * (k % w2), 4 * (k / w2));
-                (0..16).map(|i| level0[(y + i / 4) * w + x + i % 4]).sum()
+                (0..16)
+                    .map(|i| u32::from(heights[(y + i / 4) * w + x + i % 4]))
+                    .sum()
             })
             .collect();
         squared_differences(&sums, w2, h2, &mut coarse);
@@ -103,12 +105,12 @@ pub fn coarse_share(grids: &[Grid<'_>]) -> f64 {
 
 /// Appends `dx² + dy²` of the central differences (`v[x+1] − v[x−1]`,
 /// likewise in y) of every interior pixel of a `w × h` grid.
-fn squared_differences(v: &[u32], w: usize, h: usize, out: &mut Vec<u64>) {
+fn squared_differences<T: Copy + Into<i64>>(v: &[T], w: usize, h: usize, out: &mut Vec<u64>) {
     for y in 1..h.saturating_sub(1) {
         for x in 1..w.saturating_sub(1) {
             let k = y * w + x;
-            let dx = v[k + 1] as i64 - v[k - 1] as i64;
-            let dy = v[k + w] as i64 - v[k - w] as i64;
+            let dx = v[k + 1].into() - v[k - 1].into();
+            let dy = v[k + w].into() - v[k - w].into();
             out.push((dx * dx + dy * dy) as u64);
         }
     }
