@@ -371,28 +371,32 @@ fn a_window_of_the_start_is_the_crop_of_the_whole() {
     // Every piece is a hash of the seed and its position, and the guide a
     // field of absolute positions: any region starts as the crop of the
     // whole (what windows and tiles rely on).
-    // A world of 1200 px and one of 4800: the guide's rank window is
-    // ±7 nodes in the first, ±12 in the second (`coarse::guide::rank_steps`).
+    // Worlds of 1000, 1200 and 4800 px: the first has its pieces' ranks
+    // balanced among the whole world's (`coarse::guide::balance`), the
+    // guide's rank window is ±8 nodes in the second, ±12 in the third
+    // (`coarse::guide::rank_steps`). Its top-left 300 × 200 level-L
+    // pixels (at most the world) stand for the whole.
     let (l, atlas) = start_level();
-    for world in [(1200, 800), (4800, 3200)] {
+    for world in [(1000, 700), (1200, 800), (4800, 3200)] {
+        let (w, h) = (300.min(world.0 >> l), 200.min(world.1 >> l));
         let whole = start(
             &atlas,
             None,
-            (Rect::new(0, 0, 300, 200), world),
+            (Rect::new(0, 0, w, h), world),
             (l, 8),
             (4, 100),
         );
         for r in [
             Rect::new(37, 21, 50, 40),
             Rect::new(0, 0, 7, 9),
-            Rect::new(250, 150, 50, 50),
+            Rect::new(w - 50, h - 50, 50, 50),
         ] {
             let part = start(&atlas, None, (r, world), (l, 8), (4, 100));
             for y in 0..r.height() {
                 for x in 0..r.width() {
                     let (a, b) = (
                         part.s(y * r.width() + x),
-                        whole.s((r.y0 + y) * 300 + r.x0 + x),
+                        whole.s((r.y0 + y) * w + r.x0 + x),
                     );
                     assert_eq!((a.x, a.y), (b.x, b.y), "{world:?} {r:?} pixel ({x}, {y})");
                 }

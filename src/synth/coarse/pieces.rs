@@ -4,7 +4,7 @@ use super::{Pool, Source, guide};
 use crate::database::layout::MARGIN;
 use crate::hash::{below, hash4};
 use crate::level::fixed::{Coord, FRAC_BITS};
-use crate::level::state::State;
+use crate::level::state::{State, level_size};
 use crate::stages::common::ALL_TYPES;
 use crate::stages::upsample_jitter;
 use crate::synth::cone::Rect;
@@ -30,7 +30,9 @@ const BAND_PER_MILLE: u32 = 20;
 /// ([`nearest`]: a Voronoi mosaic with wavy edges); piece (i, j) copies
 /// the exemplar around one texel of the pool, placed at its centre — drawn
 /// by a hash of the seed and (i, j) from the pool's ranks around the
-/// guide's rank there — mirrored at the interior's edges; each pixel gets
+/// guide's rank there (balanced among the world's pieces in worlds up to
+/// [`guide::BALANCED_SIDE`], [`guide::balance`]) — mirrored at the
+/// interior's edges; each pixel gets
 /// the level's jitter (`jitter`, fixed point, the same hash as
 /// `upsample_jitter`) and offset V = 0 (its own altitude).
 ///
@@ -71,14 +73,22 @@ pub fn pieces(
         (cell(region.y1 as i32 - 1) + reach - j0 + 1) as usize,
     );
     let ij = |k: usize| (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
-    let places: Vec<(i32, i32)> = (0..ni * nj)
-        .map(|k| {
-            let (fx, fy) = feature(seed, side, ij(k));
-            ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1)
-        })
-        .collect();
-    let steps = guide::rank_steps(world);
-    let quantiles = guide::quantiles(seed, src.pool.scale(), steps, &places);
+    // A piece's centre in output pixels, where the guide is read.
+    let place = |ij| {
+        let (fx, fy) = feature(seed, side, ij);
+        ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1)
+    };
+    let places: Vec<(i32, i32)> = (0..ni * nj).map(|k| place(ij(k))).collect();
+    let (scale, steps) = (src.pool.scale(), guide::rank_steps(world));
+    let mut quantiles = guide::quantiles(seed, scale, steps, &places);
+    if world.0.max(world.1) <= guide::BALANCED_SIDE {
+        // Every piece of the world, whatever the region: a window is
+        // balanced as the whole is.
+        let (wl, hl) = level_size(world.0, world.1, l);
+        let (ci, cj) = (cell(wl as i32 - 1) + 1, cell(hl as i32 - 1) + 1);
+        let all: Vec<(i32, i32)> = (0..ci * cj).map(|k| place((k % ci, k / ci))).collect();
+        guide::balance(&mut quantiles, guide::quantiles(seed, scale, steps, &all));
+    }
     // The pool of every type set painted in the region (the whole pool
     // where a set has no texel at this level: type seeding then does what
     // it can, as it did before).
