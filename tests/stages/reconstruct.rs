@@ -25,8 +25,7 @@ use crate::common::variants::{assert_agree, gpu_or_skip, rig};
 /// pixel from coordinates, in i64: the blend b (the mean of the neighbours'
 /// smooth predictions plus the pixel's own texel detail), then each
 /// interior pixel strictly below (above) its eight neighbours' blends
-/// judged by its texel's support in the exemplar and, in a hollow (on a
-/// rise), by its depth against half the texel's least rise.
+/// judged by its texel's support in the exemplar.
 fn oracle(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
     let (w, h) = (st.width as i64, st.height as i64);
     let at = |x: i64, y: i64| (y * w + x) as usize;
@@ -67,18 +66,14 @@ fn oracle(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
             }
             let pit = c < lo;
             let t = texel(x, y);
-            // The texel's rises to its supporting neighbours (higher ones
-            // for a pit, lower ones for a peak), in metres of the exemplar.
-            let rises: Vec<i64> = deltas()
+            let support = deltas()
                 .filter(|&d| d != (0, 0))
-                .map(|(dx, dy)| e((t.0 + dx as i32, t.1 + dy as i32)) - e(t))
-                .filter(|&r| if pit { r > 0 } else { r < 0 })
-                .map(i64::abs)
-                .collect();
-            let support = rises.len() as u32;
-            let depth = if pit { lo - c } else { c - hi };
-            let shallow = rises.iter().min().is_some_and(|&r| depth * 2 <= r * 256);
-            out[at(x, y)] = if support == 8 || (support >= SUPPORT && shallow) {
+                .filter(|&(dx, dy)| {
+                    let n = e((t.0 + dx as i32, t.1 + dy as i32));
+                    if pit { n > e(t) } else { n < e(t) }
+                })
+                .count() as u32;
+            out[at(x, y)] = if support == 8 {
                 c
             } else if support >= SUPPORT {
                 let sum: i64 = deltas()
