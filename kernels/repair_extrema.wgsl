@@ -1,8 +1,10 @@
 // Stage `repair_extrema`: the mirror of src/stages/repair_extrema.rs — an
 // interior pixel whose blended height (stage `reconstruct`) is strictly
 // below (above) its eight neighbours' is judged by its texel's support in
-// the exemplar: 8 keeps it, ≥ SUPPORT takes the plain mean of the nine
-// neighbours' predictions, fewer the neighbours' lowest (highest) blend.
+// the exemplar: 8 keeps it, ≥ DIMPLE_SUPPORT keeps it no deeper (higher)
+// than half the texel's least rise (drop) to its supporting neighbours,
+// ≥ SUPPORT takes the plain mean of the nine neighbours' predictions,
+// fewer the neighbours' lowest (highest) blend.
 // Edge pixels keep their blend.
 
 struct ReconstructParams {
@@ -23,6 +25,10 @@ struct ReconstructParams {
 
 // repair_extrema::SUPPORT.
 const SUPPORT: u32 = 6u;
+// repair_extrema::DIMPLE_SUPPORT.
+const DIMPLE_SUPPORT: u32 = 7u;
+// repair_extrema::DIMPLE_SHIFT.
+const DIMPLE_SHIFT: u32 = 7u;
 
 fn height(i: i32) -> i32 {
     let u = u32(i);
@@ -81,6 +87,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let t = texel(i);
     let e = height(t.x);
     var support = 0u;
+    var rise = 2147483647;
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             if (dx == 0 && dy == 0) {
@@ -89,11 +96,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             let n = height(t.x + dx + dy * t.y);
             if ((pit && n > e) || (!pit && n < e)) {
                 support += 1u;
+                rise = min(rise, abs(n - e));
             }
         }
     }
     if (support == 8u) {
         out[i] = c;
+    } else if (support >= DIMPLE_SUPPORT && pit) {
+        out[i] = max(c, lo - (rise << DIMPLE_SHIFT));
+    } else if (support >= DIMPLE_SUPPORT) {
+        out[i] = min(c, hi + (rise << DIMPLE_SHIFT));
     } else if (support >= SUPPORT) {
         out[i] = mean(gid.x, gid.y);
     } else if (pit) {

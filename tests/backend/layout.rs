@@ -381,13 +381,19 @@ fn correct_constants_match() {
 
 #[test]
 fn reconstruct_constants_match() {
-    use terrasynth::stages::repair_extrema::SUPPORT;
-    assert!(
-        Stage::RepairExtrema
-            .wgsl()
-            .contains(&format!("const SUPPORT: u32 = {SUPPORT}u;")),
-        "SUPPORT must be {SUPPORT} in repair_extrema.wgsl"
-    );
+    use terrasynth::stages::repair_extrema::{DIMPLE_SHIFT, DIMPLE_SUPPORT, SUPPORT};
+    for (name, v) in [
+        ("SUPPORT", SUPPORT),
+        ("DIMPLE_SUPPORT", DIMPLE_SUPPORT),
+        ("DIMPLE_SHIFT", DIMPLE_SHIFT),
+    ] {
+        assert!(
+            Stage::RepairExtrema
+                .wgsl()
+                .contains(&format!("const {name}: u32 = {v}u;")),
+            "{name} must be {v} in repair_extrema.wgsl"
+        );
+    }
 }
 
 /// The constants several kernels share are declared once, in

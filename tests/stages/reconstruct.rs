@@ -15,7 +15,7 @@ use terrasynth::level::atlas::AtlasLevel;
 use terrasynth::level::fixed::round;
 use terrasynth::level::state::State;
 use terrasynth::stages::reconstruct::{reconstruct, reconstruct_rect};
-use terrasynth::stages::repair_extrema::SUPPORT;
+use terrasynth::stages::repair_extrema::{DIMPLE_SUPPORT, SUPPORT};
 
 use crate::common::db::{default_db, real_syntheses};
 use crate::common::states::{random_state, real_levels};
@@ -25,7 +25,8 @@ use crate::common::variants::{assert_agree, gpu_or_skip, rig};
 /// pixel from coordinates, in i64: the blend b (the mean of the neighbours'
 /// smooth predictions plus the pixel's own texel detail), then each
 /// interior pixel strictly below (above) its eight neighbours' blends
-/// judged by its texel's support in the exemplar.
+/// judged by its texel's support in the exemplar: on a hollow's floor (a
+/// rise's top) it stays, no deeper than half the texel's least rise.
 fn oracle(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
     let (w, h) = (st.width as i64, st.height as i64);
     let at = |x: i64, y: i64| (y * w + x) as usize;
@@ -66,15 +67,25 @@ fn oracle(atlas: &AtlasLevel<'_>, heights: &[u16], st: &State) -> Vec<i32> {
             }
             let pit = c < lo;
             let t = texel(x, y);
-            let support = deltas()
+            // The texel's rises to its supporting neighbours (higher ones
+            // for a pit, lower ones for a peak), in metres of the exemplar.
+            let rises: Vec<i64> = deltas()
                 .filter(|&d| d != (0, 0))
-                .filter(|&(dx, dy)| {
-                    let n = e((t.0 + dx as i32, t.1 + dy as i32));
-                    if pit { n > e(t) } else { n < e(t) }
-                })
-                .count() as u32;
+                .map(|(dx, dy)| e((t.0 + dx as i32, t.1 + dy as i32)) - e(t))
+                .filter(|&r| if pit { r > 0 } else { r < 0 })
+                .map(i64::abs)
+                .collect();
+            let support = rises.len() as u32;
+            // Half the least rise, ×2^8.
+            let bound = rises.iter().min().map_or(0, |&r| r * 128);
             out[at(x, y)] = if support == 8 {
                 c
+            } else if support >= DIMPLE_SUPPORT {
+                if pit {
+                    c.max(lo - bound)
+                } else {
+                    c.min(hi + bound)
+                }
             } else if support >= SUPPORT {
                 let sum: i64 = deltas()
                     .map(|(dx, dy)| {

@@ -383,7 +383,9 @@ fn cli_edit_bakes_new_strokes_on_the_frame_before() {
     // rule: under 1 % of the pixels, by under 1 % of the relief). Measured:
     // none moved on the square pieces of the coarse start; 12 of 2 600, by
     // 4–11 mm, on its Voronoi pieces (issue 46), whose edits reach 55 px
-    // past the second stroke's radius at rows 112–113.
+    // past the second stroke's radius at rows 112–113; 21 with the
+    // balanced guide, and 25, by up to 4 cm, with the hollows' dimples of
+    // `repair_extrema` kept.
     let moved: Vec<f64> = inner
         .iter()
         .map(|&(x, y)| f64::from((h2.get(x, y) - h1.get(x, y)).abs()))
