@@ -27,7 +27,7 @@ const BAND_PER_MILLE: u32 = 20;
 /// level, or a window's cone): the level is cut into pieces, one per cell
 /// of a grid of `side` texels anchored at the world's origin, each pixel
 /// to the piece whose centre ([`feature`]) is nearest to it once warped
-/// ([`nearest`]: a Voronoi mosaic with wavy edges); piece (i, j) copies
+/// ([`Cells::nearest`]: a Voronoi mosaic with wavy edges); piece (i, j) copies
 /// the exemplar around one texel of the pool, placed at its centre — drawn
 /// by a hash of the seed and (i, j) from the pool's ranks around the
 /// guide's rank there (balanced among the world's pieces in worlds up to
@@ -73,12 +73,10 @@ pub fn pieces(
         (cell(region.y1 as i32 - 1) + reach - j0 + 1) as usize,
     );
     let ij = |k: usize| (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
+    let cells = Cells::new(seed, side, (i0, j0), (ni, nj));
     // A piece's centre in output pixels, where the guide is read.
-    let place = |ij| {
-        let (fx, fy) = feature(seed, side, ij);
-        ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1)
-    };
-    let places: Vec<(i32, i32)> = (0..ni * nj).map(|k| place(ij(k))).collect();
+    let place = |(fx, fy): (i32, i32)| ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1);
+    let places: Vec<(i32, i32)> = cells.features.iter().map(|&f| place(f)).collect();
     let (scale, steps) = (src.pool.scale(), guide::rank_steps(world));
     let mut quantiles = guide::quantiles(seed, scale, steps, &places);
     if world.0.max(world.1) <= guide::BALANCED_SIDE {
@@ -86,7 +84,9 @@ pub fn pieces(
         // balanced as the whole is.
         let (wl, hl) = level_size(world.0, world.1, l);
         let (ci, cj) = (cell(wl as i32 - 1) + 1, cell(hl as i32 - 1) + 1);
-        let all: Vec<(i32, i32)> = (0..ci * cj).map(|k| place((k % ci, k / ci))).collect();
+        let all: Vec<(i32, i32)> = (0..ci * cj)
+            .map(|k| place(feature(seed, side, (k % ci, k / ci))))
+            .collect();
         guide::balance(&mut quantiles, guide::quantiles(seed, scale, steps, &all));
     }
     // The pool of every type set painted in the region (the whole pool
@@ -117,8 +117,8 @@ pub fn pieces(
         let y = (region.y0 + r) as i32;
         for c in 0..w {
             let x = (region.x0 + c) as i32;
-            let ((i, j), (fx, fy)) = nearest(seed, side, (x, y));
-            let k = (j - j0) as usize * ni + (i - i0) as usize;
+            let (k, (fx, fy)) = cells.nearest(side, (x, y));
+            let (i, j) = ij(k);
             let (cx, cy) = match allowed.map_or(ALL_TYPES, |a| a[r * w + c]) {
                 ALL_TYPES => centres[k],
                 mask => draw(pool_of(mask), painted(quantiles[k]), seed, (i, j)),
@@ -154,57 +154,90 @@ fn feature(seed: u32, side: i32, (i, j): (i32, i32)) -> (i32, i32) {
     (i * side + side / 2 + off(1), j * side + side / 2 + off(2))
 }
 
-/// The piece texel (x, y) belongs to, and its centre: of the features
-/// ([`feature`]) of the 3×3 cells around the place displaced by a smooth
-/// field of up to a third of a side, the nearest (squared distance; ties
-/// to the first in row order), so the cells' straight Voronoi edges come
-/// out wavy. (A feature two cells away can rarely be nearer; leaving it
-/// out keeps the piece a function of the 3×3 alone.) The displaced place
-/// lies within a cell of (x, y)'s and the chosen centre within a cell of
-/// it: `pieces` takes the cells two around the region.
-fn nearest(seed: u32, side: i32, (x, y): (i32, i32)) -> ((i32, i32), (i32, i32)) {
-    let amp = side / 3;
-    let (wx, wy) = (
-        x + warp(seed, 3, side, x, y, amp),
-        y + warp(seed, 4, side, x, y, amp),
-    );
-    let (ci, cj) = (wx.div_euclid(side), wy.div_euclid(side));
-    let mut best = ((ci, cj), feature(seed, side, (ci, cj)), i64::MAX);
-    for dj in -1..=1 {
-        for di in -1..=1 {
-            let ij = (ci + di, cj + dj);
-            let f = feature(seed, side, ij);
-            let (dx, dy) = (i64::from(f.0 - wx), i64::from(f.1 - wy));
-            let d = dx * dx + dy * dy;
-            if d < best.2 {
-                best = (ij, f, d);
-            }
-        }
-    }
-    (best.0, best.1)
+/// The hashed values of the cells of the `side`-texel grid within reach
+/// of a region (`ni` × `nj` from cell (`i0`, `j0`), row-major): each
+/// piece's centre ([`feature`]) and the warp's lattice values (salts 3 and
+/// 4, in `[−side/3, side/3]`).
+///
+/// Why a table: every texel reads nine centres and eight lattice values;
+/// hashed per texel they were a twentieth of a 1024² synthesis.
+struct Cells {
+    i0: i32,
+    j0: i32,
+    ni: usize,
+    features: Vec<(i32, i32)>,
+    warps: Vec<(i64, i64)>,
 }
 
-/// Value noise in `[−amp, amp]` on a lattice of `side` texels: hashed
-/// values interpolated bilinearly in integers.
-fn warp(seed: u32, salt: u32, side: i32, x: i32, y: i32, amp: i32) -> i32 {
-    if amp == 0 {
-        return 0;
+impl Cells {
+    fn new(seed: u32, side: i32, (i0, j0): (i32, i32), (ni, nj): (usize, usize)) -> Cells {
+        let amp = side / 3;
+        let ij = |k: usize| (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
+        let lattice = |salt: u32, (i, j): (i32, i32)| {
+            let h = hash4(seed, SALT | salt, i as u32, j as u32);
+            i64::from(below(h, (2 * amp + 1) as u32) as i32 - amp)
+        };
+        Cells {
+            i0,
+            j0,
+            ni,
+            features: (0..ni * nj).map(|k| feature(seed, side, ij(k))).collect(),
+            warps: (0..ni * nj)
+                .map(|k| (lattice(3, ij(k)), lattice(4, ij(k))))
+                .collect(),
+        }
     }
-    let (cx, cy) = (x.div_euclid(side), y.div_euclid(side));
-    let (fx, fy) = (i64::from(x.rem_euclid(side)), i64::from(y.rem_euclid(side)));
-    let v = |dx: i32, dy: i32| {
-        i64::from(
-            below(
-                hash4(seed, SALT | salt, (cx + dx) as u32, (cy + dy) as u32),
-                (2 * amp + 1) as u32,
-            ) as i32
-                - amp,
+
+    /// The table index of cell (i, j).
+    fn at(&self, (i, j): (i32, i32)) -> usize {
+        (j - self.j0) as usize * self.ni + (i - self.i0) as usize
+    }
+
+    /// The piece texel (x, y) belongs to (its table index), and its
+    /// centre: of the features of the 3×3 cells around the place
+    /// displaced by [`Cells::warp`], the nearest (squared distance; ties
+    /// to the first in row order), so the cells' straight Voronoi edges
+    /// come out wavy. (A feature two cells away can rarely be nearer;
+    /// leaving it out keeps the piece a function of the 3×3 alone.) The
+    /// displaced place lies within a cell of (x, y)'s and the chosen centre
+    /// within a cell of it: `pieces` takes the cells two around the region.
+    fn nearest(&self, side: i32, (x, y): (i32, i32)) -> (usize, (i32, i32)) {
+        let (dx, dy) = self.warp(side, x, y);
+        let (wx, wy) = (x + dx, y + dy);
+        let (ci, cj) = (wx.div_euclid(side), wy.div_euclid(side));
+        let mut best = (0, (0, 0), i64::MAX);
+        for dj in -1..=1 {
+            for di in -1..=1 {
+                let k = self.at((ci + di, cj + dj));
+                let f = self.features[k];
+                let (dx, dy) = (i64::from(f.0 - wx), i64::from(f.1 - wy));
+                let d = dx * dx + dy * dy;
+                if d < best.2 {
+                    best = (k, f, d);
+                }
+            }
+        }
+        (best.0, best.1)
+    }
+
+    /// The displacement of (x, y): two value noises of up to a third of a
+    /// side on the cells' lattice, interpolated bilinearly in integers.
+    fn warp(&self, side: i32, x: i32, y: i32) -> (i32, i32) {
+        let k = self.at((x.div_euclid(side), y.div_euclid(side)));
+        let (fx, fy) = (i64::from(x.rem_euclid(side)), i64::from(y.rem_euclid(side)));
+        let n = i64::from(side);
+        let (v00, v10) = (self.warps[k], self.warps[k + 1]);
+        let (v01, v11) = (self.warps[k + self.ni], self.warps[k + self.ni + 1]);
+        let mix = |a: i64, b: i64, c: i64, d: i64| {
+            let top = a * (n - fx) + b * fx;
+            let bottom = c * (n - fx) + d * fx;
+            (top * (n - fy) + bottom * fy).div_euclid(n * n) as i32
+        };
+        (
+            mix(v00.0, v10.0, v01.0, v11.0),
+            mix(v00.1, v10.1, v01.1, v11.1),
         )
-    };
-    let n = i64::from(side);
-    let top = v(0, 0) * (n - fx) + v(1, 0) * fx;
-    let bottom = v(0, 1) * (n - fx) + v(1, 1) * fx;
-    (top * (n - fy) + bottom * fy).div_euclid(n * n) as i32
+    }
 }
 
 /// The quantile a painted pixel draws at: the guide's `u` pulled halfway
