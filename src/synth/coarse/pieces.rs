@@ -72,8 +72,8 @@ pub fn pieces(
         (cell(region.x1 as i32 - 1) + reach - i0 + 1) as usize,
         (cell(region.y1 as i32 - 1) + reach - j0 + 1) as usize,
     );
-    let ij = |k: usize| (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
     let cells = Cells::new(seed, side, (i0, j0), (ni, nj));
+    let ij = |k: usize| cells.ij(k);
     // A piece's centre in output pixels, where the guide is read.
     let place = |(fx, fy): (i32, i32)| ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1);
     let places: Vec<(i32, i32)> = cells.features.iter().map(|&f| place(f)).collect();
@@ -172,20 +172,31 @@ struct Cells {
 impl Cells {
     fn new(seed: u32, side: i32, (i0, j0): (i32, i32), (ni, nj): (usize, usize)) -> Cells {
         let amp = side / 3;
-        let ij = |k: usize| (i0 + (k % ni) as i32, j0 + (k / ni) as i32);
         let lattice = |salt: u32, (i, j): (i32, i32)| {
             let h = hash4(seed, SALT | salt, i as u32, j as u32);
             i64::from(below(h, (2 * amp + 1) as u32) as i32 - amp)
         };
-        Cells {
+        let mut cells = Cells {
             i0,
             j0,
             ni,
-            features: (0..ni * nj).map(|k| feature(seed, side, ij(k))).collect(),
-            warps: (0..ni * nj)
-                .map(|k| (lattice(3, ij(k)), lattice(4, ij(k))))
-                .collect(),
+            features: Vec::with_capacity(ni * nj),
+            warps: Vec::with_capacity(ni * nj),
+        };
+        for k in 0..ni * nj {
+            let ij = cells.ij(k);
+            cells.features.push(feature(seed, side, ij));
+            cells.warps.push((lattice(3, ij), lattice(4, ij)));
         }
+        cells
+    }
+
+    /// The cell (i, j) at table index `k`.
+    fn ij(&self, k: usize) -> (i32, i32) {
+        (
+            self.i0 + (k % self.ni) as i32,
+            self.j0 + (k / self.ni) as i32,
+        )
     }
 
     /// The table index of cell (i, j).
