@@ -2,7 +2,7 @@
 
 use super::appearance;
 use super::error::DbError;
-use super::file::{self, Bytes, Kind, Section};
+use super::file::{self, Kind, Section};
 use super::layout::{self, MAX_EXEMPLARS};
 use super::patchmatch;
 use super::pyramid::{self, Grid, Quantization};
@@ -311,9 +311,7 @@ pub fn build(
             bytes: bytemuck::cast_slice(sd),
         });
     }
-    let words = file::encode(&sections);
-    let len = words.len() * 8;
-    let db = Database::parse(Bytes::Owned(words, len), Path::new("<built database>"))?;
+    let db = Database::parse(file::encode(&sections), Path::new("<built database>"))?;
     Ok((db, report))
 }
 

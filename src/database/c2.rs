@@ -89,12 +89,12 @@ pub fn gather(level: &Level<'_>) -> Vec<Quad> {
 }
 
 /// The tables of every level of a database: gathered in this process, or
-/// mapped from the file that keeps them ([`super::c2_cache`]).
+/// read from the file that keeps them ([`super::c2_cache`]).
 pub enum Tables {
     Gathered(Vec<Vec<Quad>>),
     /// The file and each level's byte range in it (checked to be 32-byte
-    /// aligned when the file was opened).
-    Mapped(Bytes, Vec<Range<usize>>),
+    /// aligned when the file was read).
+    Read(Bytes, Vec<Range<usize>>),
 }
 
 impl Tables {
@@ -102,7 +102,7 @@ impl Tables {
     pub fn level(&self, i: usize) -> &[Quad] {
         match self {
             Tables::Gathered(t) => &t[i],
-            Tables::Mapped(b, r) => bytemuck::cast_slice(&b.as_slice()[r[i].clone()]),
+            Tables::Read(b, r) => bytemuck::cast_slice(&b.as_slice()[r[i].clone()]),
         }
     }
 }

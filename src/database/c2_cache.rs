@@ -5,8 +5,9 @@
 //! anew: for the embedded database 33 MB written into fresh memory,
 //! ~20 ms of a ~0.4 s `synth --size 1024x1024` (about half of it the
 //! kernel zeroing the pages), paid again by every Dask worker and every
-//! short `synth`. Mapped from a file the OS already holds in its page
-//! cache, they cost one checksum pass. The embedded database keeps them
+//! short `synth`. Read from a file the OS already holds in its page
+//! cache, they cost a copy and one checksum pass (into huge pages, like
+//! the database: [`super::file::Bytes`]). The embedded database keeps them
 //! beside its own cached file ([`super::default`]); a database the user
 //! names is left as it is (its tables are gathered per process, as
 //! before), so that nothing is written beside the user's files.
@@ -134,20 +135,20 @@ pub fn decode(
     Ok(ranges)
 }
 
-/// The tables of `db` kept at `path`, mapped; `None` if the file is
-/// missing or refused.
+/// The tables of `db` kept at `path`; `None` if the file is missing or
+/// refused.
 pub(super) fn load(path: &Path, db: &Database) -> Option<Tables> {
-    let bytes = Bytes::map(path).ok()?;
+    let bytes = Bytes::read(path).ok()?;
     let counts: Vec<usize> = (0..db.level_count())
         .map(|i| db.level(i).similar.len())
         .collect();
     let ranges = decode(bytes.as_slice(), db.fingerprint(), &counts).ok()?;
-    // A mapping starts on a page, and every range on a multiple of 32
+    // `Bytes` starts on 64 bytes, and every range on a multiple of 32
     // bytes from it; checked anyway, since `Tables::level` casts.
     let aligned = ranges
         .iter()
         .all(|r| bytemuck::try_cast_slice::<u8, Quad>(&bytes.as_slice()[r.clone()]).is_ok());
-    aligned.then_some(Tables::Mapped(bytes, ranges))
+    aligned.then_some(Tables::Read(bytes, ranges))
 }
 
 /// Keeps `tables` of `db` at `path` (atomically). A file that cannot be

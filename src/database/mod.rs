@@ -122,7 +122,7 @@ struct LevelRanges {
 }
 
 /// A loaded (or freshly built) database. Cheap to share by reference; the
-/// arrays are views into one buffer or memory map.
+/// arrays are views into one buffer ([`file::Bytes`]).
 pub struct Database {
     meta: Meta,
     bytes: Bytes,
@@ -147,19 +147,17 @@ impl std::fmt::Debug for Database {
 }
 
 impl Database {
-    /// Loads a `.tsdb` file by memory map, verifying every checksum and the
-    /// contents (see [`file`]).
+    /// Loads a `.tsdb` file, verifying every checksum and the contents
+    /// (see [`file`]).
     pub fn load(path: &Path) -> Result<Database, DbError> {
-        Database::parse(Bytes::map(path)?, path)
+        Database::parse(Bytes::read(path)?, path)
     }
 
     /// Validates an in-memory `.tsdb` image (for embedding, pipes and the
     /// fuzzer); `name` stands for its origin in error messages. The bytes are
-    /// copied once into 8-byte-aligned storage, as the arrays require.
+    /// copied once into aligned storage, as the arrays require.
     pub fn from_bytes(bytes: &[u8], name: &Path) -> Result<Database, DbError> {
-        let mut words = vec![0u64; bytes.len().div_ceil(8)];
-        bytemuck::cast_slice_mut::<u64, u8>(&mut words)[..bytes.len()].copy_from_slice(bytes);
-        Database::parse(Bytes::Owned(words, bytes.len()), name)
+        Database::parse(Bytes::copied(bytes), name)
     }
 
     /// Writes the database atomically.
@@ -218,7 +216,7 @@ impl Database {
         }
     }
     /// C₂'s diagonal texels of level `i` (the CPU correction's table,
-    /// [`c2`]), gathered for every level on first use, or mapped from the
+    /// [`c2`]), gathered for every level on first use, or read from the
     /// file that keeps them ([`Database::keep_c2_at`]).
     ///
     /// Built without a lock: a caller that finds the tables missing builds
@@ -249,7 +247,7 @@ impl Database {
     }
 
     /// Keeps C₂'s tables ([`Database::c2`]) in the file `path` across
-    /// processes: they are mapped from it when it holds this database's
+    /// processes: they are read from it when it holds this database's
     /// tables, else gathered and written there. For databases in the
     /// cache directory ([`c2_cache`]); has no effect once the tables exist.
     pub fn keep_c2_at(&mut self, path: PathBuf) {
