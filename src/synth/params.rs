@@ -41,19 +41,13 @@ pub struct Params {
     /// similar texel C₂ as a candidate (the paper's k = 2); finer levels
     /// score C₁ alone (k = 1). 0: k = 2 everywhere, as in the paper.
     ///
-    /// Why 2: C₂ wins 0.15–0.22 % of the pixels at every level (κ = 2 and
-    /// the height prior rarely let it), yet it is a level's farthest
-    /// reads: at level 0 scoring it took ~16 % of the instructions, and
-    /// with the coarse start's small pieces levels 1–2 (with C₂) took
-    /// 41 % of level 0's time for 5/16 of its pixels (a CPU profile of
-    /// the 1024² `bench`). Without it at level 0 the realism protocol
-    /// (8 DEMs × 9 seeds) gave the same mean ratio, 0.520; without it at
-    /// levels 0–1 too, 0.522. On the 8 shared DEMs (seeds 11–13, the
-    /// exemplar's size) leaving level 1 out too kept every realism and
-    /// novelty figure within 0.04 of the ratio and one point of slope
-    /// and copies (at 3× the exemplar's side too), and the 1024² `bench`
-    /// ran 5 % faster (0.95×, per-round median of 15 interleaved
-    /// rounds). At every level the ratio rose to 0.532, so the coarse
+    /// Why 1: at level 0, C₂ won 0.17 % of the pixels of a 1024²
+    /// synthesis (0.15–0.22 % at every level: κ = 2 and the height prior
+    /// rarely let it), yet scoring it took ~16 % of level 0's
+    /// instructions and its texels were the level's farthest reads.
+    /// Without it at level 0 the realism protocol (8 DEMs × 9 seeds) gave
+    /// the same mean ratio, 0.520; without it at levels 0–1 too, 0.522
+    /// (olympic 0.244 → 0.262), and at every level 0.532, so the coarse
     /// levels keep it: a C₂ there starts a patch from elsewhere in the
     /// exemplars.
     pub similar_from: usize,
@@ -69,7 +63,7 @@ impl Default for Params {
             start_exemplar: None,
             piece_size: DEFAULT_PIECE_SIZE,
             prior: crate::stages::correct::DEFAULT_PRIOR,
-            similar_from: 2,
+            similar_from: 1,
             keep_levels: false,
         }
     }

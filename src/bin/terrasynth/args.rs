@@ -154,8 +154,8 @@ pub struct SynthesisArgs {
     pub height_prior: u32,
     /// The finest level whose correction also scores each source's most
     /// similar texel C₂ (k = 2); finer levels score C₁ alone. 0 is the
-    /// paper's k = 2 at every level; the default leaves out levels 0 and
-    /// 1, where C₂ almost never wins.
+    /// paper's k = 2 at every level; the default leaves out level 0, where
+    /// C₂ almost never wins.
     #[arg(long, default_value_t = terrasynth::synth::Params::default().similar_from)]
     pub similar_from: usize,
 }
