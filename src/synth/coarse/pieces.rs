@@ -73,7 +73,6 @@ pub fn pieces(
         (cell(region.y1 as i32 - 1) + reach - j0 + 1) as usize,
     );
     let cells = Cells::new(seed, side, (i0, j0), (ni, nj));
-    let ij = |k: usize| cells.ij(k);
     // A piece's centre in output pixels, where the guide is read.
     let place = |(fx, fy): (i32, i32)| ((2 * fx + 1) << l >> 1, (2 * fy + 1) << l >> 1);
     let places: Vec<(i32, i32)> = cells.features.iter().map(|&f| place(f)).collect();
@@ -110,15 +109,15 @@ pub fn pieces(
     };
     let centres: Vec<(i32, i32)> = (0..ni * nj)
         .into_par_iter()
-        .map(|k| draw(src.pool, quantiles[k], seed, ij(k)))
+        .map(|k| draw(src.pool, quantiles[k], seed, cells.ij(k)))
         .collect();
     let st = State::new(w, h);
     (0..h).into_par_iter().for_each(|r| {
         let y = (region.y0 + r) as i32;
         for c in 0..w {
             let x = (region.x0 + c) as i32;
-            let (k, (fx, fy)) = cells.nearest(side, (x, y));
-            let (i, j) = ij(k);
+            let (k, (fx, fy)) = cells.nearest((x, y));
+            let (i, j) = cells.ij(k);
             let (cx, cy) = match allowed.map_or(ALL_TYPES, |a| a[r * w + c]) {
                 ALL_TYPES => centres[k],
                 mask => draw(pool_of(mask), painted(quantiles[k]), seed, (i, j)),
@@ -162,6 +161,7 @@ fn feature(seed: u32, side: i32, (i, j): (i32, i32)) -> (i32, i32) {
 /// Why a table: every texel reads nine centres and eight lattice values;
 /// hashed per texel they were a twentieth of a 1024² synthesis.
 struct Cells {
+    side: i32,
     i0: i32,
     j0: i32,
     ni: usize,
@@ -177,6 +177,7 @@ impl Cells {
             i64::from(below(h, (2 * amp + 1) as u32) as i32 - amp)
         };
         let mut cells = Cells {
+            side,
             i0,
             j0,
             ni,
@@ -212,8 +213,9 @@ impl Cells {
     /// leaving it out keeps the piece a function of the 3×3 alone.) The
     /// displaced place lies within a cell of (x, y)'s and the chosen centre
     /// within a cell of it: `pieces` takes the cells two around the region.
-    fn nearest(&self, side: i32, (x, y): (i32, i32)) -> (usize, (i32, i32)) {
-        let (dx, dy) = self.warp(side, x, y);
+    fn nearest(&self, (x, y): (i32, i32)) -> (usize, (i32, i32)) {
+        let side = self.side;
+        let (dx, dy) = self.warp(x, y);
         let (wx, wy) = (x + dx, y + dy);
         let (ci, cj) = (wx.div_euclid(side), wy.div_euclid(side));
         let mut best = (0, (0, 0), i64::MAX);
@@ -233,7 +235,8 @@ impl Cells {
 
     /// The displacement of (x, y): two value noises of up to a third of a
     /// side on the cells' lattice, interpolated bilinearly in integers.
-    fn warp(&self, side: i32, x: i32, y: i32) -> (i32, i32) {
+    fn warp(&self, x: i32, y: i32) -> (i32, i32) {
+        let side = self.side;
         let k = self.at((x.div_euclid(side), y.div_euclid(side)));
         let (fx, fy) = (i64::from(x.rem_euclid(side)), i64::from(y.rem_euclid(side)));
         let n = i64::from(side);
