@@ -434,7 +434,8 @@ fn write_heightfield(
 /// between the reference's two halves; about 1 is as real as the
 /// reference), ``descriptors`` (per descriptor: ``id``, ``unit``,
 /// ``synth``, ``reference``, ``distance``, ``halves``, ``ratio``, ...),
-/// ``median_slope``, ``relief`` and ``pits``.
+/// ``median_slope``, ``relief``, ``pits`` and ``closed`` (the share of
+/// the area in closed depressions: water with no valley out).
 #[pyfunction]
 #[pyo3(signature = (synth, reference, cell_size, reference_cell_size=None))]
 fn eval<'py>(

@@ -126,6 +126,7 @@ impl Reference {
             median_slope: pair(synth.median_slope(), self.whole.median_slope()),
             relief: pair(synth.relief, self.whole.relief),
             pits: pair(synth.pits(), self.whole.pits()),
+            closed: pair(synth.closed, self.whole.closed),
         }
     }
 }
@@ -184,4 +185,7 @@ pub struct Comparison {
     pub relief: Pair,
     /// Pit fraction.
     pub pits: Pair,
+    /// [`super::drainage::closed_share`]: the area in closed depressions
+    /// (above the reference's: lowlands with no valley out).
+    pub closed: Pair,
 }

@@ -18,8 +18,10 @@
 //! | `hypsometric` | scalar | hypsometric integral (mean − min) / (max − min) of the heights — how much stands high |
 //!
 //! Reported beside them, not in the ratio: **relief** (the 1st–99th
-//! percentile height range, m: robust to single spikes) and the **median
-//! slope** (degrees).
+//! percentile height range, m: robust to single spikes), the **median
+//! slope** (degrees) and the share of the area in **closed** depressions
+//! ([`drainage::closed_share`]: the area more than 5 m below its spill
+//! level — water with no valley out).
 //!
 //! Distances ([`distance`]): distributions by the Wasserstein-1 distance of
 //! 199 quantiles over the pooled 10–90 % range; scalars by |a−b|/(|a|+|b|).
@@ -162,12 +164,14 @@ pub fn help_text() -> String {
         s += &format!("  {} ({kind}):\n      {}\n", d.id, d.doc);
     }
     s += &format!(
-        "Also reported, not in the ratio: relief (1st-99th percentile height range, m) and the \
-         median slope (deg).\n\
+        "Also reported, not in the ratio: relief (1st-99th percentile height range, m), the \
+         median slope (deg) and the closed share (the area more than {} m below its spill level, \
+         water with no valley out).\n\
          Distances: distributions by the Wasserstein-1 distance of 199 quantiles over the pooled \
          10-90 % range; scalars by |a-b|/(|a|+|b|). Realism ratio: the mean over descriptors of \
          d(synthesis, reference) / max(d(reference left half, right half), {}); 1.0 = as \
          different as the real terrain is from itself.\n",
+        drainage::CLOSED_DEPTH_M,
         compare::FLOOR
     );
     s
@@ -201,6 +205,8 @@ pub struct Descriptors {
     pub spectrum: Spectrum,
     /// The 1st–99th percentile height range, metres.
     pub relief: f64,
+    /// [`drainage::closed_share`], a fraction of the area.
+    pub closed: f64,
 }
 
 impl Descriptors {
@@ -228,11 +234,16 @@ pub fn describe(hf: &Heightfield) -> Result<Descriptors, EvalError> {
         });
     }
     check_nodata(hf)?;
-    let ((spectrum, drainage), (slope, rest)) = rayon::join(
+    let ((spectrum, (drainage, closed)), (slope, rest)) = rayon::join(
         || {
             rayon::join(
                 || spectrum::spectrum(hf),
-                || Sample::new(drainage::log_area(hf)),
+                || {
+                    rayon::join(
+                        || Sample::new(drainage::log_area(hf)),
+                        || drainage::closed_share(hf),
+                    )
+                },
             )
         },
         || {
@@ -269,6 +280,7 @@ pub fn describe(hf: &Heightfield) -> Result<Descriptors, EvalError> {
         values,
         spectrum,
         relief: elevation::relief(&heights),
+        closed,
     })
 }
 

@@ -267,6 +267,11 @@ fn scalar_panel(img: &mut RgbaImage, at: (u32, u32), cmp: &Comparison) {
     ));
     lines.push(format!("relief kept {:.0} %", cmp.relief.ratio * 100.0));
     lines.push(format!("pits x {:.2}", cmp.pits.ratio));
+    lines.push(format!(
+        "closed {:.1} / {:.1} %",
+        cmp.closed.synth * 100.0,
+        cmp.closed.reference * 100.0
+    ));
     let line_h = ((GLYPH_HEIGHT + 4) * TEXT) as i64;
     for (k, l) in lines.iter().enumerate() {
         draw_text(

@@ -100,7 +100,7 @@ def test_eval_reports_the_realism_ratio(db):
     a = terrasynth.synthesize(db, world, seed=1)
     b = terrasynth.synthesize(db, world, seed=2)
     r = terrasynth.eval(a, b, db.cell_size())
-    assert set(r) >= {"ratio", "descriptors", "median_slope", "relief", "pits"}
+    assert set(r) >= {"ratio", "descriptors", "median_slope", "relief", "pits", "closed"}
     assert np.isfinite(r["ratio"]) and r["ratio"] > 0
     assert all({"id", "distance", "ratio"} <= set(d) for d in r["descriptors"])
     json.dumps(r)

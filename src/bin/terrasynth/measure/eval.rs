@@ -347,6 +347,12 @@ pub fn print_comparison(c: &Comparison) {
         c.pits.synth * 100.0,
         c.pits.ratio
     );
+    println!(
+        "closed depressions {:.1} % → {:.1} % of the area  (more than {} m below their spill level: water with no valley out)",
+        c.closed.reference * 100.0,
+        c.closed.synth * 100.0,
+        eval::drainage::CLOSED_DEPTH_M
+    );
 }
 
 /// Type and exemplar shares, with the difference in points.

@@ -58,6 +58,9 @@ pub(super) struct Medians {
     pub(super) pits_real: f64,
     pub(super) pits_synth: f64,
     pub(super) pits_ratio: f64,
+    /// [`terrasynth::eval::drainage::closed_share`]; not a target.
+    pub(super) closed_real: f64,
+    pub(super) closed_synth: f64,
     /// Copy share and self-repetition (when novelty is measured).
     pub(super) copy_share: Option<f64>,
     pub(super) repetition: Option<f64>,
@@ -222,12 +225,13 @@ pub(super) fn run_dem(
             })
             .unwrap_or_default();
         eprintln!(
-            "{name} seed {seed}: ratio {:.2}, median slope {:.1}° → {:.1}°, relief kept {:.0} %, pits ×{:.2}{copies} ({:.1} s)",
+            "{name} seed {seed}: ratio {:.2}, median slope {:.1}° → {:.1}°, relief kept {:.0} %, pits ×{:.2}, closed {:.1} %{copies} ({:.1} s)",
             c.ratio,
             c.median_slope.reference,
             c.median_slope.synth,
             c.relief.ratio * 100.0,
             c.pits.ratio,
+            c.closed.synth * 100.0,
             ts.elapsed().as_secs_f64()
         );
         seeds.push(SeedResult {
@@ -255,6 +259,8 @@ pub(super) fn run_dem(
         pits_real: first.pits.reference,
         pits_synth: med(&|c| c.pits.synth),
         pits_ratio: med(&|c| c.pits.ratio),
+        closed_real: first.closed.reference,
+        closed_synth: med(&|c| c.closed.synth),
         copy_share: novelty_median(&seeds, |n| n.copy_share),
         repetition: novelty_median(&seeds, |n| n.repetition),
     };

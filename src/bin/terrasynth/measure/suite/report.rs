@@ -19,7 +19,7 @@ pub(super) fn print_report(r: &SuiteReport) {
         r.piece_size
     );
     println!(
-        "{:<26} {:>9} {:>7} {:>6} {:>5}  {:>20}  {:>7}  {:>22}  {:>15} {:>7}  targets",
+        "{:<26} {:>9} {:>7} {:>6} {:>5}  {:>20}  {:>7}  {:>22}  {:>17}  {:>15} {:>7}  targets",
         "DEM",
         "size",
         "cell m",
@@ -28,6 +28,7 @@ pub(super) fn print_report(r: &SuiteReport) {
         "median slope real→synth",
         "relief",
         "pits real→synth",
+        "closed real→syn",
         "copies real→syn",
         "repeats",
     );
@@ -35,7 +36,7 @@ pub(super) fn print_report(r: &SuiteReport) {
         let m = &d.median;
         let t = &d.targets;
         println!(
-            "{:<26} {:>9} {:>7.1} {:>6.2} {:>5.2}  {:>6.1}° → {:>5.1}° ({:>3.0} %)  {:>6.0} %  {:>5.2} % → {:>5.2} % ({:>4.2}×)  {:>15} {:>7}  {}{}{}{}{}",
+            "{:<26} {:>9} {:>7.1} {:>6.2} {:>5.2}  {:>6.1}° → {:>5.1}° ({:>3.0} %)  {:>6.0} %  {:>5.2} % → {:>5.2} % ({:>4.2}×)  {:>17}  {:>15} {:>7}  {}{}{}{}{}",
             d.name,
             format!("{}x{}", d.width, d.height),
             d.cell_size_m,
@@ -48,6 +49,11 @@ pub(super) fn print_report(r: &SuiteReport) {
             m.pits_real * 100.0,
             m.pits_synth * 100.0,
             m.pits_ratio,
+            format!(
+                "{:.1} % → {:.1} %",
+                m.closed_real * 100.0,
+                m.closed_synth * 100.0
+            ),
             match (d.copy_baseline, m.copy_share) {
                 (Some(b), Some(c)) => format!("{:.0} % → {:.0} %", b * 100.0, c * 100.0),
                 _ => "-".into(),
@@ -64,6 +70,10 @@ pub(super) fn print_report(r: &SuiteReport) {
     }
     println!(
         "real: the DEM's top half against its bottom half, in the same units (real terrain against itself)"
+    );
+    println!(
+        "closed: share of the area more than {} m below its spill level (water with no valley out), the DEM → the synthesis; not a target",
+        terrasynth::eval::drainage::CLOSED_DEPTH_M
     );
     println!(
         "copies: share of 64-px windows matching the DEM at NCC ≥ 0.95 in any orientation, its halves → the synthesis; repeats: windows with a near-duplicate elsewhere in the synthesis"
