@@ -80,8 +80,8 @@ pub fn pit_fraction(hf: &Heightfield) -> f64 {
 mod tests {
     use super::*;
 
-    /// 64 × 64 cells at 100 m with a `side`-cell square at `floor` m whose
-    /// corner is at (x, y).
+    /// 64 × 64 cells of 30 m, the ground at 100 m, with a `side`-cell
+    /// square at `floor` m whose corner is at (x, y).
     fn hollow(x: usize, y: usize, side: usize, floor: f32) -> Heightfield {
         Heightfield::from_fn(64, 64, 30.0, |i, j| {
             let inside = (x..x + side).contains(&i) && (y..y + side).contains(&j);

@@ -20,8 +20,9 @@
 //! Reported beside them, not in the ratio: **relief** (the 1st–99th
 //! percentile height range, m: robust to single spikes), the **median
 //! slope** (degrees) and the share of the area in **closed** depressions
-//! ([`drainage::closed_share`]: the area more than 5 m below its spill
-//! level — water with no valley out).
+//! ([`drainage::closed_share`]: the area more than
+//! [`drainage::CLOSED_DEPTH_M`] below its spill level — water with no
+//! valley out).
 //!
 //! Distances ([`distance`]): distributions by the Wasserstein-1 distance of
 //! 199 quantiles over the pooled 10–90 % range; scalars by |a−b|/(|a|+|b|).
