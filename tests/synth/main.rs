@@ -13,3 +13,4 @@ mod scene_session;
 mod sculpt;
 mod tiles;
 mod tiles_engine;
+mod valleys;

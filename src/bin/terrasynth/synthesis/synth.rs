@@ -6,11 +6,15 @@ use crate::args::{
     select_backend, write_output,
 };
 use std::path::{Path, PathBuf};
+use terrasynth::Heightfield;
 use terrasynth::database::Database;
 use terrasynth::io::{self, CoordsMap};
 use terrasynth::render::{self, RenderOptions};
-use terrasynth::synth::Synthesizer;
+use terrasynth::scene::{CurveItem, Scene, SceneEdits};
+use terrasynth::synth::cone::Rect;
+use terrasynth::synth::session::Session;
 use terrasynth::synth::source_map::source_map;
+use terrasynth::synth::{Params, Synthesizer, valleys};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -70,6 +74,13 @@ pub struct Args {
     /// of the whole world eroded.
     #[arg(long, value_name = "S", value_parser = crate::terrain::erode::parse_strength, conflicts_with = "scene")]
     erode: Option<f32>,
+    /// Give the terrain a valley network: synthesize, find where its water
+    /// would run with every closed basin breached, and synthesize again
+    /// with those valleys as curve constraints (about twice the time; see
+    /// README, "Valleys"). Whole maps only: where water runs depends on
+    /// the whole terrain.
+    #[arg(long, conflicts_with_all = ["scene", "window", "coords", "coords_preview"])]
+    valleys: bool,
 }
 
 /// Refuses outputs that would replace an input, before any work is done.
@@ -135,6 +146,10 @@ pub fn run(a: Args) -> CliResult {
     let params = a
         .synthesis
         .params(a.coords.is_some() || a.coords_preview.is_some());
+    if a.valleys {
+        check_synthesis_memory(w, h, 3.0)?;
+        return with_valleys(&a, &db, params, &inputs);
+    }
     let mut synth = Synthesizer::new(&db, params)?;
     select_backend(&mut synth, a.backend)?;
     // With erosion, a window is synthesized with the halo its erosion reads.
@@ -162,12 +177,88 @@ pub fn run(a: Args) -> CliResult {
         }
         _ => (synth.run(w, h, a.seed)?, format!("{w} x {h}")),
     };
+    let win = a.window.zip(extent);
+    let ms = result.timings.total.as_secs_f64() * 1e3;
+    finish(
+        &a,
+        &synth,
+        &mut result.heightfield,
+        win,
+        (&what, ms),
+        &inputs,
+    )?;
+    if let Some(l0) = result.levels.first() {
+        let paths = (a.coords.as_deref(), a.coords_preview.as_deref());
+        write_coords(&source_map(&l0.coords, l0.width, w, h, &db), &db, paths)?;
+    }
+    Ok(())
+}
+
+/// `synth --valleys`: the terrain, its valley network
+/// ([`terrasynth::synth::valleys`]), and the terrain again with those
+/// valleys as curve constraints — the second frame of an editing session
+/// on the first, as if an artist had drawn them, so that away from the
+/// valleys the terrain stays the first frame's (coherence).
+fn with_valleys(a: &Args, db: &Database, params: Params, inputs: &[&Path]) -> CliResult {
+    let (w, h) = a.size;
+    let mut session = Session::new(db, params.clone(), w, h, a.seed)?;
+    select_backend(session.synthesizer_mut(), a.backend)?;
+    let first = session.apply(Vec::new())?;
+    let t = std::time::Instant::now();
+    let network = valleys::network(&first.heightfield);
+    let found = t.elapsed();
+    let scene = Scene {
+        file: PathBuf::from("synth --valleys"),
+        database: a.db.clone(),
+        width: w,
+        height: h,
+        seed: a.seed,
+        jitter: params.jitter,
+        passes: params.passes,
+        start_exemplar: params.start_exemplar,
+        points: Vec::new(),
+        curves: (network.into_iter().enumerate())
+            .map(|(i, spec)| CurveItem {
+                id: format!("valley{i}"),
+                spec,
+            })
+            .collect(),
+        junctions: Vec::new(),
+        types: None,
+        freeze: None,
+        pastes: Vec::new(),
+        sculpt: Vec::new(),
+    };
+    let count = scene.curves.len();
+    let mut second = session.apply(SceneEdits::new().edits(&scene, db)?)?;
+    let ms = (first.time + found + second.time).as_secs_f64() * 1e3;
+    let what = format!("{w} x {h}, {count} valley curves");
+    finish(
+        a,
+        session.synthesizer(),
+        &mut second.heightfield,
+        None,
+        (&what, ms),
+        inputs,
+    )
+}
+
+/// Erodes (`--erode`; `win` is the window and the extent synthesized for
+/// it), writes the heightfield and its preview, and reports `what` took
+/// `ms`.
+fn finish(
+    a: &Args,
+    synth: &Synthesizer<'_>,
+    hf: &mut Heightfield,
+    win: Option<(Rect, Rect)>,
+    (what, ms): (&str, f64),
+    inputs: &[&Path],
+) -> CliResult {
     if let Some(strength) = a.erode {
         let t = std::time::Instant::now();
-        let hf = &result.heightfield;
-        result.heightfield = match (a.window, extent) {
-            (Some(win), Some(ext)) => terrasynth::erode::window(hf, ext, win, strength)?,
-            _ => terrasynth::erode::erode(hf, strength)?,
+        *hf = match win {
+            Some((win, ext)) => terrasynth::erode::window(hf, ext, win, strength)?,
+            None => terrasynth::erode::erode(hf, strength)?,
         };
         eprintln!(
             "eroded (strength {strength}) in {:.0} ms",
@@ -177,34 +268,21 @@ pub fn run(a: Args) -> CliResult {
     // The heightfield's encoder runs on one core: the preview is drawn
     // meanwhile.
     let (written, drawn) = rayon::join(
-        || write_output(&result.heightfield, &a.output, None, a.engine, &inputs),
-        || {
-            a.preview
-                .as_ref()
-                .map(|_| preview(&synth, &result.heightfield))
-        },
+        || write_output(hf, &a.output, None, a.engine, inputs),
+        || a.preview.as_ref().map(|_| preview(synth, hf)),
     );
     written?;
-    let (lo, hi) = result
-        .heightfield
-        .extent()
-        .range
-        .expect("synthesis has no nodata");
+    let (lo, hi) = hf.extent().range.expect("synthesis has no nodata");
     eprintln!(
-        "wrote {} ({what}, seed {}): heights {:.1} .. {:.1} m in {:.0} ms",
+        "wrote {} ({what}, seed {}): heights {:.1} .. {:.1} m in {ms:.0} ms",
         a.output.display(),
         a.seed,
         lo,
         hi,
-        result.timings.total.as_secs_f64() * 1e3
     );
     if let (Some(p), Some(drawn)) = (&a.preview, drawn) {
         render::write_png(p, &drawn?.image)?;
         eprintln!("wrote {}", p.display());
-    }
-    if let Some(l0) = result.levels.first() {
-        let paths = (a.coords.as_deref(), a.coords_preview.as_deref());
-        write_coords(&source_map(&l0.coords, l0.width, w, h, &db), &db, paths)?;
     }
     Ok(())
 }
@@ -296,7 +374,7 @@ pub fn write_coords(
 /// The preview, shaded where the synthesis ran (same bytes either way).
 fn preview(
     synth: &Synthesizer<'_>,
-    hf: &terrasynth::Heightfield,
+    hf: &Heightfield,
 ) -> Result<render::Preview, Box<dyn std::error::Error + Send + Sync>> {
     Ok(render::render_on(
         &synth.engine(),
