@@ -22,7 +22,6 @@ mod params;
 mod restricted;
 pub mod session;
 pub mod source_map;
-pub mod valleys;
 mod window;
 mod windowed;
 

@@ -13,6 +13,9 @@
 //! heaps ([`fill`]). The fill runs in strips side by side, accumulation
 //! beside lakes: see the README's `water` section for the times.
 //!
+//! [`valleys`] is water's view for synthesis: the valley network a
+//! synthesized terrain is given as curve constraints (`synth --valleys`).
+//!
 //! [`tiled`] computes the same rasters on a world cut into tiles, bit for
 //! bit, holding a few tiles at a time (`terrasynth tiles --water`).
 //!
@@ -32,6 +35,7 @@ pub mod rivers;
 pub mod sea;
 mod summary;
 pub mod tiled;
+pub mod valleys;
 
 pub use lakes::{Lake, Thresholds};
 pub use summary::Summary;

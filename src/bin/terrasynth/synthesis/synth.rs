@@ -14,7 +14,8 @@ use terrasynth::scene::{CurveItem, Scene, SceneEdits};
 use terrasynth::synth::cone::Rect;
 use terrasynth::synth::session::Session;
 use terrasynth::synth::source_map::source_map;
-use terrasynth::synth::{Params, Synthesizer, valleys};
+use terrasynth::synth::{Params, Synthesizer};
+use terrasynth::water::valleys;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -195,7 +196,7 @@ pub fn run(a: Args) -> CliResult {
 }
 
 /// `synth --valleys`: the terrain, its valley network
-/// ([`terrasynth::synth::valleys`]), and the terrain again with those
+/// ([`terrasynth::water::valleys`]), and the terrain again with those
 /// valleys as curve constraints — the second frame of an editing session
 /// on the first, as if an artist had drawn them, so that away from the
 /// valleys the terrain stays the first frame's (coherence).

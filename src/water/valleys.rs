@@ -31,6 +31,7 @@
 //! the network is not a function of a window (`synth --valleys` refuses
 //! `--window`).
 
+use super::d8::{CLOCKWISE, OUTLET, accumulate};
 use crate::heightfield::Heightfield;
 use crate::synth::control::curve::{CurveSpec, Widget};
 use glam::DVec2;
@@ -63,8 +64,6 @@ pub const WIDGET_EVERY: usize = 4;
 /// Chaikin iterations that round the cells' zig-zag into a valley's line.
 pub const SMOOTHING: u32 = 2;
 
-const ROOT: u32 = u32::MAX;
-
 /// The valley network of `hf` (no nodata) as curve specs, larger
 /// valleys first; none where the map is under two cells a side.
 pub fn network(hf: &Heightfield) -> Vec<CurveSpec> {
@@ -87,12 +86,11 @@ pub fn network(hf: &Heightfield) -> Vec<CurveSpec> {
         }
     }
     let (parent, order) = drainage(&floor, nw, nh);
-    let mut area = vec![1u32; nw * nh];
+    let area = accumulate(&parent);
     let mut carved = floor.clone();
     for &c in order.iter().rev() {
         let p = parent[c as usize];
-        if p != ROOT {
-            area[p as usize] += area[c as usize];
+        if p != OUTLET {
             carved[p as usize] = carved[p as usize].min(carved[c as usize]);
         }
     }
@@ -100,7 +98,7 @@ pub fn network(hf: &Heightfield) -> Vec<CurveSpec> {
     let mut fed = vec![false; nw * nh];
     for &c in &order {
         let p = parent[c as usize];
-        if channel(c) && p != ROOT {
+        if channel(c) && p != OUTLET {
             fed[p as usize] = true;
         }
     }
@@ -119,7 +117,7 @@ pub fn network(hf: &Heightfield) -> Vec<CurveSpec> {
         traced[head as usize] = true;
         loop {
             let p = parent[*path.last().unwrap() as usize];
-            if p == ROOT {
+            if p == OUTLET {
                 break;
             }
             path.push(p);
@@ -169,10 +167,10 @@ pub fn network(hf: &Heightfield) -> Vec<CurveSpec> {
 /// Where each cell's water goes: a priority flood from the border cells
 /// that always grows at the lowest cell it reaches (8 neighbours), so a
 /// cell's parent is the neighbour the flood came from. Returns the parents
-/// ([`ROOT`] for the border) and the order the cells were reached in
+/// ([`OUTLET`] for the border) and the order the cells were reached in
 /// (every parent before its children).
 fn drainage(floor: &[i64], nw: usize, nh: usize) -> (Vec<u32>, Vec<u32>) {
-    let mut parent = vec![ROOT; nw * nh];
+    let mut parent = vec![OUTLET; nw * nh];
     let mut seen = vec![false; nw * nh];
     let mut order = Vec::with_capacity(nw * nh);
     let mut heap = BinaryHeap::new();
@@ -188,16 +186,7 @@ fn drainage(floor: &[i64], nw: usize, nh: usize) -> (Vec<u32>, Vec<u32>) {
     while let Some(Reverse((_, c))) = heap.pop() {
         order.push(c);
         let (x, y) = ((c as usize % nw) as isize, (c as usize / nw) as isize);
-        for (dx, dy) in [
-            (-1, -1),
-            (0, -1),
-            (1, -1),
-            (-1, 0),
-            (1, 0),
-            (-1, 1),
-            (0, 1),
-            (1, 1),
-        ] {
+        for &(dx, dy, _) in &CLOCKWISE {
             let (nx, ny) = (x + dx, y + dy);
             if nx < 0 || ny < 0 || nx >= nw as isize || ny >= nh as isize {
                 continue;
