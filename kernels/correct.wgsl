@@ -107,12 +107,16 @@ fn parent_offset(x: u32, y: u32) -> i32 {
 }
 
 // correct::{W_FREE, SEEDS_PER_ALLOWED_TYPE, SEED_SALT, FLAT.weight, FLAT_FIT.weight};
-// types::SEEDS_PER_TYPE; nudge::MAX_ERROR.
+// types::SEEDS_PER_TYPE; nudge::{MAX_ERROR, KEEP_DETAIL, DETAIL_LEVELS,
+// DETAIL_STEP}.
 const W_FREE: u32 = 4u;
 const SEEDS_PER_ALLOWED_TYPE: u32 = 9u;
 const SEED_SALT: u32 = 2120089600u;
 const SEEDS_PER_TYPE: u32 = 64u;
 const MAX_ERROR: i32 = 16777216;
+const KEEP_DETAIL: i32 = 65536;
+const DETAIL_LEVELS: u32 = 2u;
+const DETAIL_STEP: i32 = 2;
 const FLAT_WEIGHT: i32 = 8;
 const FLAT_FIT_WEIGHT: i32 = 44;
 
@@ -416,12 +420,28 @@ fn phi(x_in: i32, tol: i32) -> i32 {
     return i32(mag);
 }
 
-// nudge::nudge.
+// nudge::nudge (nudge::Target::tolerance: the low 16 bits of a tolerance).
 fn nudge(v: i32, h_c: i32, goal: vec2<i32>) -> i32 {
     if (goal.y < 0) {
         return v;
     }
-    return v + phi(saturating_sub(goal.x, h_c), goal.y);
+    return v + phi(saturating_sub(goal.x, h_c), goal.y & 0xFFFF);
+}
+
+// nudge::own_detail: the winner texel q's height h minus the floor of the
+// mean of the 3×3 texels DETAIL_STEP apart around it, where the goal keeps
+// detail at the finest levels; else 0.
+fn own_detail(level: u32, goal: vec2<i32>, h: i32, q: vec2<i32>) -> i32 {
+    if (level >= DETAIL_LEVELS || goal.y < 0 || (goal.y & KEEP_DETAIL) == 0) {
+        return 0;
+    }
+    var sum = 0;
+    for (var dy = -DETAIL_STEP; dy <= DETAIL_STEP; dy += DETAIL_STEP) {
+        for (var dx = -DETAIL_STEP; dx <= DETAIL_STEP; dx += DETAIL_STEP) {
+            sum += texel(q.x + dx, q.y + dy).x - MODE1_BIAS;
+        }
+    }
+    return h - div_floor(sum, 9);
 }
 
 // One diagonal (dx, dy) of N_S at (x, y): the texel each of its three
@@ -522,8 +542,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var v = best.h;
     if (best.has_q && (p.flags & F_TARGETS) != 0u) {
-        let h_c = texel(best.q.x, best.q.y).x - MODE1_BIAS + v;
-        v = nudge(v, h_c, guide[i].blend_target);
+        let goal = guide[i].blend_target;
+        let h = texel(best.q.x, best.q.y).x - MODE1_BIAS;
+        v = nudge(v, h + v - own_detail(p.level, goal, h, best.q), goal);
     }
     state_s[i] = best.s;
     state_v[i] = v;

@@ -347,7 +347,7 @@ fn shade_constants_match() {
 #[test]
 fn correct_constants_match() {
     use terrasynth::database::types::SEEDS_PER_TYPE;
-    use terrasynth::stages::correct::nudge::MAX_ERROR;
+    use terrasynth::stages::correct::nudge::{DETAIL_LEVELS, DETAIL_STEP, KEEP_DETAIL, MAX_ERROR};
     use terrasynth::stages::correct::{
         CORRECT_ALLOWED, CORRECT_COHERENCE, CORRECT_TARGETS, FLAT, FLAT_FIT, SEED_SALT,
         SEEDS_PER_ALLOWED_TYPE, W_FREE,
@@ -358,6 +358,7 @@ fn correct_constants_match() {
         ("F_ALLOWED", CORRECT_ALLOWED),
         ("F_COHERENCE", CORRECT_COHERENCE),
         ("W_FREE", W_FREE as u32),
+        ("DETAIL_LEVELS", DETAIL_LEVELS),
         ("SEEDS_PER_ALLOWED_TYPE", SEEDS_PER_ALLOWED_TYPE),
         ("SEED_SALT", SEED_SALT),
         ("SEEDS_PER_TYPE", SEEDS_PER_TYPE as u32),
@@ -369,6 +370,8 @@ fn correct_constants_match() {
     }
     for (name, v) in [
         ("MAX_ERROR", MAX_ERROR),
+        ("KEEP_DETAIL", KEEP_DETAIL),
+        ("DETAIL_STEP", DETAIL_STEP),
         ("FLAT_WEIGHT", FLAT.weight as i32),
         ("FLAT_FIT_WEIGHT", FLAT_FIT.weight as i32),
     ] {

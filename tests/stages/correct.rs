@@ -17,9 +17,10 @@ use terrasynth::database::layout;
 use terrasynth::io::maps::type_mask::TypeMask;
 use terrasynth::isa::Isa;
 use terrasynth::level::atlas::AtlasLevel;
+use terrasynth::level::fixed::round;
 use terrasynth::level::state::{State, level_size};
-use terrasynth::stages::common::ALL_TYPES;
-use terrasynth::stages::correct::nudge::{MAX_TOL, Target};
+use terrasynth::stages::common::{ALL_TYPES, texel_height};
+use terrasynth::stages::correct::nudge::{KEEP_DETAIL, MAX_TOL, Target};
 use terrasynth::stages::correct::{
     self, Coherence, CorrectParams, DEFAULT_PRIOR, Guide, PRIORS, SUBPASSES,
 };
@@ -166,7 +167,7 @@ fn random_guide_inputs(
             } else {
                 Target {
                     height: (next() % 70_000) as i32 - 2_000,
-                    tol: (next() % 5_000) as i32,
+                    tol: (next() % 5_000) as i32 | [0, KEEP_DETAIL][(next() % 2) as usize],
                 }
             }
         })
@@ -260,7 +261,8 @@ proptest! {
         let targets: Vec<Target> = (0..w * h).map(|i| {
             let r = b(i, 1);
             if r % 4 == 0 { Target::NONE } else {
-                Target { height: (r >> 8) as i32 % 90_000 - 10_000, tol: (b(i, 2) % (MAX_TOL as u32 + 1)) as i32 }
+                let keep = [0, KEEP_DETAIL][(b(i, 5) % 2) as usize];
+                Target { height: (r >> 8) as i32 % 90_000 - 10_000, tol: (b(i, 2) % (MAX_TOL as u32 + 1)) as i32 | keep }
             }
         }).collect();
         let allowed: Vec<u32> = (0..w * h).map(|i| match b(i, 3) % 5 {
@@ -353,7 +355,9 @@ fn guided_correct_agrees_on_real_guides() {
                 } else {
                     Target {
                         height: (v * 20.0) as i32,
-                        tol: (y as i32 * 50).min(MAX_TOL),
+                        // Curves' targets keep the winner's detail; points'
+                        // do not (both kinds, the kernel's two branches).
+                        tol: (y as i32 * 50).min(MAX_TOL) | [0, KEEP_DETAIL][x % 2],
                     }
                 }
             })
@@ -466,6 +470,56 @@ fn controls_change_the_result_as_intended() {
             "pixel {i}"
         );
     }
+    // With KEEP_DETAIL (a curve's target) the winner's smooth height, the
+    // floor of the mean of the nine texels two apart around it, meets the
+    // target and its own detail stays on top; without, its height does (a
+    // point's).
+    let height = |s: &State, i: usize| {
+        let c = s.coords()[i];
+        texel_height(atlas.appearance(round(c.x), round(c.y))) + s.offsets()[i]
+    };
+    let smooth = |s: &State, i: usize| {
+        let c = s.coords()[i];
+        let (x, y) = (round(c.x), round(c.y));
+        let sum: i32 = [-2, 0, 2]
+            .into_iter()
+            .flat_map(|dy| [-2, 0, 2].map(|dx| (dx, dy)))
+            .map(|(dx, dy)| texel_height(atlas.appearance(x + dx, y + dy)))
+            .sum();
+        sum.div_euclid(9) + s.offsets()[i]
+    };
+    let target = 20_000;
+    let hold = |flag: i32| {
+        let targets = vec![
+            Target {
+                height: target,
+                tol: flag
+            };
+            w * h
+        ];
+        let held = copy(&st);
+        let g = Guide {
+            targets: Some(&targets),
+            ..Guide::NONE
+        };
+        correct::correct_guided(&atlas, &held, None, &p, &g, Isa::default());
+        held
+    };
+    let (exact, detailed) = (hold(0), hold(KEEP_DETAIL));
+    let corrected: Vec<usize> = (0..w * h)
+        .filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0)
+        .collect();
+    let mut kept = 0;
+    for &i in &corrected {
+        assert_eq!(height(&exact, i), target, "pixel {i}: exact");
+        assert_eq!(smooth(&detailed, i), target, "pixel {i}: smooth height");
+        kept += (height(&detailed, i) != target) as usize;
+    }
+    assert!(
+        kept * 2 > corrected.len(),
+        "detail kept at {kept} of {}",
+        corrected.len()
+    );
     // A window corrects only inside.
     let windowed = copy(&st);
     let g = Guide {

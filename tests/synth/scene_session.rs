@@ -63,8 +63,31 @@ fn curve_height_profile_follows_the_widgets_on_a_real_dem() {
 
         s += 1.0;
     }
+    // The shape: the 5×5 mean of the terrain at the curve's pixels against
+    // the profile (the exemplar's detail rides on it, see
+    // stages::correct::nudge::own_detail).
+    let mut shape = 0.0;
+    let mut s = 0.0;
+    while s <= c.length() {
+        let p = c.point_at(s);
+        let (x, y) = (
+            (p.x as usize).clamp(2, SIZE - 3),
+            (p.y as usize).clamp(2, SIZE - 3),
+        );
+        let mean = (y - 2..=y + 2)
+            .flat_map(|v| (x - 2..=x + 2).map(move |u| hf.get(u, v) as f64))
+            .sum::<f64>()
+            / 25.0;
+        shape += (mean - c.height_at(s)).abs() / relief;
+        s += 1.0;
+    }
     errs.sort_by(f64::total_cmp);
     let n = errs.len();
+    let shape = shape / n as f64;
+    eprintln!(
+        "the profile's shape (5×5 mean): mean |error| {:.2} % of relief",
+        100.0 * shape
+    );
     let mean = errs.iter().sum::<f64>() / n as f64;
     let (median, p90, max) = (errs[n / 2], errs[n * 9 / 10], errs[n - 1]);
     eprintln!(
@@ -117,13 +140,17 @@ fn curve_height_profile_follows_the_widgets_on_a_real_dem() {
     };
     let (t_curve, t_free) = (texture(hf), texture(&plain));
     eprintln!("fine relief within 2 px of the curve: {t_curve:.2} m (unconstrained {t_free:.2} m)");
-    assert!(t_curve >= 0.6 * t_free, "{t_curve:.2} m vs {t_free:.2} m");
-    // Measured: mean 1.02 %, median 0.82 %, p90 2.25 %, max 3.67 % (seed 5;
-    // seeds 1, 2, 3, 9 give 0.85–1.02 % at pixel centres); unconstrained
-    // 11.9 %; fine relief 93 % of the unconstrained terrain's. The issue's
+    // Measured: 10.18 m against 11.63 m (88 %); 8.97 m (77 %) when the
+    // nudge set each pixel's own height to the profile, before the winner
+    // kept its detail (issue 40).
+    assert!(t_curve >= 0.8 * t_free, "{t_curve:.2} m vs {t_free:.2} m");
+    // Measured: mean 1.09 %, median 0.90 %, p90 2.19 %, max 4.21 % (seed 5),
+    // the shape (5×5 mean) 1.06 %; unconstrained 11.2 %. With the pixels'
+    // own heights nudged to the profile: 0.69 / 0.59 / 1.45 / 2.88 %, shape
+    // 0.74 % — a crest's own texels stand above their 5×5 mean. The issue's
     // goal: within 2 % of relief along the curve's length, asserted on the
-    // mean and the median (single samples keep the finest level's detail,
-    // see control::blend).
+    // mean, the median and the shape (single samples keep the finest
+    // levels' detail, see stages::correct::nudge::own_detail).
     assert!(
         free_err / n as f64 > 5.0 * mean,
         "the constraint must matter"
@@ -137,6 +164,11 @@ fn curve_height_profile_follows_the_widgets_on_a_real_dem() {
         median <= 0.02,
         "median profile error {:.2} % of relief",
         100.0 * median
+    );
+    assert!(
+        shape <= 0.02,
+        "the profile's shape off by {:.2} % of relief",
+        100.0 * shape
     );
 }
 

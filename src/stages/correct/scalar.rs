@@ -3,7 +3,7 @@
 //! (borders included) and is the oracle the [`super::simd`] path is tested
 //! against.
 
-use super::nudge::nudge;
+use super::nudge::{nudge, own_detail};
 use super::{
     CLAMP, CorrectParams, DIAGONALS, Guide, Prior, SEED_SALT, SEEDS_PER_ALLOWED_TYPE, W_FREE, weigh,
 };
@@ -270,8 +270,11 @@ pub fn correct_pixel_guided(
     debug_assert!(best.0 < u32::MAX);
     let (_, s, mut v, texel) = best;
     if let (Some(q), Some(t)) = (texel, g.targets) {
-        let h_c = texel_height(atlas.appearance(q.0, q.1)) + v;
-        v = nudge(v, h_c, t[i]);
+        let h = texel_height(atlas.appearance(q.0, q.1));
+        let d = own_detail(g.level, t[i], h, |dx, dy| {
+            texel_height(atlas.appearance(q.0 + dx, q.1 + dy))
+        });
+        v = nudge(v, h + v - d, t[i]);
     }
     (s, v)
 }

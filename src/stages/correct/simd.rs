@@ -57,7 +57,7 @@ mod gather;
 mod grid;
 mod score;
 
-use super::nudge::nudge;
+use super::nudge::{nudge, own_detail};
 use super::{Guide, ParentRow, Prior, W_FREE, scalar, weigh};
 use crate::database::c2::Quad;
 use crate::isa::Isa;
@@ -317,7 +317,7 @@ fn decide<const P: u32, const AVX2: bool>(
         let (cost, i, hh) = best_of::<P, AVX2>(app, atlas.c2, ns, (p, similar), bar, prior);
         if i == usize::MAX {
             return match free {
-                true => (prev, nudged(atlas, idx, h_prev, pixel, g)),
+                true => (prev, nudged(atlas, (idx, col.stride as i32), h_prev, pixel, g)),
                 false => (prev, v),
             };
         }
@@ -330,11 +330,21 @@ fn decide<const P: u32, const AVX2: bool>(
 /// The winner's offset `v`, nudged towards the pixel's geometric target
 /// if any (`idx`: the winner's texel).
 #[inline(always)]
-fn nudged(atlas: &AtlasLevel<'_>, idx: i32, v: i32, pixel: usize, g: &Guide<'_>) -> i32 {
+fn nudged(
+    atlas: &AtlasLevel<'_>,
+    (idx, stride): (i32, i32),
+    v: i32,
+    pixel: usize,
+    g: &Guide<'_>,
+) -> i32 {
     match g.targets {
         Some(t) => {
-            let h_c = texel_height(atlas.level.appearance[idx as usize]) + v;
-            nudge(v, h_c, t[pixel])
+            let app = atlas.level.appearance;
+            let h = texel_height(app[idx as usize]);
+            let d = own_detail(g.level, t[pixel], h, |dx, dy| {
+                texel_height(app[(idx + dx + dy * stride) as usize])
+            });
+            nudge(v, h + v - d, t[pixel])
         }
         None => v,
     }
@@ -365,7 +375,7 @@ fn finish(
                 x: n.x - (dx << FRAC_BITS),
                 y: n.y - (dy << FRAC_BITS),
             };
-            (s, pair.c1())
+            (s, (pair.c1(), (pair.down - pair.up) >> 1))
         }
         (c, _) => {
             let (n, u) = source_at(atlas, st, (x as i32, y as i32), pair.from as usize);
@@ -384,7 +394,7 @@ fn finish(
                 0 => pair.c1(),
                 _ => atlas.index(q.0, q.1) as i32,
             };
-            (s, idx)
+            (s, (idx, atlas.columns[q.0 as usize].stride as i32))
         }
     };
     (s, nudged(atlas, idx, best.2, pixel, g))

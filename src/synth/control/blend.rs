@@ -40,6 +40,15 @@
 //! `stages::correct::nudge::phi`) at every level. The
 //! blend weight b keeps the centre distance.
 //!
+//! **Detail on a shape, exact heights at a site.** The sums also count
+//! the reaching constraints that ask for exact heights (points, sculpt
+//! strokes: [`super::Hold::keeps_detail`] false). Where none does — a
+//! curve's reach alone — the target carries
+//! [`KEEP_DETAIL`], and the nudge moves the winner's smooth height (the
+//! mean of nine texels over its 5×5 neighbourhood) to the profile at the
+//! finest two levels, so the exemplar's texture stays on the feature
+//! (`stages::correct::nudge::own_detail`).
+//!
 //! **Exactness.** Each sample's b, b·h_t and b·d_t are quantized to
 //! integers on the CPU and the sums are i64, so subtract → modify → add
 //! gives the same sums as evaluation from scratch, bit for bit (tested
@@ -90,7 +99,7 @@ use crate::synth::window::row_bounds;
 use rayon::prelude::*;
 use std::ops::Range;
 
-use crate::stages::correct::nudge::{MAX_TOL, Target};
+use crate::stages::correct::nudge::{KEEP_DETAIL, MAX_TOL, Target};
 
 /// The tolerance slope s (eq. 8) of points: ¼ where the paper has ½.
 ///
@@ -127,6 +136,8 @@ struct Sums {
     b: i64,
     bh: i64,
     bd: i64,
+    /// Reaching constraints that do not keep detail ([`Hold::keeps_detail`]).
+    exact: i64,
 }
 
 /// Running sums of one level, over its pixels `[x0, x0 + width) ×
@@ -400,7 +411,7 @@ fn target(s: &Sums, px_to_units: f64) -> Target {
     let tol = (t_px * px_to_units).round().min(MAX_TOL as f64) as i32;
     Target {
         height: height.clamp(i32::MIN as i64 / 2, i32::MAX as i64 / 2) as i32,
-        tol,
+        tol: if s.exact == 0 { tol | KEEP_DETAIL } else { tol },
     }
 }
 
@@ -482,6 +493,7 @@ impl Stamp<'_> {
         cell.b += self.sign * b;
         cell.bh += self.sign * bh;
         cell.bd += self.sign * bd;
+        cell.exact += self.sign * !self.hold.keeps_detail as i64;
         Some((cell.b != 0) as i64 - was as i64)
     }
 }

@@ -89,6 +89,11 @@ pub struct Hold {
     /// No sample reaches farther than this, output pixels (lets the blend
     /// skip tiles without sampling them).
     pub max_reach: f64,
+    /// The terrain keeps the exemplar's own detail on the constraint's
+    /// shape (a curve's profile) rather than meeting its heights exactly
+    /// (a point's site, a sculpt stroke): see
+    /// [`own_detail`](crate::stages::correct::nudge::own_detail).
+    pub keeps_detail: bool,
 }
 
 /// Invalid control inputs. Messages name the field and the allowed range.

@@ -120,6 +120,7 @@ impl Constraint for PointConstraint {
             tolerance_slope: super::blend::S,
             level_cap: (self.slope_angle == 0.0).then_some(4.0),
             max_reach: self.radius,
+            keeps_detail: false,
         }
     }
 }

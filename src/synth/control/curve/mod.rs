@@ -392,6 +392,7 @@ impl Constraint for Curve {
             tolerance_slope: super::blend::S_CURVE,
             level_cap: None,
             max_reach: self.field.margin,
+            keeps_detail: true,
         }
     }
 

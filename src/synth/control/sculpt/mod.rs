@@ -256,6 +256,7 @@ impl Constraint for SculptLayer {
             tolerance_slope: S_SCULPT,
             level_cap: None,
             max_reach: DISTANCE_PX,
+            keeps_detail: false,
         }
     }
 }
