@@ -450,20 +450,19 @@ fn controls_change_the_result_as_intended() {
     };
     let plain = copy(&st);
     correct::correct(&atlas, &plain, None, &p, Isa::default());
-    // A far-away target with zero tolerance moves every corrected offset.
-    let targets = vec![
-        Target {
-            height: 200_000,
-            tol: 0
+    // `st` corrected with one target everywhere.
+    let hold = |height: i32, tol: i32| {
+        let targets = vec![Target { height, tol }; w * h];
+        let held = copy(&st);
+        let g = Guide {
+            targets: Some(&targets),
+            ..Guide::NONE
         };
-        w * h
-    ];
-    let pulled = copy(&st);
-    let g = Guide {
-        targets: Some(&targets),
-        ..Guide::NONE
+        correct::correct_guided(&atlas, &held, None, &p, &g, Isa::default());
+        held
     };
-    correct::correct_guided(&atlas, &pulled, None, &p, &g, Isa::default());
+    // A far-away target with zero tolerance moves every corrected offset.
+    let pulled = hold(200_000, 0);
     for i in (0..w * h).filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0) {
         assert!(
             pulled.offsets()[i] > plain.offsets()[i] + 10_000,
@@ -489,23 +488,7 @@ fn controls_change_the_result_as_intended() {
         sum.div_euclid(9) + s.offsets()[i]
     };
     let target = 20_000;
-    let hold = |flag: i32| {
-        let targets = vec![
-            Target {
-                height: target,
-                tol: flag
-            };
-            w * h
-        ];
-        let held = copy(&st);
-        let g = Guide {
-            targets: Some(&targets),
-            ..Guide::NONE
-        };
-        correct::correct_guided(&atlas, &held, None, &p, &g, Isa::default());
-        held
-    };
-    let (exact, detailed) = (hold(0), hold(KEEP_DETAIL));
+    let (exact, detailed) = (hold(target, 0), hold(target, KEEP_DETAIL));
     let corrected: Vec<usize> = (0..w * h)
         .filter(|i| (i % w) % 2 == 0 && (i / w) % 2 == 0)
         .collect();
