@@ -146,7 +146,9 @@ type Best = (u32, Coord, i32, Option<(i32, i32)>);
 /// 3. if a type constraint rejected them all, 9 hash-chosen seeds per
 ///    allowed type, scored like C₁;
 /// 4. the winner's offset nudged by φ_d towards the blended target
-///    (eq. 8–9), unless it is a previous result taken as is.
+///    (eq. 8–9), unless it is a previous result taken as is — at the
+///    finest two levels of a curve's reach, by the winner's smooth height
+///    rather than its own, so its detail stays (`nudge::own_detail`).
 ///
 /// Why two forms of the previous result: inside an edit's influence a kept
 /// coordinate must still follow the new target (so its offset is re-fitted
