@@ -323,7 +323,8 @@ pub const SUBPASSES: [(u32, u32); 4] = [(0, 0), (1, 0), (0, 1), (1, 1)];
 /// [`Guide::NONE`] is plain synthesis. Rasters are level-sized, row-major.
 #[derive(Debug, Clone, Copy)]
 pub struct Guide<'a> {
-    /// The level index (salts the type-seeding hash).
+    /// The level index (salts the type-seeding hash; the finest levels
+    /// keep a curve's detail, [`nudge::own_detail`]).
     pub level: u32,
     /// Geometric constraints: blended target and tolerance per pixel; the
     /// winner's height is nudged by φ_d (eq. 8–9).
