@@ -6,7 +6,7 @@ use super::fill::{fill_ssd, hole_fill};
 use super::input::control_point::{ACROSS, ALONG, UNIT};
 use super::input::graph;
 use super::input::sketch::{Kind, Sketch};
-use super::merge::{self, Canvas, Window};
+use super::merge::{self, Canvas, Window, join_pits};
 use super::place::costs::{FEATURE_TRANSFORMS as FEATURE_TRANSFORMS_COUNT, feature_cost};
 use super::{
     Library, PatchError, Scored, Stats, Synthesis, Timings, deform_by_sketch, detrend,
@@ -174,6 +174,7 @@ pub fn synthesize_with(
     )?;
     remove_drift(&mut canvas.heights, w, h, n);
     deform_by_sketch(&mut canvas.heights, &field, w, h, n, params.sketch_relief);
+    stats.join_pits = join_pits::repair(&mut canvas.heights, &canvas.placement, w, h);
     // The merge fixes heights only up to a constant: put the lowest point
     // at the sources' typical lowest level (the median of their minima), so
     // that the output is not partly below sea level for no reason (the

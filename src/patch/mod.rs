@@ -21,8 +21,15 @@
 //!    under 6 transforms (integer SSD + noise on an 8× reduced grid through
 //!    an explicit-SIMD kernel, then the same second round and merge);
 //! 6. the broad drift of the merge is removed ([`remove_drift`]), the
-//!    sketch's broad shape added ([`deform_by_sketch`]) and the lowest point
-//!    put at the sources' typical lowest level.
+//!    sketch's broad shape added ([`deform_by_sketch`]), the pits the joins
+//!    between patches made raised ([`join_pits`]) and the lowest point put
+//!    at the sources' typical lowest level.
+//!
+//! Only the sources whose relief fits the library's take part
+//! ([`Library`], [`MAX_STRETCH`]).
+//!
+//! [`join_pits`]: merge::join_pits
+//! [`MAX_STRETCH`]: input::library::MAX_STRETCH
 //!
 //! Sources are prepared once per [`Library`] and their features kept on
 //! disk between processes ([`cache`]).

@@ -169,7 +169,8 @@ fn sketch_synthesis_matches_end_to_end() {
         return;
     }
     let mut src = Vec::new();
-    for name in ["pyrenees_andorra", "thuringia_hills"] {
+    // Two sources of ranges' relief (1.68 km and 905 m), so both take part.
+    for name in ["pyrenees_andorra", "riviera_coast"] {
         let Some(hf) = dem::heights(name, "the real-DEM sketch cross-check") else {
             return;
         };
@@ -180,6 +181,7 @@ fn sketch_synthesis_matches_end_to_end() {
         ..Params::default()
     };
     let lib = Library::prepare(&src, &params, &Silent).unwrap();
+    assert_eq!(lib.sources.len(), 2, "left out: {:?}", lib.left_out);
     let sketch = Sketch::from_json(
         br#"{"width": 160, "height": 160, "strokes": [
         {"kind": "ridge", "width": 8, "points": [[80, 90], [30, 20]]},

@@ -10,10 +10,12 @@ use terrasynth::patch::input::sketch::{Kind, Sketch, SketchError};
 use terrasynth::patch::{self, Library, Params};
 use terrasynth::progress::Silent;
 
-/// 256² crops of two DEMs, or None (with a message) without ../shared/dem.
+/// 256² crops of three DEMs, or None (with a message) without
+/// ../shared/dem. Their 2–98 % reliefs: the Pyrenees 1.68 km, the Riviera
+/// 905 m, Thuringia 366 m (under half the largest: left out).
 fn sources() -> Option<Vec<(String, Heightfield)>> {
     let mut out = Vec::new();
-    for name in ["pyrenees_andorra", "thuringia_hills"] {
+    for name in ["pyrenees_andorra", "riviera_coast", "thuringia_hills"] {
         let hf = common::dem::heights(name, "the patch pipeline tests")?;
         out.push((name.to_string(), hf.crop(200, 200, 256, 256).unwrap()));
     }
@@ -54,6 +56,17 @@ fn synthesis_is_complete_converged_deterministic_and_follows_the_sketch() {
             .iter()
             .all(|s| !s.ridges.is_empty() && !s.valleys.is_empty())
     );
+    // The two sources with the relief of ranges take part, brought to the
+    // Pyrenees' relief; the hills are left out, not stretched ×4.6.
+    let names: Vec<&str> = lib.sources.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["pyrenees_andorra", "riviera_coast"]);
+    assert_eq!(lib.left_out.len(), 1, "{:?}", lib.left_out);
+    assert_eq!(lib.left_out[0].0, "thuringia_hills");
+    assert!(lib.left_out[0].1 * 2.0 < lib.relief, "{:?}", lib.left_out);
+    for s in &lib.sources {
+        let r = terrasynth::patch::place::candidates::relief(&s.heights);
+        assert!((r / lib.relief - 1.0).abs() < 0.01, "{}: {r}", s.name);
+    }
     let a = run(&lib, 2);
     let s = &a.stats;
     assert!(s.feature_patches >= 6, "{s:?}");
@@ -76,8 +89,8 @@ fn synthesis_is_complete_converged_deterministic_and_follows_the_sketch() {
     let adh = patch::adherence(hf, &y_sketch(), 3.0).unwrap();
     assert!(adh > 0.1, "adherence {adh}");
     // No seams: no step between neighbours far beyond the sources' own, as
-    // the library uses them (rescaled to one relief: the hills' crop is
-    // scaled up to the mountains' relief, and its steps with it).
+    // the library uses them (rescaled to one relief: the Riviera's crop is
+    // scaled up to the Pyrenees' relief, and its steps with it).
     let max_step = |d: &[f32], w: usize| {
         d.windows(2)
             .enumerate()

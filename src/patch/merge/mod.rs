@@ -12,6 +12,7 @@
 
 pub(crate) mod broad_shape;
 pub mod graphcut;
+pub mod join_pits;
 
 use crate::blend::gradient_domain::guided_rhs;
 use crate::patch::merge::graphcut::{Label, Seam, kwatra, min_cut};
@@ -28,6 +29,13 @@ pub struct Canvas {
     /// sources; [`Canvas::NO_SOURCE`] where nothing is placed): the
     /// coherence cost of round two reads it ([`crate::patch::Weights::coherence`]).
     pub source: Vec<u32>,
+    /// Which placement each filled pixel came from (its index among the
+    /// merges, in order; [`Canvas::NO_SOURCE`] where nothing is placed):
+    /// where a pixel's 3×3 neighbours came from two placements, the
+    /// neighbourhood exists in no source ([`join_pits`]).
+    pub placement: Vec<u32>,
+    /// How many patches were merged so far.
+    pub placed: u32,
 }
 
 impl Canvas {
@@ -41,6 +49,8 @@ impl Canvas {
             heights: vec![0.0; width * height],
             filled: vec![false; width * height],
             source: vec![Canvas::NO_SOURCE; width * height],
+            placement: vec![Canvas::NO_SOURCE; width * height],
+            placed: 0,
         }
     }
 }
@@ -260,6 +270,18 @@ pub fn apply(
     take_new: &[bool],
     opts: &SolveOptions,
 ) -> Option<SolveReport> {
+    let report = merge(c, win, (patch, source), take_new, opts);
+    c.placed += 1;
+    report
+}
+
+fn merge(
+    c: &mut Canvas,
+    win: Window,
+    (patch, source): (&[f32], u32),
+    take_new: &[bool],
+    opts: &SolveOptions,
+) -> Option<SolveReport> {
     let n = win.n;
     let (w, h) = (c.width, c.height);
     // Solve grid: the window grown by one pixel, clipped.
@@ -307,6 +329,7 @@ pub fn apply(
                 c.heights[i] = patch[y * n + x];
                 c.filled[i] = true;
                 c.source[i] = source;
+                c.placement[i] = c.placed;
             }
         }
         return None;
@@ -472,6 +495,7 @@ pub fn apply(
                 c.heights[i] = u[gy * gw + gx];
                 c.filled[i] = true;
                 c.source[i] = source;
+                c.placement[i] = c.placed;
             }
         }
     }

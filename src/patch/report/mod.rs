@@ -36,6 +36,9 @@ pub struct Stats {
     pub round1_fill: u64,
     /// Worst relative residual of the Poisson solves.
     pub worst_residual: f64,
+    /// Pits on the joins between patches raised to their lowest neighbour
+    /// ([`crate::patch::merge::join_pits`]).
+    pub join_pits: usize,
 }
 
 /// A finished synthesis.

@@ -28,7 +28,9 @@ Example:
 pub struct Args {
     /// The sketch (.json polylines, or an image).
     sketch: PathBuf,
-    /// Source DEMs (any readable heightfield format).
+    /// Source DEMs (any readable heightfield format). Those whose 2-98 %
+    /// relief is under half the largest one's are left out (with a note):
+    /// the others are brought to the largest relief.
     #[arg(long, num_args = 1.., required = true, value_name = "DEM")]
     sources: Vec<PathBuf>,
     /// Output size WxH [default: the sketch's size].
@@ -87,6 +89,20 @@ pub fn run(a: Args) -> CliResult {
         Library::prepare_cached(&sources, &params, &dir, &bar)?
     };
     let prep_ms = t_prep.elapsed().as_secs_f64() * 1e3;
+    if !lib.left_out.is_empty() {
+        let names: Vec<String> = lib
+            .left_out
+            .iter()
+            .map(|(name, relief)| format!("{name} ({relief:.0} m)"))
+            .collect();
+        eprintln!(
+            "note: {} of {} sources are left out, their 2-98 % relief under half the largest ({:.0} m), which a sketch's ranges take: {}",
+            lib.left_out.len(),
+            sources.len(),
+            lib.relief,
+            names.join(", ")
+        );
+    }
     let (engine, notice) = Engine::choose(a.backend.into())?;
     if let Some(n) = notice {
         eprintln!("note: {n}");
@@ -98,9 +114,10 @@ pub fn run(a: Args) -> CliResult {
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
     let s = &result.stats;
     eprintln!(
-        "wrote {} ({w} x {h}) from {} source(s), fill costs on the {}: {} user patches, {} feature + {} fill patches",
+        "wrote {} ({w} x {h}) from {} source(s), {} pits on patch joins raised, fill costs on the {}: {} user patches, {} feature + {} fill patches",
         a.output.display(),
         lib.sources.len(),
+        s.join_pits,
         cost.name(),
         s.user_patches,
         s.feature_patches,
