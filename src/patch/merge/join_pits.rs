@@ -12,6 +12,7 @@
 //! output's pit density, and its realism ratio's pits descriptor, well off
 //! its source's. A pit away from every seam is the source's own and stays.
 
+use crate::procedural::grid::MOORE;
 use rayon::prelude::*;
 
 /// Raises every strict pit whose 3×3 neighbourhood spans two placements
@@ -25,16 +26,6 @@ use rayon::prelude::*;
 ///
 /// [`Canvas::placement`]: super::Canvas::placement
 pub fn repair(heights: &mut [f32], placement: &[u32], w: usize, h: usize) -> usize {
-    const MOORE: [(isize, isize); 8] = [
-        (-1, -1),
-        (0, -1),
-        (1, -1),
-        (-1, 0),
-        (1, 0),
-        (-1, 1),
-        (0, 1),
-        (1, 1),
-    ];
     if w < 3 || h < 3 {
         return 0;
     }
@@ -48,8 +39,8 @@ pub fn repair(heights: &mut [f32], placement: &[u32], w: usize, h: usize) -> usi
                 let c = heights[i];
                 let mut low = f32::INFINITY;
                 let mut join = false;
-                for d in MOORE {
-                    let j = at(d);
+                for &(dx, dy, _) in &MOORE {
+                    let j = at((dx, dy));
                     if heights[j] <= c {
                         return None;
                     }
