@@ -270,18 +270,6 @@ pub fn apply(
     take_new: &[bool],
     opts: &SolveOptions,
 ) -> Option<SolveReport> {
-    let report = merge(c, win, (patch, source), take_new, opts);
-    c.placed += 1;
-    report
-}
-
-fn merge(
-    c: &mut Canvas,
-    win: Window,
-    (patch, source): (&[f32], u32),
-    take_new: &[bool],
-    opts: &SolveOptions,
-) -> Option<SolveReport> {
     let n = win.n;
     let (w, h) = (c.width, c.height);
     // Solve grid: the window grown by one pixel, clipped.
@@ -332,6 +320,7 @@ fn merge(
                 c.placement[i] = c.placed;
             }
         }
+        c.placed += 1;
         return None;
     }
     let has_a = |gx: usize, gy: usize| c.filled[ci(gx, gy)];
@@ -499,5 +488,6 @@ fn merge(
             }
         }
     }
+    c.placed += 1;
     report
 }
