@@ -20,9 +20,9 @@ use std::borrow::Cow;
 /// at 36–41 % of the relief the Pyrenees alone give them, smooth and with
 /// dense contours; brought to the largest, the plains were stretched up to
 /// ×10 into ranges, with their terraces and pits. Left at their own relief,
-/// the detail cost picked mid-relief hills everywhere (20–61 %); capped at
-/// ×2, a patchwork of scales (54–97 %) that scored 2.4–3.8 against every
-/// source. A sketch of ridges and valleys asks for the relief of the
+/// the detail cost picked mid-relief hills everywhere (20–61 %); with the
+/// stretch capped at ×1.5 or ×2, a patchwork of scales (54–97 %) that
+/// scored 2.4–4.3 against its dominant source. A sketch of ridges and valleys asks for the relief of the
 /// library's ranges, and only the sources that have it can make them: on
 /// the three example sketches the eight DEMs then keep 91–107 % of the
 /// one-source relief (the Pyrenees, Yosemite and the Riviera take part).
