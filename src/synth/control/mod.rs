@@ -199,19 +199,34 @@ impl Paste {
         if delta == 0 {
             return 0;
         }
-        let t = (self.depth(level, x, y) / PASTE_FEATHER).min(1.0);
+        let t = (self.depth(level, x, y).max(0.0) / PASTE_FEATHER).min(1.0);
         (f64::from(delta) * t * t * (3.0 - 2.0 * t)).round() as i32
     }
 
     /// How far inside the lasso the centre of level-`level` source pixel
-    /// (x, y) lies, output pixels (0 outside it).
+    /// (x, y) lies, output pixels; negative outside it.
     pub fn depth(&self, level: usize, x: usize, y: usize) -> f64 {
         let s = (1u64 << level) as f64;
         let (px, py) = ((x as f64 + 0.5) * s, (y as f64 + 0.5) * s);
-        match inside(&self.lasso, px, py) {
-            true => distance_to_polygon(&self.lasso, px, py),
-            false => 0.0,
+        let d = distance_to_polygon(&self.lasso, px, py);
+        if inside(&self.lasso, px, py) { d } else { -d }
+    }
+
+    /// How far beyond its lasso the paste writes, output pixels: a
+    /// [`Lift::Ground`] paste's seam ([`lift::SEAM`]), nothing for a
+    /// [`Lift::Source`] one.
+    pub fn reach(&self) -> f64 {
+        match self.lift {
+            Lift::Ground => lift::SEAM,
+            Lift::Source => 0.0,
         }
+    }
+
+    /// Whether the paste writes the level-0 source pixel centred at
+    /// (x, y): inside its lasso, or less than [`Paste::reach`] outside it.
+    pub fn covers(&self, x: f64, y: f64) -> bool {
+        inside(&self.lasso, x, y)
+            || (self.lift == Lift::Ground && distance_to_polygon(&self.lasso, x, y) < self.reach())
     }
 }
 

@@ -13,7 +13,7 @@ use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::level_size;
 use crate::stages::correct::W_FREE;
-use crate::synth::control::{Lift, Paste, PasteSource, inside, lift};
+use crate::synth::control::{Lift, Paste, PasteSource, lift};
 use crate::synth::union;
 
 impl Session<'_> {
@@ -33,11 +33,11 @@ impl Session<'_> {
             }
         };
         // The source pixels the lasso can hold (see `lasso_bounds`).
-        let mut b = lasso_bounds(&p.lasso, sw, sh);
+        let mut b = lasso_bounds(&p.lasso, p.reach(), sw, sh);
         let mut mask = vec![false; sw * sh];
         for y in b[1]..b[3] {
             for x in b[0]..b[2] {
-                mask[y * sw + x] = inside(&p.lasso, x as f64 + 0.5, y as f64 + 0.5);
+                mask[y * sw + x] = p.covers(x as f64 + 0.5, y as f64 + 0.5);
             }
         }
         if let (Lift::Ground, Some(last)) = (p.lift, frames.levels[0].last()) {
@@ -180,10 +180,11 @@ impl Session<'_> {
 }
 
 /// Bounds `[x0, y0, x1, y1)` of a `w × h` grid's pixels whose centres may
-/// lie inside `lasso` (a pixel beyond them is outside it): the lasso's
-/// bounding box and a pixel more, against rounding in [`inside`]'s
-/// crossings. The whole grid when a vertex is not finite.
-fn lasso_bounds(lasso: &[(f64, f64)], w: usize, h: usize) -> [usize; 4] {
+/// lie inside `lasso` or less than `grow` outside it (a pixel beyond them
+/// is farther): the lasso's bounding box widened by `grow` and a pixel
+/// more, against rounding in [`crate::synth::control::inside`]'s crossings. The whole grid when a
+/// vertex is not finite.
+fn lasso_bounds(lasso: &[(f64, f64)], grow: f64, w: usize, h: usize) -> [usize; 4] {
     if lasso.iter().any(|&(x, y)| !x.is_finite() || !y.is_finite()) {
         return [0, 0, w, h];
     }
@@ -193,8 +194,8 @@ fn lasso_bounds(lasso: &[(f64, f64)], w: usize, h: usize) -> [usize; 4] {
         (x0, x1) = (x0.min(x), x1.max(x));
         (y0, y1) = (y0.min(y), y1.max(y));
     }
-    let lo = |v: f64, n: usize| ((v - 1.5).floor().max(0.0) as usize).min(n);
-    let hi = |v: f64, n: usize| ((v + 1.5).ceil().max(0.0) as usize).min(n);
+    let lo = |v: f64, n: usize| ((v - grow - 1.5).floor().max(0.0) as usize).min(n);
+    let hi = |v: f64, n: usize| ((v + grow + 1.5).ceil().max(0.0) as usize).min(n);
     [lo(x0, w), lo(y0, h), hi(x1, w), hi(y1, h)]
 }
 
@@ -254,6 +255,7 @@ fn near_fresh(fresh: &[bool], (w, h): (usize, usize), bounds: [usize; 4], m: usi
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::synth::control::inside;
 
     #[test]
     fn near_fresh_is_the_square_search_around_every_pixel() {
@@ -281,7 +283,7 @@ mod tests {
     fn interior_negates_near_seam() {
         let lasso = [(3.2, 4.0), (20.7, 5.5), (11.0, 15.9), (6.5, 9.0)];
         let (sw, sh) = (24, 18);
-        let b = lasso_bounds(&lasso, sw, sh);
+        let b = lasso_bounds(&lasso, 0.0, sw, sh);
         let mask: Vec<bool> = (0..sw * sh)
             .map(|k| inside(&lasso, (k % sw) as f64 + 0.5, (k / sw) as f64 + 0.5))
             .collect();
@@ -303,13 +305,13 @@ mod tests {
     fn no_pixel_beyond_the_lasso_bounds_is_inside() {
         let lasso = [(3.2, 4.0), (20.7, 5.5), (11.0, 15.9), (6.5, 9.0)];
         let (w, h) = (30, 25);
-        let [x0, y0, x1, y1] = lasso_bounds(&lasso, w, h);
+        let [x0, y0, x1, y1] = lasso_bounds(&lasso, 0.0, w, h);
         for k in 0..w * h {
             let (x, y) = (k % w, k / w);
             if inside(&lasso, x as f64 + 0.5, y as f64 + 0.5) {
                 assert!((x0..x1).contains(&x) && (y0..y1).contains(&y), "({x}, {y})");
             }
         }
-        assert_eq!(lasso_bounds(&[(f64::NAN, 0.0)], w, h), [0, 0, w, h]);
+        assert_eq!(lasso_bounds(&[(f64::NAN, 0.0)], 0.0, w, h), [0, 0, w, h]);
     }
 }

@@ -18,7 +18,7 @@ use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::level_size;
 use crate::synth::cone::Rect;
-use crate::synth::control::{Lift, Paste, PasteSource, inside, lift};
+use crate::synth::control::{Lift, Paste, PasteSource, lift};
 use crate::synth::{Frames, PassResult};
 
 /// One paste at one level.
@@ -57,22 +57,23 @@ impl PasteGeometry {
                 (r.width as usize, r.height as usize)
             }
         };
-        // Pixel centres i + 0.5 inside the lasso lie in its bounds.
+        // Pixel centres i + 0.5 the paste covers lie in these bounds.
         let (sw, sh) = src_size(0);
         let clip = |v: f64, n: usize| (v.max(0.0) as usize).min(n);
         let (lo_x, hi_x, lo_y, hi_y) = p.lasso.iter().fold(
             (f64::MAX, f64::MIN, f64::MAX, f64::MIN),
             |(a, b, c, d), &(x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
         );
+        let grow = p.reach() + 1.0;
         let mut bbox = Rect {
-            x0: clip((lo_x - 1.0).floor(), sw),
-            y0: clip((lo_y - 1.0).floor(), sh),
-            x1: clip((hi_x + 1.0).ceil(), sw),
-            y1: clip((hi_y + 1.0).ceil(), sh),
+            x0: clip((lo_x - grow).floor(), sw),
+            y0: clip((lo_y - grow).floor(), sh),
+            x1: clip((hi_x + grow).ceil(), sw),
+            y1: clip((hi_y + grow).ceil(), sh),
         };
         let mut mask: Vec<bool> = (bbox.y0..bbox.y1)
             .flat_map(|y| (bbox.x0..bbox.x1).map(move |x| (x, y)))
-            .map(|(x, y)| inside(&p.lasso, x as f64 + 0.5, y as f64 + 0.5))
+            .map(|(x, y)| p.covers(x as f64 + 0.5, y as f64 + 0.5))
             .collect();
         let mut levels = Vec::with_capacity(last + 1);
         for i in 0..=last {
