@@ -52,8 +52,9 @@
 //!     "to": [700, 300],                 // where the lasso's centroid goes, output pixels
 //!     "delta_m": 0,                     // optional, -20000..=20000: height offset δ, metres
 //!     "lift": "ground"                  // optional: "ground" (default in version 2) lifts the paste so that it meets the
-//!                                       // terrain along its lasso (the median step there is 0), then by δ, exactly to the
-//!                                       // lasso, bending to the ground over 6 px beyond it; "source" (default in
+//!                                       // terrain along its lasso (the median step there is 0, its floor not below the
+//!                                       // ground's), then by δ, exactly to the
+//!                                       // lasso, bending to the ground over 16 px beyond it; "source" (default in
 //!                                       // version 1) keeps the source's own heights, δ rising
 //!                                       // over 16 px inside the lasso (synth::control::Lift)
 //!   }],

@@ -12,6 +12,9 @@
 //! - the paste meets the ground: the median height step across the lasso,
 //!   and across the outer edge of the seam beyond it ([`SEAM`]), is at
 //!   most twice the terrain's own median 3-px height difference;
+//! - no more than 2 % of the paste sinks below the ground's floor (the
+//!   2 % low of the ground along the seam's outer edge): a piece of
+//!   mountains lands as mountains, not as a basin;
 //! - δ raises the paste from there: the constant with δ is the constant
 //!   without it plus δ.
 //!
@@ -116,6 +119,9 @@ struct Landing {
     /// The median step across the seam's outer edge.
     edge_step: f64,
     own_step: f64,
+    /// The share of the interior below the ground's floor along the seam's
+    /// outer edge (its 2 % low, less 0.5 % of relief).
+    sunk: f64,
 }
 
 /// Pastes `p` (whose target lasso is `target`) into a new session of `db`
@@ -153,6 +159,22 @@ fn land(
         .map(|k| f64::from(out.get(k % n, k / n)) - source(&base, k % n, k / n))
         .collect();
     let close = all.iter().filter(|d| (**d - c).abs() <= tol).count() as f64 / all.len() as f64;
+    let mut edge = Vec::new();
+    let mut interior = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+            let d = distance_to(target, cx, cy);
+            if inner(x, y) {
+                interior.push(f64::from(out.get(x, y)));
+            } else if !inside(target, cx, cy) && (SEAM..SEAM + 2.0).contains(&d) {
+                edge.push(f64::from(base.get(x, y)));
+            }
+        }
+    }
+    edge.sort_by(f64::total_cmp);
+    let floor = edge[edge.len() * 2 / 100] - tol;
+    let sunk = interior.iter().filter(|&&h| h < floor).count() as f64 / interior.len() as f64;
     let exact = diffs.iter().filter(|d| (**d - c).abs() < 0.02).count() as f64 / diffs.len() as f64;
     let within = |(x, y): (usize, usize)| inside(target, x as f64 + 0.5, y as f64 + 0.5);
     let covered = |(x, y): (usize, usize)| {
@@ -168,6 +190,7 @@ fn land(
         rim_step: median(steps(&out, 1, |p, q| within(p) != within(q))),
         edge_step: median(steps(&out, 1, |p, q| covered(p) != covered(q))),
         own_step: median(steps(&base, 3, |_, _| true)),
+        sunk,
     }
 }
 
@@ -185,7 +208,8 @@ fn check(
     );
     println!(
         "{what}: {:.2} / {:.2} % exact beyond the band, {:.1} / {:.1} % of all within 0.5 % of relief, \
-         lift {:.0} m, rim step {:.1} m, seam edge step {:.1} m (own 3-px step {:.1} m)",
+         lift {:.0} m, rim step {:.1} m, seam edge step {:.1} m (own 3-px step {:.1} m), \
+         {:.1} % below the ground",
         a.exact * 100.0,
         b.exact * 100.0,
         a.close * 100.0,
@@ -193,7 +217,13 @@ fn check(
         a.lift,
         a.rim_step,
         a.edge_step,
-        a.own_step
+        a.own_step,
+        a.sunk * 100.0
+    );
+    assert!(
+        a.sunk <= 0.03,
+        "{what}: {:.1} % of the paste sank below the ground's floor",
+        a.sunk * 100.0
     );
     for l in [&a, &b] {
         assert!(

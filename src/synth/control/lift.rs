@@ -5,8 +5,9 @@
 //! source's absolute heights dropped a piece of plateau onto a lowland as a
 //! cookie-cutter mesa — 83–87° walls, steps of up to 1.1 km along the lasso
 //! (issue 40) — and left the user guessing δ by hand. Lifted by the median
-//! step between the ground under the lasso and the source along it, the
-//! paste meets the terrain where it is put, and δ raises or lowers it from
+//! step between the ground under the lasso and the source along it (or
+//! more, so that its floor does not sink below the ground's), the paste
+//! meets the terrain where it is put, and δ raises or lowers it from
 //! there. The lift is one constant, so the pasted relief is the source's,
 //! exactly, all the way to the lasso: one constant cannot match a whole
 //! rim, though (a massif's rim rises and falls by hundreds of metres where
@@ -19,7 +20,7 @@
 //! outer 3 px (5 px with the blends) to the ground — 8–15 % of a 92-px
 //! lasso, so only 85–92 % of the pasted pixels were within 0.5 % of relief
 //! of source + lift where issue 40 asks 95 %. Outside, the paste is exact
-//! from 2 px inside its lasso, and the bend has twice the room.
+//! from 2 px inside its lasso, and the bend has room to be a slope.
 
 use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::{Coord, round};
@@ -45,11 +46,13 @@ pub enum Lift {
 /// 3×3, `repair_extrema` reads the blends of the 3×3), so a ground paste
 /// is its source + lift + δ, exactly, from 2 px inside its lasso.
 ///
-/// Why 6 px: the bend is as steep as the rim's mismatch over this width,
-/// and the mismatch left after the lift is large where a massif lands on
-/// a plain (median 582 m along the rim at 1024²); over 2 px it stood as a
-/// wall.
-pub const SEAM: f64 = 6.0;
+/// Why 16 px: the bend is as steep as the rim's mismatch over this width,
+/// and the mismatch is large where a massif lands on a plain — up to a
+/// kilometre once the floor rule ([`ground_offset`]) lifts it. Over 2 px it
+/// stood as a wall; over 6 px the floor-lifted massif stood as a mesa;
+/// over 16 px its flanks run down to the plain at a median 30° (90th
+/// percentile 55°, the massif's own slopes 23°; 512², 92.6-m cells).
+pub const SEAM: f64 = 16.0;
 
 /// How far (output pixels) the seam keeps the ground's smooth height whole
 /// at its outer edge before bending to the paste's.
@@ -63,55 +66,89 @@ pub const SEAM: f64 = 6.0;
 /// pixel it was 17 m (0.93×).
 pub const SEAM_HOLD: f64 = 1.0;
 
-/// The level-0 source pixels of a paste's rim, row-major: those it writes
-/// (`writes`, over `[x0, x1) × [y0, y1)`) with a 4-neighbour it does not.
-pub fn rim(
+/// Where a paste lies, level-0 source pixels, row-major: those inside its
+/// lasso, and its rim — the pixels it writes (the seam included) with a
+/// 4-neighbour it does not write.
+pub struct Footprint {
+    pub inner: Vec<(usize, usize)>,
+    pub rim: Vec<(usize, usize)>,
+}
+
+/// The [`Footprint`] of a paste that writes the source pixels `writes`
+/// accepts over `[x0, x1) × [y0, y1)`, those of them `inner` accepts
+/// inside its lasso.
+pub fn footprint(
     (x0, y0, x1, y1): (usize, usize, usize, usize),
     writes: impl Fn(usize, usize) -> bool,
-) -> Vec<(usize, usize)> {
+    inner: impl Fn(usize, usize) -> bool,
+) -> Footprint {
     let out = |x: usize, y: usize, dx: isize, dy: isize| {
         let (u, v) = (x.checked_add_signed(dx), y.checked_add_signed(dy));
         !matches!((u, v), (Some(u), Some(v)) if writes(u, v))
     };
-    (y0..y1)
+    let all: Vec<(usize, usize)> = (y0..y1)
         .flat_map(|y| (x0..x1).map(move |x| (x, y)))
         .filter(|&(x, y)| writes(x, y))
+        .collect();
+    let rim = (all.iter().copied())
         .filter(|&(x, y)| {
             [(1, 0), (-1, 0), (0, 1), (0, -1)]
                 .iter()
                 .any(|&(dx, dy)| out(x, y, dx, dy))
         })
-        .collect()
+        .collect();
+    let inner = all.into_iter().filter(|&(x, y)| inner(x, y)).collect();
+    Footprint { inner, rim }
 }
 
+/// The low quantile (per cent) [`ground_offset`] takes of the ground along
+/// a paste's rim and of the paste itself: low enough to be the floor of
+/// each, high enough that a few pixels in a river bed do not set it.
+pub const FLOOR_PERCENT: usize = 2;
+
 /// The lift (database units) that puts a paste on the ground: the median
-/// over its `rim` of the target's height minus the source's, each the
-/// smooth height of its level-0 texel plus its offset — what the previous
-/// frame holds at the target, what the paste would write there at δ = 0.
-/// 0 for an empty rim (a paste wholly outside the world).
+/// over its rim of the target's height minus the source's, raised where
+/// that would sink the paste's floor below the ground's — its
+/// [`FLOOR_PERCENT`] quantile inside the lasso below that of the ground
+/// along its rim.
+/// Heights are the smooth height of a level-0 texel plus its offset: what
+/// the previous frame holds at the target, what the paste would write
+/// there at δ = 0. 0 for a paste that writes nothing inside its lasso
+/// (wholly outside the world).
 ///
 /// Why the median of the steps: it is the lift that makes the typical step
 /// along the rim zero, whatever a few pixels on a cliff or in a river do.
-/// The rim is the seam's outer edge ([`SEAM`] beyond the lasso), where the
-/// seam hands over to the ground.
+/// Why the floor: a rim median alone landed a lasso drawn over ridges
+/// around a valley with its ridges on the ground and its valley below it
+/// — a 55-px disc of the Pyrenees exemplar on a plain at 102 m had its
+/// median inside at −36 m, 55 % of it at or below 0 m, a sunken sea where
+/// the user pasted mountains; a massif's lower flank sank the same way
+/// into a lake. With the floor, the valley lands on the ground and the
+/// ridges rise from it (median 793 m, 2 % at or below 0 m), the seam
+/// bringing them down to the plain.
 /// Why smooth heights: they are what the correction matches; the detail
 /// of both sides is unrelated and would only add noise.
 pub fn ground_offset(
     atlas: &AtlasLevel<'_>,
-    rim: &[(usize, usize)],
+    footprint: &Footprint,
     source: impl Fn(usize, usize) -> (Coord, i32),
     target: impl Fn(usize, usize) -> (Coord, i32),
 ) -> i32 {
     let height = |(c, v): (Coord, i32)| texel_height(atlas.appearance(round(c.x), round(c.y))) + v;
-    let mut steps: Vec<i32> = rim
-        .iter()
-        .map(|&(x, y)| height(target(x, y)) - height(source(x, y)))
-        .collect();
-    if steps.is_empty() {
+    let rim = &footprint.rim;
+    if rim.is_empty() || footprint.inner.is_empty() {
         return 0;
     }
-    let mid = steps.len() / 2;
-    *steps.select_nth_unstable(mid).1
+    let quantile = |mut v: Vec<i32>, percent: usize| {
+        let k = (v.len() * percent / 100).min(v.len() - 1);
+        *v.select_nth_unstable(k).1
+    };
+    let steps = (rim.iter()).map(|&(x, y)| height(target(x, y)) - height(source(x, y)));
+    let ground = rim.iter().map(|&(x, y)| height(target(x, y)));
+    let paste = (footprint.inner.iter()).map(|&(x, y)| height(source(x, y)));
+    let floor =
+        quantile(ground.collect(), FLOOR_PERCENT) - quantile(paste.collect(), FLOOR_PERCENT);
+    quantile(steps.collect(), 50).max(floor)
 }
 
 /// Bends the values a ground paste writes at one pixel toward the ground
@@ -158,11 +195,14 @@ mod tests {
     fn the_rim_is_the_written_pixels_beside_unwritten_ones() {
         // A 4×3 block at (2, 1) inside a 10×10 source: its 10 outer pixels.
         let block = |x: usize, y: usize| (2..6).contains(&x) && (1..4).contains(&y);
-        let r = rim((0, 0, 10, 10), block);
-        assert_eq!(r.len(), 10);
-        assert!(!r.contains(&(3, 2)) && !r.contains(&(4, 2)));
-        assert!(r.contains(&(2, 1)) && r.contains(&(5, 3)));
+        let f = footprint((0, 0, 10, 10), block, |x, _| x < 4);
+        assert_eq!((f.inner.len(), f.rim.len()), (6, 10));
+        assert!(!f.rim.contains(&(3, 2)) && !f.rim.contains(&(4, 2)));
+        assert!(f.rim.contains(&(2, 1)) && f.rim.contains(&(5, 3)));
         // A pixel on the source's edge is on the rim.
-        assert_eq!(rim((0, 0, 2, 1), |_, _| true).len(), 2);
+        assert_eq!(
+            footprint((0, 0, 2, 1), |_, _| true, |_, _| true).rim.len(),
+            2
+        );
     }
 }

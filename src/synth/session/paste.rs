@@ -67,12 +67,13 @@ impl Session<'_> {
                         }
                     }
             };
-            let rim = lift::rim((b[0], b[1], b[2], b[3]), writes);
+            let inner = |x: usize, y: usize| p.depth(0, x, y) > 0.0;
+            let footprint = lift::footprint((b[0], b[1], b[2], b[3]), writes, inner);
             let target = |x: usize, y: usize| {
-                let t = target_of(x, y).expect("a rim pixel is written");
+                let t = target_of(x, y).expect("a footprint pixel is written");
                 (last.coords[t], last.offsets[t])
             };
-            delta += lift::ground_offset(&AtlasLevel::new(db, 0), &rim, source, target);
+            delta += lift::ground_offset(&AtlasLevel::new(db, 0), &footprint, source, target);
         }
         // Bounds of the level-0 pixels written (the margin's seeds).
         let mut written = None;

@@ -184,8 +184,9 @@ impl PasteGeometry {
             let (tx, ty) = (x as i64 + l.off.0, y as i64 + l.off.1);
             tx >= 0 && ty >= 0 && self.source_of(0, tx as usize, ty as usize).is_some()
         };
-        let rim = lift::rim((b.x0, b.y0, b.x1, b.y1), writes);
-        let whole = rim.iter().all(|&(x, y)| {
+        let inner = |x: usize, y: usize| self.paste.depth(0, x, y) > 0.0;
+        let footprint = lift::footprint((b.x0, b.y0, b.x1, b.y1), writes, inner);
+        let whole = (footprint.inner.iter().chain(&footprint.rim)).all(|&(x, y)| {
             at(x as i64 + l.off.0, y as i64 + l.off.1).is_some()
                 && (l.exemplar.is_some() || at(x as i64, y as i64).is_some())
         });
@@ -198,7 +199,7 @@ impl PasteGeometry {
         };
         let target =
             |x: usize, y: usize| at(x as i64 + l.off.0, y as i64 + l.off.1).expect("checked");
-        Some(lift::ground_offset(atlas, &rim, source, target))
+        Some(lift::ground_offset(atlas, &footprint, source, target))
     }
 
     /// Bounding box of the level-`i` pixels the paste writes, if any.
