@@ -28,8 +28,17 @@
 //! Only the sources whose relief fits the library's take part
 //! ([`Library`], [`MAX_STRETCH`]).
 //!
+//! [`sketch`]: input::sketch
+//! [`ppa`]: input::ppa
+//! [`candidates::PreparedSource`]: place::candidates::PreparedSource
+//! [`graph`]: input::graph
+//! [`candidates`]: place::candidates
+//! [`costs`]: place::costs
+//! [`graphcut`]: merge::graphcut
+//! [`hole_fill`]: fill::hole_fill
 //! [`join_pits`]: merge::join_pits
 //! [`MAX_STRETCH`]: input::library::MAX_STRETCH
+//! [`cache`]: input::cache
 //!
 //! Sources are prepared once per [`Library`] and their features kept on
 //! disk between processes ([`cache`]).

@@ -68,7 +68,7 @@
 //!   ±[`CLAMP`] before squaring: 16 terms plus the prior's P ≤ 8, times
 //!   κ ≤ 2, stay below 2³² in a u32 (2·24·9459² = 4 294 688 688). Clamping
 //!   only flattens the scores of very bad candidates.
-//! - Ties keep the earlier candidate: Δ in [`DELTAS`] order (Δ = 0 first, so
+//! - Ties keep the earlier candidate: Δ in [`crate::stages::common::DELTAS`] order (Δ = 0 first, so
 //!   a pixel keeps its own coordinate on a tie), C₁ before C₂.
 //!
 //! Scoring reads the nearest texel of each coordinate; the candidate keeps
@@ -86,7 +86,7 @@
 //! offsets, or at (±2, ±1)/(±1, ±2)), and borders reflect by 2 so parity is
 //! kept: subpasses run in place, in parallel, deterministically. Outside
 //! the level, coordinates are extrapolated from the reflected pixel (see
-//! [`neighbour`]).
+//! [`scalar::neighbour`]).
 
 pub mod nudge;
 pub mod scalar;
@@ -330,7 +330,7 @@ pub struct Guide<'a> {
     /// winner's height is nudged by φ_d (eq. 8–9).
     pub targets: Option<&'a [Target]>,
     /// Type constraints: the target set R^i(p) as a bit mask of type ids
-    /// ([`ALL_TYPES`] = unconstrained).
+    /// ([`crate::stages::common::ALL_TYPES`] = unconstrained).
     pub allowed: Option<&'a [u32]>,
     /// Coherence: the previous frame's result of this level and pass, one
     /// more candidate per pixel with its cost × W/4.

@@ -37,7 +37,7 @@
 //! - **Prefetched candidates.** Candidates are listed a few pixels ahead
 //!   of scoring and their texels prefetched (a software pipeline).
 //! - **Vector scoring.** The four diagonal texels of a candidate are two
-//!   `i16x8` loads; residuals are formed in `i32x8`, clamped to ±[`CLAMP`]
+//!   `i16x8` loads; residuals are formed in `i32x8`, clamped to ±[`super::CLAMP`]
 //!   (which fits in i16) and squared-and-summed by `i16x8::dot`, the
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 //! - **A chunk's sources at once.** The AVX2 copy forms every pixel's
