@@ -143,12 +143,11 @@ pub fn ground_offset(
         let k = (v.len() * percent / 100).min(v.len() - 1);
         *v.select_nth_unstable(k).1
     };
-    let steps = (rim.iter()).map(|&(x, y)| height(target(x, y)) - height(source(x, y)));
-    let ground = rim.iter().map(|&(x, y)| height(target(x, y)));
+    let ground: Vec<i32> = rim.iter().map(|&(x, y)| height(target(x, y))).collect();
+    let steps = (rim.iter().zip(&ground)).map(|(&(x, y), g)| g - height(source(x, y)));
     let paste = (footprint.inner.iter()).map(|&(x, y)| height(source(x, y)));
-    let floor =
-        quantile(ground.collect(), FLOOR_PERCENT) - quantile(paste.collect(), FLOOR_PERCENT);
-    quantile(steps.collect(), 50).max(floor)
+    let median = quantile(steps.collect(), 50);
+    median.max(quantile(ground, FLOOR_PERCENT) - quantile(paste.collect(), FLOOR_PERCENT))
 }
 
 /// Bends the values a ground paste writes at one pixel toward the ground
@@ -172,19 +171,11 @@ pub fn seam(atlas: &AtlasLevel<'_>, values: &mut [(Coord, i32)], ground: (Coord,
     values.iter_mut().for_each(|v| v.1 += step);
 }
 
-/// How far (level-`level` pixels, Chebyshev) [`near_seam`] looks for a
-/// pixel not written.
+/// How far (level-`level` pixels, Chebyshev) a pixel of the seam may lie
+/// from a pixel the paste does not write: `SEAM` output px, and one more
+/// pixel.
 pub fn seam_reach(level: usize) -> usize {
     (SEAM / (1u64 << level) as f64).ceil() as usize + 1
-}
-
-/// Whether level-`level` source pixel (x, y) may lie in the seam: some
-/// pixel within `SEAM` output px (and one more pixel) is not written
-/// (`writes`). A cheap test before the exact distance to the lasso.
-pub fn near_seam(level: usize, x: usize, y: usize, writes: impl Fn(i64, i64) -> bool) -> bool {
-    let r = seam_reach(level) as i64;
-    let (x, y) = (x as i64, y as i64);
-    (-r..=r).any(|dy| (-r..=r).any(|dx| !writes(x + dx, y + dy)))
 }
 
 #[cfg(test)]
