@@ -1,6 +1,6 @@
 //! Error types shared across the crate. Each area has its own
 //! `#[non_exhaustive]` enum whose messages state what was wrong and the
-//! allowed range; [`Error`] gathers them for callers that do not care which
+//! allowed range; [`Error`](enum@Error) gathers them for callers that do not care which
 //! area failed (the CLI prints it and exits non-zero).
 
 use crate::size::SizeError;

@@ -148,7 +148,7 @@ impl std::fmt::Debug for Database {
 
 impl Database {
     /// Loads a `.tsdb` file, verifying every checksum and the contents
-    /// (see [`file`]).
+    /// (see [`file`](mod@file)).
     pub fn load(path: &Path) -> Result<Database, DbError> {
         Database::parse(Bytes::read(path)?, path)
     }

@@ -26,7 +26,7 @@
 //!
 //! Distances ([`distance`]): distributions by the Wasserstein-1 distance of
 //! 199 quantiles over the pooled 10–90 % range; scalars by |a−b|/(|a|+|b|).
-//! The **realism ratio** ([`compare`]) is the mean over the nine
+//! The **realism ratio** ([`compare`](fn@compare)) is the mean over the nine
 //! descriptors of d(synthesis, reference) / max(d(left half, right half),
 //! [`compare::FLOOR`]) of the reference: 1.0 = as different as the real
 //! terrain is from itself. Type usage ([`types`]) reads a coordinates map.

@@ -26,7 +26,7 @@
 //!    at the sources' typical lowest level.
 //!
 //! Only the sources whose relief fits the library's take part
-//! ([`Library`], [`MAX_STRETCH`]).
+//! ([`Library`], `input::library::MAX_STRETCH`).
 //!
 //! [`sketch`]: input::sketch
 //! [`ppa`]: input::ppa
@@ -37,7 +37,6 @@
 //! [`graphcut`]: merge::graphcut
 //! [`hole_fill`]: fill::hole_fill
 //! [`join_pits`]: merge::join_pits
-//! [`MAX_STRETCH`]: input::library::MAX_STRETCH
 //! [`cache`]: input::cache
 //!
 //! Sources are prepared once per [`Library`] and their features kept on

@@ -195,7 +195,7 @@ impl Preview {
     }
 }
 
-/// Renders a preview: [`prepare`], then the `shade` stage on the CPU.
+/// Renders a preview: [`prepare`](fn@prepare), then the `shade` stage on the CPU.
 pub fn render(hf: &Heightfield, opts: &RenderOptions) -> Result<Preview, RenderError> {
     render_on(&Engine::default(), hf, opts)
 }

@@ -86,7 +86,7 @@
 //! offsets, or at (±2, ±1)/(±1, ±2)), and borders reflect by 2 so parity is
 //! kept: subpasses run in place, in parallel, deterministically. Outside
 //! the level, coordinates are extrapolated from the reflected pixel (see
-//! [`scalar::neighbour`]).
+//! `scalar::neighbour`).
 
 pub mod nudge;
 pub mod scalar;

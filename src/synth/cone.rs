@@ -11,7 +11,7 @@
 //!   (`reconstruct` blends 3×3 predictions, then repairs extrema among
 //!   3×3 blends);
 //! - **correction** (levels ≤ L): a subpass reads up to
-//!   [`REACH_PER_SUBPASS`] = 2 pixels away, so what must be right after the
+//!   `REACH_PER_SUBPASS` = 2 pixels away, so what must be right after the
 //!   level's `4 · passes` subpasses is computed over a region widened by
 //!   `2 · 4 · passes` (16 with the default 2 passes; the start level of
 //!   smooth exemplars takes more, `coarse::seams`). Pixels that near the

@@ -3,7 +3,7 @@
 //!
 //! Per frame, W⁰ (quarters) is 4 (unweighted) inside the influence of the
 //! constraints, type paint and pastes edited in this step (a replaced
-//! constraint: where its samples changed, see [`mark`]; and where a
+//! constraint: where its samples changed, see `mark`; and where a
 //! sculpt edit changed the target), 1 (coherent,
 //! 0.25) elsewhere and 0 where frozen (freezing brush, pasted regions);
 //! W^i follows by `reduce_weights`. The previous frame's per-pass results

@@ -22,7 +22,7 @@
 //! stretch from a channel head to the junction (or border) below becomes
 //! a curve, with a widget every [`WIDGET_EVERY`] cells at the carved
 //! height and sides that rise, over [`REACH_PX`] pixels, to the smoothed
-//! ground found there ([`side_slope_deg`]): the synthesis then draws
+//! ground found there (`side_slope_deg`): the synthesis then draws
 //! valleys there from the exemplars, as it does for an artist's valley
 //! curve.
 //!

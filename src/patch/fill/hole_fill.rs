@@ -14,7 +14,7 @@
 //! SIMD or the GPU: [`crate::patch::fill::fill_ssd`]), plus the noise-variance difference; the user window is permuted
 //! into each transform's frame once, and every candidate's cells are stored
 //! contiguously, so the kernel streams both. The best 5 per
-//! source go to round two and the graph-cut finalists ([`crate::patch::select`]).
+//! source go to round two and the graph-cut finalists (`crate::patch::select`).
 //!
 //! A fill patch enters as its source has it, tilt included (feature patches
 //! are detrended, [`crate::patch::detrend`]): round two's offset-free SSD then

@@ -7,7 +7,7 @@
 //! database). The key is a 64-bit FNV-1a hash of everything the features
 //! depend on: the DEM's size, cell size and height bits, the preparation
 //! parameters and the relief scale, the crate version, [`FORMAT`], and the
-//! text of every module the preparation runs ([`CODE`]), so any edit to
+//! text of every module the preparation runs (`CODE`), so any edit to
 //! that code (or a new release) makes old entries unreachable instead of
 //! stale. The file repeats the key and carries a CRC-32 of its payload;
 //! an entry that is missing, truncated, corrupted or of another key is

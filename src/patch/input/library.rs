@@ -38,7 +38,7 @@ pub struct Library {
     /// largest of the given sources' 2–98 % reliefs, in metres.
     pub relief: f32,
     /// The given sources too flat for [`Library::relief`] (under
-    /// 1/[`MAX_STRETCH`] of it), with their own relief in metres: left
+    /// 1/`MAX_STRETCH` of it), with their own relief in metres: left
     /// out, and said so to the user.
     pub left_out: Vec<(String, f32)>,
     pub params: Params,

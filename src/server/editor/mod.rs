@@ -1,4 +1,4 @@
-//! One editor session: a thread that owns a [`Session`] (paper §5.3:
+//! One editor session: a thread that owns a [`Session`](crate::synth::session::Session) (paper §5.3:
 //! coherent re-synthesis of only what an edit changed), the scene as last
 //! applied, the undo history and the last preview, and works through a
 //! queue of requests from one browser tab.

@@ -18,7 +18,7 @@
 //!   are summed once for both (8 texel reads per pixel instead of 12).
 //!   The grid is a structure of arrays, and the AVX2 copy fills its row
 //!   runs four neighbours at a time with one column lookup
-//!   ([`grid`]'s `avx2`).
+//!   (`grid`'s `avx2`).
 //! - **C₁ without the clamp.** C₁ = u clamped into u's exemplar's interior
 //!   is u itself unless a neighbour's texel lies on the interior's edge;
 //!   the fill flags those (1.3 % of the pixels at 1024²), so the rest
@@ -42,7 +42,7 @@
 //!   multiply-add that sums pairs of squares (≤ 2·11584², no overflow).
 //! - **A chunk's sources at once.** The AVX2 copy forms every pixel's
 //!   nine u and its mask of distinct ones for a whole chunk before the
-//!   pixel loop, eight pixels per vector ([`gather`]'s `avx2`), instead
+//!   pixel loop, eight pixels per vector (`gather`'s `avx2`), instead
 //!   of per pixel inside it.
 //! - **AVX2 where the CPU has it.** The span is compiled twice, for the
 //!   SSE2 baseline and for AVX2 with BMI1/BMI2/LZCNT/POPCNT, and picked at
@@ -87,7 +87,7 @@ const _: () = assert!(RING > LOOKAHEAD && RING.is_power_of_two());
 /// The rows are walked one column chunk at a time, top to bottom, so that
 /// each chunk's next row reuses three of the grid rows of the one before
 /// (level rows y, y + 1 and y + 2 are rows 2–4 of row y's grid and rows
-/// 0–2 of row y + 2's; see [`grid::fill`] for why they are unchanged):
+/// 0–2 of row y + 2's; see `grid::fill` for why they are unchanged):
 /// a fill reads two rows of taps instead of 4, each level row once per
 /// subpass.
 ///

@@ -10,11 +10,11 @@
 //! **With jitter**, level L starts as a mosaic of **pieces** of the
 //! exemplars, one per cell of a grid of
 //! [`Params::piece_size`](crate::synth::Params) output pixels (32 by
-//! default), cut along wavy edges ([`pieces`]): each piece copies the exemplar around a
+//! default), cut along wavy edges ([`pieces`](fn@pieces)): each piece copies the exemplar around a
 //! texel drawn from the [`Pool`] of every interior texel ranked by the
 //! altitude of its surroundings, at the rank an altitude guide — a smooth
 //! random field of its own (`guide.rs`) — sets for the piece's place
-//! ([`pieces`]), plus the paper's jitter; from L down, jitter and
+//! ([`pieces`](fn@pieces)), plus the paper's jitter; from L down, jitter and
 //! correction join and refine them. Where the user painted terrain types,
 //! a pixel's piece comes from the pool of those types' texels
 //! ([`Pool::of_types`]): correction sees types only at levels ≥ 2 and

@@ -26,12 +26,12 @@ const BAND_PER_MILLE: u32 = 20;
 /// Level L of an output over `region` (absolute level-L pixels: the whole
 /// level, or a window's cone): the level is cut into pieces, one per cell
 /// of a grid of `side` texels anchored at the world's origin, each pixel
-/// to the piece whose centre ([`feature`]) is nearest to it once warped
-/// ([`Cells::nearest`]: a Voronoi mosaic with wavy edges); piece (i, j) copies
+/// to the piece whose centre (`feature`) is nearest to it once warped
+/// (`Cells::nearest`: a Voronoi mosaic with wavy edges); piece (i, j) copies
 /// the exemplar around one texel of the pool, placed at its centre — drawn
 /// by a hash of the seed and (i, j) from the pool's ranks around the
 /// guide's rank there (balanced among the world's pieces in worlds up to
-/// [`guide::BALANCED_SIDE`], [`guide::balance`]) — mirrored at the
+/// `guide::BALANCED_SIDE`, `guide::balance`) — mirrored at the
 /// interior's edges; each pixel gets
 /// the level's jitter (`jitter`, fixed point, the same hash as
 /// `upsample_jitter`) and offset V = 0 (its own altitude).

@@ -32,8 +32,8 @@ pub struct Pool {
 impl Pool {
     /// The pool of exemplar `from` (or of every exemplar) at the level of
     /// `a`: every interior texel, ranked by the mean height of the interior
-    /// texels within [`REGION_PX`] of it (a square; from summed-area tables,
-    /// in integers); the guide's [`Scale`] from those exemplars' sizes.
+    /// texels within `REGION_PX` of it (a square; from summed-area tables,
+    /// in integers); the guide's `Scale` from those exemplars' sizes.
     pub fn new(a: &AtlasLevel<'_>, from: Option<usize>) -> Pool {
         let radius = (REGION_PX >> a.level.index).max(1);
         let rects = &a.level.layout.rects;

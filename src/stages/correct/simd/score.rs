@@ -69,7 +69,7 @@ pub(super) fn score_with<const P: u32>(
 /// Two diagonals per vector, three texels each; V joins mode 1. Two of a
 /// diagonal's texels lie in the grid column c + δx, which the pixels on
 /// either side of it share: they come summed in `left` and `right`
-/// ([`column`] of c − 1 and c + 1); only v = (δx, 0) is read here.
+/// ([`column`](fn@column) of c − 1 and c + 1); only v = (δx, 0) is read here.
 #[inline(always)]
 pub(super) fn neighbourhood(
     app: &[u64],

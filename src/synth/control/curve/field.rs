@@ -159,7 +159,7 @@ pub fn tiles(width: usize) -> impl Iterator<Item = (usize, usize)> {
 ///
 /// Bounded: an editor session re-sketches curves for hours, and every shape
 /// it ever drew stayed (a 1024² curve's field and envelopes are ~1–4 MB).
-/// Past [`FieldCache::budget`] bytes the least recently used shapes are
+/// Past `FieldCache::budget` bytes the least recently used shapes are
 /// dropped (a scene's own curves are used every edit, so they stay); a
 /// dropped shape is computed again if it comes back.
 #[derive(Debug)]

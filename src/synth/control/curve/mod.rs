@@ -303,7 +303,7 @@ impl Curve {
     /// The properties for position `p` whose closest curve point is `hit`:
     /// the side's own slope and reach, or in an end cap the left and right
     /// values blended by the angle around the end point (see
-    /// [`Curve::side`]).
+    /// `Curve::side`).
     pub fn props(&self, hit: Hit, p: DVec2) -> Props {
         let (s, right) = self.side(hit, p);
         Props {
