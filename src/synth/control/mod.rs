@@ -248,6 +248,26 @@ fn distance_to_polygon(poly: &[(f64, f64)], x: f64, y: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Bounds `[x0, y0, x1, y1)` of a `w × h` grid's pixels whose centres may
+/// lie inside `lasso` or less than `grow` outside it (a pixel beyond them
+/// is farther): the lasso's bounding box widened by `grow` and a pixel
+/// more, against rounding in [`inside`]'s crossings. The whole grid when a
+/// vertex is not finite.
+pub fn lasso_bounds(lasso: &[(f64, f64)], grow: f64, w: usize, h: usize) -> [usize; 4] {
+    if lasso.iter().any(|&(x, y)| !x.is_finite() || !y.is_finite()) {
+        return [0, 0, w, h];
+    }
+    let (mut x0, mut y0) = (f64::INFINITY, f64::INFINITY);
+    let (mut x1, mut y1) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for &(x, y) in lasso {
+        (x0, x1) = (x0.min(x), x1.max(x));
+        (y0, y1) = (y0.min(y), y1.max(y));
+    }
+    let lo = |v: f64, n: usize| ((v - grow - 1.5).floor().max(0.0) as usize).min(n);
+    let hi = |v: f64, n: usize| ((v + grow + 1.5).ceil().max(0.0) as usize).min(n);
+    [lo(x0, w), lo(y0, h), hi(x1, w), hi(y1, h)]
+}
+
 /// Whether (x, y) lies inside the closed polygon (even-odd rule).
 pub fn inside(poly: &[(f64, f64)], x: f64, y: f64) -> bool {
     let mut odd = false;
@@ -259,4 +279,23 @@ pub fn inside(poly: &[(f64, f64)], x: f64, y: f64) -> bool {
         }
     }
     odd
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_pixel_beyond_the_lasso_bounds_is_inside() {
+        let lasso = [(3.2, 4.0), (20.7, 5.5), (11.0, 15.9), (6.5, 9.0)];
+        let (w, h) = (30, 25);
+        let [x0, y0, x1, y1] = lasso_bounds(&lasso, 0.0, w, h);
+        for k in 0..w * h {
+            let (x, y) = (k % w, k / w);
+            if inside(&lasso, x as f64 + 0.5, y as f64 + 0.5) {
+                assert!((x0..x1).contains(&x) && (y0..y1).contains(&y), "({x}, {y})");
+            }
+        }
+        assert_eq!(lasso_bounds(&[(f64::NAN, 0.0)], 0.0, w, h), [0, 0, w, h]);
+    }
 }

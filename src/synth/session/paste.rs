@@ -13,7 +13,7 @@ use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::level_size;
 use crate::stages::correct::W_FREE;
-use crate::synth::control::{Lift, Paste, PasteSource, lift};
+use crate::synth::control::{Lift, Paste, PasteSource, lasso_bounds, lift};
 use crate::synth::union;
 
 impl Session<'_> {
@@ -32,7 +32,7 @@ impl Session<'_> {
                 (r.width as usize, r.height as usize)
             }
         };
-        // The source pixels the lasso can hold (see `lasso_bounds`).
+        // The source pixels the lasso can hold (see [`lasso_bounds`]).
         let mut b = lasso_bounds(&p.lasso, p.reach(), sw, sh);
         let mut mask = vec![false; sw * sh];
         for y in b[1]..b[3] {
@@ -180,26 +180,6 @@ impl Session<'_> {
     }
 }
 
-/// Bounds `[x0, y0, x1, y1)` of a `w × h` grid's pixels whose centres may
-/// lie inside `lasso` or less than `grow` outside it (a pixel beyond them
-/// is farther): the lasso's bounding box widened by `grow` and a pixel
-/// more, against rounding in [`crate::synth::control::inside`]'s crossings. The whole grid when a
-/// vertex is not finite.
-fn lasso_bounds(lasso: &[(f64, f64)], grow: f64, w: usize, h: usize) -> [usize; 4] {
-    if lasso.iter().any(|&(x, y)| !x.is_finite() || !y.is_finite()) {
-        return [0, 0, w, h];
-    }
-    let (mut x0, mut y0) = (f64::INFINITY, f64::INFINITY);
-    let (mut x1, mut y1) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-    for &(x, y) in lasso {
-        (x0, x1) = (x0.min(x), x1.max(x));
-        (y0, y1) = (y0.min(y), y1.max(y));
-    }
-    let lo = |v: f64, n: usize| ((v - grow - 1.5).floor().max(0.0) as usize).min(n);
-    let hi = |v: f64, n: usize| ((v + grow + 1.5).ceil().max(0.0) as usize).min(n);
-    [lo(x0, w), lo(y0, h), hi(x1, w), hi(y1, h)]
-}
-
 /// Per pixel of `b` (row-major, `b`'s width): whether every pixel within
 /// `r` (Chebyshev) is set in `mask` (`sw` wide, set only inside `b`; a
 /// pixel beyond the grid is not set), for all pixels at once: a square
@@ -303,19 +283,5 @@ mod tests {
                 }
             }
         }
-    }
-
-    #[test]
-    fn no_pixel_beyond_the_lasso_bounds_is_inside() {
-        let lasso = [(3.2, 4.0), (20.7, 5.5), (11.0, 15.9), (6.5, 9.0)];
-        let (w, h) = (30, 25);
-        let [x0, y0, x1, y1] = lasso_bounds(&lasso, 0.0, w, h);
-        for k in 0..w * h {
-            let (x, y) = (k % w, k / w);
-            if inside(&lasso, x as f64 + 0.5, y as f64 + 0.5) {
-                assert!((x0..x1).contains(&x) && (y0..y1).contains(&y), "({x}, {y})");
-            }
-        }
-        assert_eq!(lasso_bounds(&[(f64::NAN, 0.0)], 0.0, w, h), [0, 0, w, h]);
     }
 }

@@ -18,7 +18,7 @@ use crate::level::atlas::AtlasLevel;
 use crate::level::fixed::Coord;
 use crate::level::state::level_size;
 use crate::synth::cone::Rect;
-use crate::synth::control::{Lift, Paste, PasteSource, lift};
+use crate::synth::control::{Lift, Paste, PasteSource, lasso_bounds, lift};
 use crate::synth::{Frames, PassResult};
 
 /// One paste at one level.
@@ -59,18 +59,8 @@ impl PasteGeometry {
         };
         // Pixel centres i + 0.5 the paste covers lie in these bounds.
         let (sw, sh) = src_size(0);
-        let clip = |v: f64, n: usize| (v.max(0.0) as usize).min(n);
-        let (lo_x, hi_x, lo_y, hi_y) = p.lasso.iter().fold(
-            (f64::MAX, f64::MIN, f64::MAX, f64::MIN),
-            |(a, b, c, d), &(x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
-        );
-        let grow = p.reach() + 1.0;
-        let mut bbox = Rect {
-            x0: clip((lo_x - grow).floor(), sw),
-            y0: clip((lo_y - grow).floor(), sh),
-            x1: clip((hi_x + grow).ceil(), sw),
-            y1: clip((hi_y + grow).ceil(), sh),
-        };
+        let [x0, y0, x1, y1] = lasso_bounds(&p.lasso, p.reach(), sw, sh);
+        let mut bbox = Rect { x0, y0, x1, y1 };
         let mut mask: Vec<bool> = (bbox.y0..bbox.y1)
             .flat_map(|y| (bbox.x0..bbox.x1).map(move |x| (x, y)))
             .map(|(x, y)| p.covers(x as f64 + 0.5, y as f64 + 0.5))
