@@ -88,9 +88,10 @@ impl Synthesizer<'_> {
 
     /// The `passes` correction passes of one `w × h` level under control: each
     /// pass's guide uploaded to the backend, its result recorded into
-    /// `frames`. With [`Guides::restrict`](crate::synth::params::Guides::restrict) and a previous frame, only the
-    /// window that can differ is corrected (the stage gives the rest the
-    /// previous result). Returns the bounds of the pixels that differ from
+    /// `frames`. With
+    /// [`Guides::restrict`](crate::synth::params::Guides::restrict) and a
+    /// previous frame, only the window that can differ is corrected (the
+    /// stage gives the rest the previous result). Returns the bounds of the pixels that differ from
     /// the previous frame's, for the level below.
     pub(super) fn correct_level<B: Backend>(
         &self,

@@ -298,4 +298,26 @@ mod tests {
         }
         assert_eq!(lasso_bounds(&[(f64::NAN, 0.0)], 0.0, w, h), [0, 0, w, h]);
     }
+
+    /// Widened by a ground paste's seam (what the windowed mirror gathers),
+    /// the bounds hold every pixel less than the seam outside the lasso.
+    #[test]
+    fn widened_bounds_hold_the_seam() {
+        let lasso = [(40.2, 44.0), (60.7, 45.5), (51.0, 55.9), (46.5, 49.0)];
+        let (w, h) = (110, 100);
+        let grow = lift::SEAM;
+        let [x0, y0, x1, y1] = lasso_bounds(&lasso, grow, w, h);
+        let mut seam = 0;
+        for k in 0..w * h {
+            let (x, y) = (k % w, k / w);
+            let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+            if inside(&lasso, cx, cy) || distance_to_polygon(&lasso, cx, cy) < grow {
+                seam += usize::from(!inside(&lasso, cx, cy));
+                assert!((x0..x1).contains(&x) && (y0..y1).contains(&y), "({x}, {y})");
+            }
+        }
+        assert!(seam > 0, "the seam lies outside the lasso");
+        // Clipped to the grid where the seam would run off it.
+        assert_eq!(lasso_bounds(&lasso, 50.0, w, h), [0, 0, w, h]);
+    }
 }
